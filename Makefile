@@ -1,0 +1,32 @@
+# Two set-up commands a fresh machine needs: `make run` and `make test`.
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+SAMPLE ?= corpus/iso-m/sample-pocket.nc
+
+.PHONY: run test bench fuzz clean venv
+
+$(STAMP): pyproject.toml
+	$(PY) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+venv: $(STAMP)
+
+run: $(STAMP)
+	$(BIN)/nctrans convert $(SAMPLE) --from iso-m --to sinumerik
+	$(BIN)/nctrans toolpath $(SAMPLE) --from iso-m --summary
+
+test: $(STAMP)
+	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider
+
+bench: $(STAMP)
+	$(BIN)/python bench/bench.py
+
+fuzz: $(STAMP)
+	$(BIN)/python -m pytest -q -p no:cacheprovider tests/fuzz --hypothesis-profile=fuzz
+
+clean:
+	rm -rf $(VENV) build *.egg-info

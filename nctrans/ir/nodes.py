@@ -1,0 +1,411 @@
+"""The dialect-neutral IR.
+
+Every dialect's front end lowers to these nodes; the interpreter, the lowering passes and every
+emitter read them. The IR knows no dialect: modal functions are named by neutral (group, value)
+pairs taken from `rules/<dialect>.toml`, cycles by neutral kinds, variables by neutral spaces.
+
+Two levels of node:
+- *structure* (`Block`, `If`, `While`, `ForLoop`, `Loop`, `RepeatUntil`, `Case`): what a program is
+  made of, in source order. Structured control flow keeps its bodies so emitters can keep it.
+- *statements* inside a `Block`, in execution order (the front end orders them, so the interpreter
+  runs them as listed and needs no dialect knowledge of in-block ordering).
+
+The internal form is plain slotted dataclasses (cheap to build per block); `nctrans.ir.schema`
+gives the JSON form and its pydantic schema.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional, Union
+
+
+@dataclass(slots=True, frozen=True)
+class Span:
+    """Where a node came from: 1-based line and column, end exclusive."""
+    file: str
+    line: int
+    col: int = 1
+    end_line: int = 0
+    end_col: int = 0
+
+
+# --------------------------------------------------------------------------- expressions
+
+@dataclass(slots=True)
+class Num:
+    """A numeric literal. `text` keeps the source spelling (for round trips and decimal-point rules)."""
+    value: float
+    text: Optional[str] = None
+
+
+@dataclass(slots=True)
+class Str:
+    value: str
+
+
+@dataclass(slots=True)
+class Var:
+    """A variable reference.
+
+    space: "num" (ISO macro #n, key int or `index` expr), "R" (R parameters), "name" (declared
+    user/GUD/LUD names), "system" ($-variables, key is the name), "arg" (call argument by letter).
+    indices: array subscripts (Sinumerik A[1,2]) or the computed number of an ISO #[expr].
+    """
+    space: str
+    key: Union[int, str, None]
+    indices: Optional[list["Expr"]] = None
+    span: Optional[Span] = None
+
+
+@dataclass(slots=True)
+class Unary:
+    op: str          # "-", "+", "not", "bnot"
+    operand: "Expr"
+
+
+@dataclass(slots=True)
+class Binary:
+    """op: + - * / pow mod div and or xor band bor bxor == != < <= > >= concat"""
+    op: str
+    left: "Expr"
+    right: "Expr"
+
+
+@dataclass(slots=True)
+class Func:
+    """A builtin function by neutral name (sin cos tan asin acos atan atan2 sqrt abs round fix fup
+    trunc ln exp pow minval maxval ...). Angles are in degrees, as on every supported controller."""
+    name: str
+    args: list["Expr"]
+
+
+Expr = Union[Num, Str, Var, Unary, Binary, Func]
+
+
+# --------------------------------------------------------------------------- statement pieces
+
+@dataclass(slots=True)
+class AxisValue:
+    """A programmed coordinate. mode None follows the modal distance mode; "abs"/"inc" override it
+    for this one word (Sinumerik AC()/IC(), ISO U/V/W on lathes)."""
+    value: Expr
+    mode: Optional[str] = None
+
+
+# --------------------------------------------------------------------------- statements
+
+@dataclass(slots=True)
+class ModeChange:
+    """Select a modal (or one-shot) function: neutral (group, value) from the rules table.
+
+    Examples: ("motion", "linear"), ("plane", "XY"), ("distance", "incremental"),
+    ("units", "inch"), ("feed_mode", "per_rev"), ("cutter_comp", "left"), ("tool_length", "plus"),
+    ("work_offset", "G54"), ("path_mode", "exact_stop"), ("cycle_retract", "r_plane"),
+    ("spindle", "cw"), ("coolant", "flood"), ("cycle", "drill").
+    `code` is the source spelling, for messages only.
+    """
+    group: str
+    value: str
+    code: str = ""
+
+
+@dataclass(slots=True)
+class Motion:
+    """Move to `target` with the modal motion mode in force.
+
+    center: arc centre words (I/J/K), incremental from the start unless AxisValue.mode == "abs".
+    radius: arc radius (ISO R, Sinumerik CR=); negative selects the long arc.
+    turns: extra full turns of an arc or helix (ISO L / Sinumerik TURN=).
+    via: intermediate point of a 3-point arc (Sinumerik CIP).
+    machine_coords: one-shot machine coordinates (ISO G53, Sinumerik SUPA/G53).
+    polar: polar words (angle, radius) when the dialect programs them.
+    """
+    target: dict[str, AxisValue] = field(default_factory=dict)
+    center: Optional[dict[str, AxisValue]] = None
+    radius: Optional[Expr] = None
+    turns: Optional[Expr] = None
+    via: Optional[dict[str, AxisValue]] = None
+    machine_coords: bool = False
+    polar: Optional[dict[str, Expr]] = None
+
+
+@dataclass(slots=True)
+class Feed:
+    value: Expr
+
+
+@dataclass(slots=True)
+class SpindleSpeed:
+    value: Expr
+    spindle: int = 1
+
+
+@dataclass(slots=True)
+class ToolSelect:
+    tool: Expr
+
+
+@dataclass(slots=True)
+class ToolChange:
+    """M6 (or a T that changes the tool at once on dialects without M6)."""
+
+
+@dataclass(slots=True)
+class OffsetSelect:
+    """kind "length" (ISO H) or "radius" (ISO D / Sinumerik D cutting edge)."""
+    kind: str
+    index: Expr
+
+
+@dataclass(slots=True)
+class Dwell:
+    seconds: Optional[Expr] = None
+    revolutions: Optional[Expr] = None
+
+
+@dataclass(slots=True)
+class SetPosition:
+    """ISO G92: the current position becomes `target` in program coordinates (shifts the frame)."""
+    target: dict[str, AxisValue]
+
+
+@dataclass(slots=True)
+class ResetSetPosition:
+    """ISO G92.1/G92.2: drop the G92 shift."""
+
+
+@dataclass(slots=True)
+class FrameOp:
+    """A programmable frame: op in {"trans", "rot", "scale", "mirror"}.
+
+    additive: add to the current programmable frame (Sinumerik ATRANS/AROT...) instead of replacing it.
+    clear: cancel this component (ISO G69/G50/G50.1) or, with op "all", the whole programmable frame.
+    values: per-axis values (translation, scale factor, mirror flag, or rotation angle per axis).
+    center: pivot for ISO G68/G51/G51.1 (program coordinates); angle: rotation in the active plane.
+    local: ISO G52 local coordinate system (a translation that stacks under G68/G51).
+    """
+    op: str
+    values: dict[str, Expr] = field(default_factory=dict)
+    center: Optional[dict[str, AxisValue]] = None
+    angle: Optional[Expr] = None
+    additive: bool = False
+    clear: bool = False
+    local: bool = False
+
+
+@dataclass(slots=True)
+class HomeReturn:
+    """ISO G28/G30 (Sinumerik G74/G75): move via `via` to reference point `ref` (1 = home)."""
+    ref: int
+    via: dict[str, AxisValue] = field(default_factory=dict)
+    ref_index: Optional[Expr] = None
+
+
+@dataclass(slots=True)
+class CycleParams:
+    """Parameters of a canned cycle, neutral keys:
+    bottom (hole bottom), r_plane, retract_plane, safety, peck, dwell (s), shift, repeat, feed_out,
+    plus dialect-neutral extras a cycle needs. For ISO the values are raw programmed values whose
+    meaning (absolute or from R) follows the distance mode; `absolute` records what they are.
+    """
+    values: dict[str, Expr]
+
+
+@dataclass(slots=True)
+class CycleCall:
+    """A one-shot or modal call of a standard cycle by neutral kind with named parameters
+    (Sinumerik CYCLE81 ...). ISO canned cycles use ModeChange("cycle", kind) + CycleParams instead,
+    and the interpreter runs the cycle at each positioning block while the mode is active."""
+    kind: str
+    params: dict[str, Expr]
+    modal: bool = False
+    name: str = ""
+
+
+@dataclass(slots=True)
+class SubCall:
+    """Call a subprogram or macro.
+
+    name: program name as the dialect resolves it (ISO "O1000"/"1000", Sinumerik "L10", "WARMUP").
+    args: positional arguments; named_args: by letter/name (ISO G65 Type I/II letter keys like "A",
+    "I1", "J2"). repeat: repetition count. modal: "none", "after_move" (ISO G66, Sinumerik MCALL).
+    kind: how the source spelled it ("m98", "g65", "g66", "call", "proc", "l") for emitters.
+    """
+    name: str
+    args: list[Expr] = field(default_factory=list)
+    named_args: dict[str, Expr] = field(default_factory=dict)
+    repeat: Optional[Expr] = None
+    modal: str = "none"
+    kind: str = ""
+
+
+@dataclass(slots=True)
+class ModalCallOff:
+    """ISO G67 / Sinumerik MCALL without a name."""
+
+
+@dataclass(slots=True)
+class Return:
+    """Return from a subprogram (ISO M99, Sinumerik RET/M17); to_label: ISO M99 P<n>."""
+    to_label: Optional[str] = None
+
+
+@dataclass(slots=True)
+class ProgramEnd:
+    """kind: "end" (M2), "end_rewind" (M30), "restart" (ISO M99 in a main program)."""
+    kind: str = "end"
+
+
+@dataclass(slots=True)
+class Stop:
+    optional: bool = False
+
+
+@dataclass(slots=True)
+class Assign:
+    target: Var
+    value: Expr
+
+
+@dataclass(slots=True)
+class VarDecl:
+    """Sinumerik DEF: type in {INT, REAL, BOOL, CHAR, STRING, AXIS, FRAME}; dims for arrays."""
+    name: str
+    type: str
+    dims: list[int] = field(default_factory=list)
+    init: Optional[list[Expr]] = None
+    length: Optional[int] = None
+    scope: str = "local"
+
+
+@dataclass(slots=True)
+class Goto:
+    """Jump to a label or block number. direction: "forward", "backward", "any".
+    cond: jump only when true (ISO IF [..] GOTO n, Sinumerik IF .. GOTOF L)."""
+    target: str
+    direction: str = "any"
+    cond: Optional[Expr] = None
+
+
+@dataclass(slots=True)
+class Message:
+    text: Expr
+
+
+@dataclass(slots=True)
+class Alarm:
+    number: Expr
+    text: Optional[Expr] = None
+
+
+@dataclass(slots=True)
+class Passthrough:
+    """A valid construct the IR has no concept for: kept verbatim (never dropped) with why."""
+    text: str
+    reason: str = ""
+    dialect: str = ""
+
+
+Statement = Union[
+    ModeChange, Motion, Feed, SpindleSpeed, ToolSelect, ToolChange, OffsetSelect, Dwell,
+    SetPosition, ResetSetPosition, FrameOp, HomeReturn, CycleParams, CycleCall, SubCall,
+    ModalCallOff, Return, ProgramEnd, Stop, Assign, VarDecl, Goto, Message, Alarm, Passthrough,
+]
+
+
+# --------------------------------------------------------------------------- structure
+
+@dataclass(slots=True)
+class Block:
+    """One NC block (normally one source line).
+
+    number: the N number as written (without N), label: a name label (Sinumerik `LBL:`),
+    skip: block-skip level (0 for plain `/`) or None; body: statements in execution order;
+    comment: the block's comment text (without delimiters).
+    """
+    span: Span
+    body: list[Statement] = field(default_factory=list)
+    number: Optional[str] = None
+    label: Optional[str] = None
+    skip: Optional[int] = None
+    comment: Optional[str] = None
+
+
+@dataclass(slots=True)
+class If:
+    span: Span
+    cond: Expr
+    then: list["Node"]
+    orelse: list["Node"] = field(default_factory=list)
+
+
+@dataclass(slots=True)
+class While:
+    span: Span
+    cond: Expr
+    body: list["Node"]
+    label: Optional[str] = None     # ISO DO m / END m identifier
+
+
+@dataclass(slots=True)
+class ForLoop:
+    span: Span
+    var: Var
+    start: Expr
+    end: Expr
+    body: list["Node"]
+    step: Optional[Expr] = None
+
+
+@dataclass(slots=True)
+class Loop:
+    """Endless loop (Sinumerik LOOP/ENDLOOP); left only by GOTO."""
+    span: Span
+    body: list["Node"]
+
+
+@dataclass(slots=True)
+class RepeatUntil:
+    span: Span
+    body: list["Node"]
+    cond: Expr
+
+
+@dataclass(slots=True)
+class Case:
+    span: Span
+    subject: Expr
+    branches: list[tuple[Expr, str]]     # value -> label to jump to (Sinumerik CASE ... GOTOF)
+    default: Optional[str] = None
+
+
+Node = Union[Block, If, While, ForLoop, Loop, RepeatUntil, Case]
+
+
+@dataclass(slots=True)
+class Param:
+    name: str
+    type: str = "REAL"
+    by_ref: bool = False
+    dims: list[int] = field(default_factory=list)
+
+
+@dataclass(slots=True)
+class Subprogram:
+    name: str
+    span: Span
+    body: list[Node]
+    params: list[Param] = field(default_factory=list)
+
+
+@dataclass(slots=True)
+class Program:
+    """A parsed source file: its main body and the subprograms it defines (ISO O-blocks after the
+    main program, Sinumerik PROC). meta holds header facts: program number/name, `%` marks, the
+    archive header, the dialect profile in force."""
+    file: str
+    dialect: str
+    body: list[Node]
+    subprograms: dict[str, Subprogram] = field(default_factory=dict)
+    meta: dict[str, object] = field(default_factory=dict)
+    name: Optional[str] = None

@@ -1,0 +1,39 @@
+"""The neutral vocabulary of ModeChange (group -> allowed values), cycle kinds and variable spaces.
+
+Front ends map their codes onto these names through `rules/<dialect>.toml`; the interpreter and the
+emitters know only these names. Adding a value here is how a new concept enters the IR.
+"""
+
+MODAL_GROUPS: dict[str, tuple[str, ...]] = {
+    # motion: what a Motion statement does. "cycle" while a canned cycle mode is active is tracked
+    # by the "cycle" group instead; "none" after ISO G80 on controllers that cancel motion (LinuxCNC).
+    "motion": ("rapid", "linear", "arc_cw", "arc_ccw", "thread", "none"),
+    "plane": ("XY", "ZX", "YZ"),
+    "distance": ("absolute", "incremental"),
+    "arc_distance": ("incremental", "absolute"),          # ISO G91.1 / G90.1
+    "units": ("mm", "inch"),
+    "feed_mode": ("per_min", "per_rev", "inverse_time"),
+    "cutter_comp": ("off", "left", "right"),
+    "tool_length": ("off", "plus", "minus"),
+    # work_offset values are ISO names: G53 (none), G54..G59, G54.1P1..G54.1P300 (extended)
+    "work_offset": (),
+    "path_mode": ("exact_stop", "continuous", "tapping", "corner_override"),
+    "exact_stop_once": ("on",),                             # ISO G09: this block only
+    "cycle": ("off", "drill", "drill_dwell", "peck", "chip_break", "tap", "tap_left",
+              "bore_feed_out", "bore_stop_rapid_out", "bore_dwell_feed_out", "fine_bore",
+              "back_bore", "bore_manual"),
+    "cycle_retract": ("initial", "r_plane"),                # ISO G98 / G99
+    "spindle": ("cw", "ccw", "off", "orient"),
+    "spindle_mode": ("rpm", "css"),                         # G97 / G96
+    "coolant": ("mist", "flood", "off", "through"),
+    "polar": ("off", "on"),                                 # ISO G15/G16
+    "diameter": ("radius", "diameter"),                     # lathe DIAMOF/DIAMON
+    "corner": ("arc", "intersection"),                      # Sinumerik G450 / G451
+}
+
+# Cycle-parameter keys used in CycleParams / CycleCall (neutral, all lengths in program units).
+CYCLE_PARAMS = ("bottom", "r_plane", "retract_plane", "safety", "peck", "dwell", "shift",
+                "repeat", "feed", "depth_rel", "first_peck", "decrement", "min_peck", "relief")
+
+# Variable spaces of nodes.Var
+VAR_SPACES = ("num", "R", "name", "system", "arg")

@@ -1,0 +1,42 @@
+"""The toolpath: the flat stream of canonical motions the interpreter produces.
+
+This is the seam (LinuxCNC's canonical calls): backplot, check, equiv and cycle time read these
+records only, never the IR or the source. Units are mm and degrees, machine coordinates after every
+offset, frame and tool-length compensation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant", "stop")
+
+
+@dataclass(slots=True)
+class ToolpathRecord:
+    seq: int
+    file: str
+    line: int
+    kind: str
+    start: Optional[dict[str, float]] = None
+    end: Optional[dict[str, float]] = None
+    center: Optional[dict[str, float]] = None
+    direction: Optional[str] = None        # "cw" | "ccw"
+    plane: Optional[str] = None            # "XY" | "ZX" | "YZ"
+    turns: Optional[int] = None
+    feed: Optional[float] = None
+    feed_mode: Optional[str] = None        # "per_min" | "per_rev" | "inverse_time"
+    spindle: Optional[float] = None
+    tool: Optional[int] = None
+    dwell_s: Optional[float] = None
+    spindle_dir: Optional[str] = None      # spindle events: "cw" | "ccw" | "off" | "orient"
+    coolant: Optional[str] = None          # coolant events: "mist" | "flood" | "off"
+    stop_kind: Optional[str] = None        # stop events: "stop" | "optional" | "end"
+
+    def to_dict(self) -> dict:
+        out = {}
+        for name in self.__slots__:
+            v = getattr(self, name)
+            if v is not None:
+                out[name] = v
+        return out
