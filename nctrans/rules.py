@@ -1,0 +1,76 @@
+"""Dialect code tables (`rules/<dialect>.toml`) loaded and validated with pydantic.
+
+A table lists every G/M (or keyword) code a dialect knows: its neutral (group, value) meaning from
+`nctrans.ir.vocabulary`, its own modal-group number, whether it is modal, whether it is the power-on
+default, a one-line meaning and the seed reference. Front ends look codes up here; emitters look the
+reverse way; the lint catalogue documents from here. No G-code tables in if-chains.
+"""
+from __future__ import annotations
+
+import tomllib
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Optional
+
+from pydantic import BaseModel, ConfigDict, Field
+
+RULES_DIR = Path(__file__).resolve().parent.parent / "rules"
+
+
+def normalise_code(letter: str, number: str | float | int) -> str:
+    """Canonical spelling of a numbered code: G00 -> G0, G01.0 -> G1, g54.1 -> G54.1."""
+    text = str(number).strip()
+    if "." in text:
+        whole, frac = text.split(".", 1)
+        frac = frac.rstrip("0")
+        whole = str(int(whole or "0"))
+        return f"{letter.upper()}{whole}.{frac}" if frac else f"{letter.upper()}{whole}"
+    return f"{letter.upper()}{int(text)}"
+
+
+class CodeRule(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    code: str                       # canonical spelling, e.g. "G0", "G54.1", "M3", "TRANS"
+    group: str                      # neutral group ("motion", "plane", ...) or a statement kind
+    value: str = ""                 # neutral value within the group
+    modal: bool = True
+    default: bool = False           # power-on/reset default of its group
+    dialect_group: Optional[int | str] = None   # the manual's own group number/name
+    meaning: str = ""
+    ref: str = ""                   # seed line reference
+    args: dict[str, str] = Field(default_factory=dict)   # address letter -> neutral parameter
+
+
+class RulesTable(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    dialect: str
+    description: str = ""
+    options: dict[str, Any] = Field(default_factory=dict)
+    addresses: dict[str, str] = Field(default_factory=dict)   # letter -> what it is
+    codes: list[CodeRule] = Field(default_factory=list)
+
+    def model_post_init(self, _ctx: Any) -> None:
+        self._by_code = {c.code.upper(): c for c in self.codes}
+        self._by_meaning: dict[tuple[str, str], CodeRule] = {}
+        for c in self.codes:
+            self._by_meaning.setdefault((c.group, c.value), c)
+
+    def lookup(self, code: str) -> Optional[CodeRule]:
+        """The rule for a canonical code spelling (see normalise_code), or None if unknown."""
+        return self._by_code.get(code.upper())
+
+    def code_for(self, group: str, value: str) -> Optional[CodeRule]:
+        """The first code (table order = preferred spelling) that selects (group, value)."""
+        return self._by_meaning.get((group, value))
+
+    def defaults(self) -> dict[str, str]:
+        """Power-on modal state {group: value}, handed to the interpreter via Program.meta."""
+        return {c.group: c.value for c in self.codes if c.default}
+
+
+@lru_cache(maxsize=None)
+def load_table(dialect: str) -> RulesTable:
+    path = RULES_DIR / f"{dialect}.toml"
+    with path.open("rb") as fh:
+        data = tomllib.load(fh)
+    return RulesTable.model_validate(data)
