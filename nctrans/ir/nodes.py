@@ -230,6 +230,9 @@ class SubCall:
     args: positional arguments; named_args: by letter/name (ISO G65 Type I/II letter keys like "A",
     "I1", "J2"). repeat: repetition count. modal: "none", "after_move" (ISO G66, Sinumerik MCALL).
     kind: how the source spelled it ("m98", "g65", "g66", "call", "proc", "l") for emitters.
+    bindings: where each named argument lands in the callee (ISO G65 "A" -> Var("num", 1)), so the
+    interpreter binds arguments without dialect knowledge. Positional args bind to the callee's
+    Subprogram.params in order.
     """
     name: str
     args: list[Expr] = field(default_factory=list)
@@ -237,6 +240,7 @@ class SubCall:
     repeat: Optional[Expr] = None
     modal: str = "none"
     kind: str = ""
+    bindings: dict[str, "Var"] = field(default_factory=dict)
 
 
 @dataclass(slots=True)
