@@ -303,6 +303,21 @@ class Alarm:
 
 
 @dataclass(slots=True)
+class DataSetting:
+    """Programmable data input (ISO G10): write a work offset or a tool-offset table entry.
+
+    kind "work_offset": values per axis letter; index 0 = external offset, 1..6 = G54..G59, or with
+    extended=True the G54.1 P number (G10 L20). kind "tool_length" / "tool_length_wear" /
+    "tool_radius" / "tool_radius_wear": values {"value": R}, index = offset number (G10 L10-L13).
+    Under incremental distance mode the values are added to the stored ones (seed L1197-1204).
+    """
+    kind: str
+    index: "Expr"
+    values: dict[str, "Expr"] = field(default_factory=dict)
+    extended: bool = False
+
+
+@dataclass(slots=True)
 class Passthrough:
     """A valid construct the IR has no concept for: kept verbatim (never dropped) with why."""
     text: str
@@ -314,6 +329,7 @@ Statement = Union[
     ModeChange, Motion, Feed, SpindleSpeed, ToolSelect, ToolChange, OffsetSelect, Dwell,
     SetPosition, ResetSetPosition, FrameOp, HomeReturn, CycleParams, CycleCall, SubCall,
     ModalCallOff, Return, ProgramEnd, Stop, Assign, VarDecl, Goto, Message, Alarm, Passthrough,
+    DataSetting,
 ]
 
 
