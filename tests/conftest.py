@@ -1,0 +1,55 @@
+"""Shared fixtures: where the read-only shared tree is, and LinuxCNC's rs274 as the reference.
+
+The corpus is read in place from ../shared (never copied into the project). rs274 is optional on a
+developer machine (its tests skip) but required in CI: with CI set, a missing rs274 is a failure, so
+the reference comparison cannot silently vanish from the pipeline.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+TESTS = Path(__file__).resolve().parent
+SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+CORPUS = SHARED / "corpus"
+DATA = TESTS / "data"
+
+
+@pytest.fixture(scope="session")
+def shared_dir() -> Path:
+    return SHARED
+
+
+@pytest.fixture(scope="session")
+def corpus_dir() -> Path:
+    if not CORPUS.is_dir():
+        pytest.skip(f"shared corpus not found at {CORPUS}")
+    return CORPUS
+
+
+@pytest.fixture(scope="session")
+def data_dir() -> Path:
+    return DATA
+
+
+@pytest.fixture(scope="session")
+def rs274() -> Path:
+    """Path of LinuxCNC's stand-alone rs274: skip without it, but fail when CI is set."""
+    import rs274 as harness
+    found = shutil.which("rs274") or (harness.RS274 if Path(harness.RS274).exists() else None)
+    if found is None:
+        msg = "LinuxCNC rs274 not installed (Debian package linuxcnc-uspace)"
+        if os.environ.get("CI"):
+            pytest.fail(msg + " and CI is set: the reference comparison must run in CI", pytrace=False)
+        pytest.skip(msg)
+    harness.RS274 = found
+    return Path(found)
+
+
+@pytest.fixture(scope="session")
+def rs274_cache(tmp_path_factory) -> Path:
+    """Per-session directory for rs274 outputs, so each program runs through rs274 once."""
+    return tmp_path_factory.mktemp("rs274")
