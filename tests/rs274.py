@@ -45,7 +45,8 @@ PLANES = {
     "CANON_PLANE_XZ": ("Z", "X", "Y", "ZX"),
 }
 
-_CALL = re.compile(r"^\s*(\d+)\s+(N\S*)\s+([A-Z_0-9]+)\((.*)\)")
+# "%5d N%-6s" then the call: a 6-digit N word runs straight into the name ("N110795PROGRAM_END()")
+_CALL = re.compile(r"^\s*(\d+)\s+(N(?:\.+|\d*))\s*([A-Z_][A-Z_0-9]*)\((.*)\)")
 _NUM = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 
 
