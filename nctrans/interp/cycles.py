@@ -1,0 +1,334 @@
+"""Canned (hole-machining) cycles expanded into plain moves, dwells and spindle events.
+
+The interpreter calls `expand_cycle` once per cycle block; the result is what a controller does for
+that block, so backplot, cycle time and "flatten cycles" emitters never see a cycle.
+
+The judge is LinuxCNC's rs274 (2.9): wherever LinuxCNC has the cycle, the steps reproduce its
+canonical calls exactly (checked by tests/test_cycles.py against rs274). Where the ISO digest
+(specs/iso.md §5, the Siemens ISO-mode / Fanuc behaviour) differs, the difference is listed here:
+
+- Initial level (iso.md §5.1 "Zi", L2456-2469): LinuxCNC records it once per cycle series and, under
+  G98, positions in the plane at max(Zi, R) even when the tool is lower (after a G99 hole it rises
+  diagonally); under G99 it positions at the current height. If Zi (G98) or the current height
+  (G99) is below R, it first rapids the drilling axis alone up to R at the old plane position, then
+  moves in the plane (§5.3 prologue says "RAP(x,y) at current Z*; RAP(Zr)", which would drag the
+  tool through the part). G98 then returns to max(Zi, R).
+- G73 (chip_break) and G83 (peck): same stroke pattern as §5.3, but LinuxCNC's back-off / re-approach
+  distance d is 0.010 inch, i.e. 0.254 mm in both inch and mm programs (§5.3 / §5.4: `_ZSFR[1]`
+  default 1 mm or 1 inch for G73; G83 automatic 0.6 mm or depth/50). Pecks stop at the first depth
+  not deeper than the bottom (LinuxCNC: `depth > bottom`), then one feed to the bottom.
+- G84 / G74 (tap, tap_left): LinuxCNC feeds out all the way to the clear level (Zi under G98) with
+  the spindle reversed, dwelling P only once at the bottom after reversing: stop, reverse, dwell,
+  feed out, stop, forward. §5.3 feeds out to R only, dwells at both ends and rapids to Zi.
+  The dwell is always emitted (P defaults to 0 in LinuxCNC).
+- G85 (bore_feed_out): identical to §5.3 (feed to R, rapid to the clear level even under G99).
+- G86 (bore_stop_rapid_out): LinuxCNC dwells P at the bottom before stopping the spindle (P is
+  required there); §5.3 has no dwell.
+- G89 (bore_dwell_feed_out): LinuxCNC feeds out all the way to the clear level; §5.3 feeds to R and
+  rapids to Zi.
+- G88 (bore_manual, not in the ISO digest): feed, dwell, spindle stop, program stop, spindle restart.
+  No retract move is emitted; LinuxCNC then takes the tool to be at the clear level (the operator
+  retracted by hand), so the caller must set the drilling axis to the clear level afterwards.
+- G76 (fine_bore) and G87 (back_bore): LinuxCNC's G76 is lathe threading and its G87 uses I/J/K, so
+  these follow §5.3 (lift-off direction `_ZSFI[5]` default: minus the first plane axis, table §5.3).
+
+Heights are compared along the drilling direction (from `approach` towards `bottom`), so Sinumerik
+cycles drilling in +Z work too; LinuxCNC would reject R below Z (see `cycle_problems`).
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from functools import lru_cache
+from typing import Literal, Optional, Sequence
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from nctrans.rules import RULES_DIR
+
+DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
+PLANE_AXES = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}
+
+# LinuxCNC G83_RAPID_DELTA: 0.010 inch, multiplied by 25.4 in mm programs -> the same 0.254 mm.
+PECK_CLEARANCE_INCH = 0.010
+# More pecks than this is a runaway (tiny Q); expansion stops pecking and cycle_problems says so.
+MAX_PECKS = 10_000
+
+Step = tuple
+
+
+def peck_clearance_mm(units_mm: bool) -> float:
+    """LinuxCNC's G73 back-off and G83 re-approach distance, in mm (the same for inch and mm programs)."""
+    return PECK_CLEARANCE_INCH * 25.4
+
+
+def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dict[str, float],
+                 approach: float, bottom: float, retract: float, peck: float | None,
+                 dwell_s: float | None, shift: float | None, feed: float,
+                 spindle_dir: str | None, units_mm: bool,
+                 repeat: int = 1, step: Optional[dict[str, float]] = None,
+                 liftoff: Optional[str] = None) -> list[Step]:
+    """The steps of one cycle block: ("rapid"|"linear", point) | ("dwell", s) | ("spindle", dir) | ("stop", "stop").
+
+    `retract` is the level the hole ends at: the initial level Zi under G98 (may be below R; the
+    clear level is then R), `approach` (R) under G99. `repeat` (ISO K/L) drills that many holes in
+    one block, each shifted by `step` (the G91 plane increments) from the previous one; `hole` is
+    the first. Points are full axis dicts. Never raises on user values; see `cycle_problems`.
+    """
+    ax = DRILL_AXIS[plane]
+    a1, a2 = PLANE_AXES[plane]
+    cur = dict(position)
+    steps: list[Step] = []
+
+    def move(kind_: str, **axes: float) -> None:
+        nonlocal cur
+        cur = dict(cur)
+        cur.update(axes)
+        steps.append((kind_, cur))
+
+    def to_level(kind_: str, level: float) -> None:
+        move(kind_, **{ax: level})
+
+    if kind == "back_bore":
+        up = 1.0 if retract >= approach else -1.0
+    else:
+        up = 1.0 if approach >= bottom else -1.0
+
+    def above(a: float, b: float) -> bool:
+        return (a - b) * up > 0
+
+    # Where the tool travels in the plane, and where each hole ends (LinuxCNC old_cc / clear_cc).
+    base = retract if retract != approach else cur.get(ax, approach)
+    travel = base
+    if kind != "back_bore" and above(approach, base):
+        to_level("rapid", approach)
+        travel = approach
+    clear = retract if above(retract, approach) or kind == "back_bore" else approach
+
+    lift_axis, lift_sign = _liftoff(plane, liftoff)
+    q_shift = abs(shift) if shift else 0.0
+    delta = peck_clearance_mm(units_mm) * up
+
+    target = {a1: hole.get(a1, cur.get(a1, 0.0)), a2: hole.get(a2, cur.get(a2, 0.0))}
+    for k in range(max(repeat, 0)):
+        if k and step:
+            target = {a: target[a] + step.get(a, 0.0) for a in (a1, a2)}
+        move("rapid", **target, **{ax: travel})
+        if kind == "back_bore":
+            _back_bore(steps, move, to_level, ax, lift_axis, lift_sign * q_shift, target,
+                       approach, bottom, clear, dwell_s, spindle_dir)
+            travel = clear
+            continue
+        if travel != approach:
+            to_level("rapid", approach)
+        if kind in ("peck", "chip_break"):
+            depth = approach - up * (peck or 0.0)
+            count = 0
+            while peck and peck > 0 and above(depth, bottom) and count < MAX_PECKS:
+                to_level("linear", depth)
+                if kind == "peck":
+                    to_level("rapid", approach)
+                to_level("rapid", depth + delta)
+                depth = depth - up * peck
+                count += 1
+            to_level("linear", bottom)
+            to_level("rapid", clear)
+        elif kind in ("tap", "tap_left"):
+            fwd, rev = ("cw", "ccw") if kind == "tap" else ("ccw", "cw")
+            to_level("linear", bottom)
+            steps += [("spindle", "off"), ("spindle", rev), ("dwell", dwell_s or 0.0)]
+            to_level("linear", clear)
+            steps += [("spindle", "off"), ("spindle", fwd)]
+        elif kind == "fine_bore":
+            to_level("linear", bottom)
+            if dwell_s is not None:
+                steps.append(("dwell", dwell_s))
+            steps.append(("spindle", "orient"))
+            move("rapid", **{lift_axis: target[lift_axis] + lift_sign * q_shift})
+            to_level("rapid", clear)
+            move("rapid", **{lift_axis: target[lift_axis]})
+            steps.append(("spindle", spindle_dir if spindle_dir in ("cw", "ccw") else "cw"))
+        else:
+            to_level("linear", bottom)
+            if kind in ("drill_dwell", "bore_stop_rapid_out", "bore_dwell_feed_out",
+                        "bore_manual") and dwell_s is not None:
+                steps.append(("dwell", dwell_s))
+            if kind == "bore_feed_out":
+                to_level("linear", approach)
+                to_level("rapid", clear)
+            elif kind == "bore_dwell_feed_out":
+                to_level("linear", clear)
+            elif kind in ("bore_stop_rapid_out", "bore_manual"):
+                steps.append(("spindle", "off"))
+                if kind == "bore_manual":
+                    steps.append(("stop", "stop"))
+                    cur = dict(cur)
+                    cur[ax] = clear          # the operator retracts; LinuxCNC assumes the clear level
+                else:
+                    to_level("rapid", clear)
+                if spindle_dir in ("cw", "ccw"):
+                    steps.append(("spindle", spindle_dir))
+            else:                            # drill, drill_dwell
+                to_level("rapid", clear)
+        travel = clear
+    return steps
+
+
+def _back_bore(steps, move, to_level, ax, lift_axis, q, target, approach, bottom, clear,
+               dwell_s, spindle_dir) -> None:
+    """iso.md §5.3 G87: enter the hole shifted, cut upwards from R (hole bottom) to Z, leave shifted."""
+    restart = spindle_dir if spindle_dir in ("cw", "ccw") else "cw"
+    steps.append(("spindle", "orient"))
+    move("rapid", **{lift_axis: target[lift_axis] + q})
+    to_level("rapid", approach)
+    move("rapid", **{lift_axis: target[lift_axis]})
+    steps.append(("spindle", restart))
+    to_level("linear", bottom)
+    if dwell_s is not None:
+        steps.append(("dwell", dwell_s))
+    steps.append(("spindle", "orient"))
+    move("rapid", **{lift_axis: target[lift_axis] + q})
+    to_level("rapid", clear)
+    move("rapid", **{lift_axis: target[lift_axis]})
+    steps.append(("spindle", restart))
+
+
+def _liftoff(plane: str, liftoff: Optional[str]) -> tuple[str, float]:
+    """G76/G87 shift direction: "+X", "-Y", ... or the `_ZSFI[5]`=0 default (minus the first plane axis)."""
+    if liftoff and len(liftoff) == 2 and liftoff[0] in "+-" and liftoff[1].upper() in PLANE_AXES[plane]:
+        return liftoff[1].upper(), (1.0 if liftoff[0] == "+" else -1.0)
+    return PLANE_AXES[plane][0], -1.0
+
+
+DWELL_REQUIRED = ("drill_dwell", "bore_stop_rapid_out", "bore_dwell_feed_out", "bore_manual")
+
+
+def cycle_problems(kind: str, *, approach: float, bottom: float, peck: float | None,
+                   dwell_s: float | None, shift: float | None, spindle_dir: str | None,
+                   repeat: int = 1) -> list[str]:
+    """What LinuxCNC (or the ISO spec, for cycles it lacks) rejects in these values: NC206/NC204 texts."""
+    out: list[str] = []
+    if kind != "back_bore" and approach < bottom:
+        out.append("R plane below the hole bottom (LinuxCNC: R less than Z in cycle)")
+    if kind in ("peck", "chip_break"):
+        if peck is None:
+            out.append("peck depth Q missing")
+        elif peck <= 0:
+            out.append("peck depth Q must be positive")
+        elif abs(approach - bottom) / peck > MAX_PECKS:
+            out.append(f"more than {MAX_PECKS} pecks: peck depth Q too small")
+    if kind in DWELL_REQUIRED and dwell_s is None:
+        out.append("dwell time P missing")
+    if kind == "tap" and spindle_dir != "cw":
+        out.append("spindle must turn clockwise (M3) for right-hand tapping")
+    if kind == "tap_left" and spindle_dir != "ccw":
+        out.append("spindle must turn counterclockwise (M4) for left-hand tapping")
+    if kind in ("bore_stop_rapid_out", "bore_manual") and spindle_dir not in ("cw", "ccw"):
+        out.append("spindle not turning")
+    if kind in ("fine_bore", "back_bore") and not shift:
+        out.append("shift Q missing or zero")
+    if repeat < 0:
+        out.append("negative repeat count")
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Sinumerik standard cycles (rules/cycles.toml)
+
+class KindBy(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    param: str
+    values: dict[str, str]
+
+
+class SinumerikCycle(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    name: str
+    kind: str
+    meaning: str = ""
+    params: list[str]
+    kind_by: Optional[KindBy] = None
+
+
+class HolePattern(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    name: str
+    shape: Literal["row", "circle"]
+    meaning: str = ""
+    params: list[str]
+
+
+class CycleTable(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    names: dict[str, str] = Field(default_factory=dict)
+    cycle: list[SinumerikCycle] = Field(default_factory=list)
+    pattern: list[HolePattern] = Field(default_factory=list)
+
+    def neutral(self, name: str) -> str:
+        """The neutral key of a Siemens parameter name, or its lowercase spelling if it has none."""
+        return self.names.get(name, name.lower())
+
+
+@lru_cache(maxsize=1)
+def cycle_table() -> CycleTable:
+    with open(RULES_DIR / "cycles.toml", "rb") as fh:
+        return CycleTable.model_validate(tomllib.load(fh))
+
+
+def sinumerik_cycles() -> dict[str, SinumerikCycle]:
+    return {c.name: c for c in cycle_table().cycle}
+
+
+def sinumerik_cycle_args(name: str, args: Sequence[float | None]) -> Optional[tuple[str, dict[str, float]]]:
+    """Bind positional CYCLExx arguments (None = empty) to neutral keys: (kind, params), or None if unknown.
+
+    Arguments beyond the parameter list are dropped (the front end reports them).
+    """
+    cyc = sinumerik_cycles().get(name.upper())
+    if cyc is None:
+        return None
+    table = cycle_table()
+    params = {table.neutral(p): float(v) for p, v in zip(cyc.params, args) if v is not None}
+    kind = cyc.kind
+    if cyc.kind_by is not None:
+        sel = dict(zip(cyc.params, args)).get(cyc.kind_by.param)
+        kind = cyc.kind_by.values.get(str(int(sel)) if sel is not None else "0", kind)
+    return kind, params
+
+
+def sinumerik_cycle_levels(params: dict[str, float], *, current: float) -> tuple[float, float, float]:
+    """(approach, bottom, retract) of a Sinumerik drilling cycle from RTP, RFP, SDIS, DP, DPR.
+
+    approach = RFP + SDIS (towards RTP), retract = RTP (`current` when RTP is not given), bottom = DP,
+    or RFP - DPR when DPR is given: the Siemens cycles manual [GK] says DPR wins when both are
+    programmed. The drilling direction is from RTP towards RFP (RTP below RFP drills upwards).
+    A missing RFP is taken as 0; a missing depth gives bottom = RFP (the caller reports NC206).
+    """
+    rfp = params.get("r_plane", 0.0)
+    rtp = params.get("retract_plane", current)
+    up = 1.0 if rtp >= rfp else -1.0
+    approach = rfp + up * abs(params.get("safety", 0.0))
+    if "depth_rel" in params:
+        bottom = rfp - up * abs(params["depth_rel"])
+    else:
+        bottom = params.get("bottom", rfp)
+    return approach, bottom, rtp
+
+
+def hole_pattern(name: str, args: Sequence[float | None]) -> list[tuple[float, float]]:
+    """Plane positions (abscissa, ordinate) of HOLES1 (row) / HOLES2 (circle); [] if unknown or NUM < 1."""
+    pat = {p.name: p for p in cycle_table().pattern}.get(name.upper())
+    if pat is None:
+        return []
+    v = {p: (float(a) if a is not None else 0.0) for p, a in zip(pat.params, args)}
+    v.update({p: 0.0 for p in pat.params if p not in v})
+    num = int(v["NUM"])
+    if num < 1 or num > MAX_PECKS:
+        return []
+    if pat.shape == "row":
+        ang = math.radians(v["STA1"])
+        return [(v["SPCA"] + (v["FDIS"] + i * v["DBH"]) * math.cos(ang),
+                 v["SPCO"] + (v["FDIS"] + i * v["DBH"]) * math.sin(ang)) for i in range(num)]
+    inda = v["INDA"] if v["INDA"] else 360.0 / num
+    return [(v["CPA"] + v["RAD"] * math.cos(math.radians(v["STA1"] + i * inda)),
+             v["CPO"] + v["RAD"] * math.sin(math.radians(v["STA1"] + i * inda))) for i in range(num)]
