@@ -1,0 +1,198 @@
+"""Throughput and memory of lint and toolpath on the largest ISO milling corpus programs (`make bench`).
+
+For each program: lines/s in-process (parse + interpret, and parse + interpret + JSONL serialisation
+to a null sink), the CLI end to end (subprocess wall time, output to /dev/null), LinuxCNC rs274 on the
+same file in the same run and the CLI/rs274 time ratio. Then peak memory (tracemalloc) for one
+program and for the same program repeated 10x: the IR is held whole (it grows with the text), the
+interpreter streams, so its peak beyond the IR must stay flat. Plain-text table; no assertions.
+"""
+from __future__ import annotations
+
+import argparse
+import gc
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import tracemalloc
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared"
+CORPUS = SHARED / "corpus" / "iso-mill"
+PROGRAMS = ("mheaton-fusion-adaptive-1001.nc", "camotics-flower_mold.nc", "camotics-bear.nc")
+RS274 = shutil.which("rs274") or "/usr/bin/rs274"
+NCTRANS = [str(Path(sys.executable).with_name("nctrans"))]
+if not Path(NCTRANS[0]).exists():
+    NCTRANS = [sys.executable, "-m", "nctrans.cli"]
+
+
+class NullSink:
+    def write(self, s: str) -> int:
+        return len(s)
+
+
+def read_text(path: Path) -> str:
+    data = path.read_bytes()
+    try:
+        from nctrans import source
+        return source.decode(data, path.name).text
+    except ImportError:
+        return data.decode("utf-8", errors="replace")
+
+
+def parse(text: str, name: str):
+    from nctrans.dialects.base import get
+    return get("iso-m").parse(text, name)
+
+
+def interpret(program, diagnostics: list):
+    from nctrans.interp import interpret as run
+    return run(program, None, diagnostics=diagnostics)
+
+
+def lint_in_process(text: str, name: str) -> int:
+    """What lint computes: parse diagnostics plus the interpreter's (records are discarded)."""
+    res = parse(text, name)
+    diags = list(res.diagnostics)
+    for _ in interpret(res.program, diags):
+        pass
+    return len(diags)
+
+
+def toolpath_in_process(text: str, name: str) -> int:
+    """Parse + interpret + one JSON line per record to a null sink."""
+    res = parse(text, name)
+    sink = NullSink()
+    n = 0
+    dumps = json.JSONEncoder(separators=(",", ":")).encode
+    for rec in interpret(res.program, list(res.diagnostics)):
+        sink.write(dumps(rec.to_dict()) + "\n")
+        n += 1
+    return n
+
+
+def best_time(fn, repeat: int) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        gc.collect()
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def wall(cmd: list[str], repeat: int) -> tuple[float, int]:
+    """Best wall time and the exit code; exit 3 stands for a crash (traceback on stderr)."""
+    best, rc = float("inf"), 0
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        best = min(best, time.perf_counter() - t0)
+        rc = 3 if b"Traceback" in proc.stderr else proc.returncode
+    return best, rc
+
+
+def rs274_time(path: Path, repeat: int, tmp: Path) -> float | None:
+    if not Path(RS274).exists():
+        return None
+    tbl = tmp / "zero.tbl"
+    if not tbl.exists():
+        tbl.write_text("".join(f"T{n} P{n} Z0 D0 ;\n" for n in range(1, 100)))
+    t, _ = wall([RS274, "-t", str(tbl), "-g", str(path), str(tmp / "rs274.out")], repeat)
+    return t
+
+
+def repeated(text: str, times: int) -> str:
+    """The program body `times` over, one header and one end, so the interpreter runs it all."""
+    end = re.compile(r"^\s*(%|O\d+.*|.*\bM0*(2|30)\b.*)\s*$", re.IGNORECASE)
+    body = "\n".join(line for line in text.splitlines() if not end.match(line))
+    return "%\n" + "\n".join([body] * times) + "\nM30\n%\n"
+
+
+def peaks(text: str, name: str) -> tuple[float, float]:
+    """(peak MiB while parsing, peak MiB above the parsed IR while interpreting + serialising)."""
+    gc.collect()
+    tracemalloc.start()
+    res = parse(text, name)
+    parse_peak = tracemalloc.get_traced_memory()[1]
+    held = tracemalloc.get_traced_memory()[0]
+    tracemalloc.reset_peak()
+    sink = NullSink()
+    for rec in interpret(res.program, list(res.diagnostics)):
+        sink.write(json.dumps(rec.to_dict()))
+    interp_peak = tracemalloc.get_traced_memory()[1] - held
+    tracemalloc.stop()
+    return parse_peak / 2**20, interp_peak / 2**20
+
+
+def fmt(v, spec=",.0f"):
+    return "n/a" if v is None else format(v, spec)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=2, help="runs per measurement; the best is shown")
+    ap.add_argument("programs", nargs="*", help="programs (default: the three largest iso-mill ones)")
+    args = ap.parse_args(argv)
+    paths = [Path(p) for p in args.programs] or [CORPUS / p for p in PROGRAMS]
+    paths = [p for p in paths if p.exists()]
+    if not paths:
+        print(f"no programs found (corpus expected at {CORPUS})")
+        return 0
+    print(f"python {sys.version.split()[0]}, rs274 {'found' if Path(RS274).exists() else 'missing'}, "
+          f"best of {args.repeat}; lines/s = source lines / seconds")
+    head = (f"{'program':34} {'lines':>6} {'records':>8} {'lint l/s':>10} {'toolpath l/s':>12} "
+            f"{'CLI lint s':>10} {'CLI tp s':>9} {'CLI tp l/s':>10} {'rs274 s':>8} {'CLI/rs274':>9}")
+    print(head)
+    print("-" * len(head))
+    notes = []
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        for path in paths:
+            text = read_text(path)
+            lines = text.count("\n") or 1
+            records = lint_rate = tp_rate = None
+            try:
+                records = toolpath_in_process(text, path.name)
+                lint_rate = lines / best_time(lambda: lint_in_process(text, path.name), args.repeat)
+                tp_rate = lines / best_time(lambda: toolpath_in_process(text, path.name), args.repeat)
+            except Exception as e:                      # a missing stage: report, keep benchmarking
+                notes.append(f"{path.name}: in-process: {type(e).__name__}: {e}")
+            cli_lint, rc_l = wall(NCTRANS + ["lint", str(path), "--from", "iso-m"], args.repeat)
+            cli_tp, rc_t = wall(NCTRANS + ["toolpath", str(path), "--from", "iso-m", "--format", "jsonl"],
+                                args.repeat)
+            if rc_t >= 2:
+                notes.append(f"{path.name}: CLI toolpath exit {rc_t}")
+                cli_tp = None
+            if rc_l >= 2:
+                notes.append(f"{path.name}: CLI lint exit {rc_l}")
+                cli_lint = None
+            rs = rs274_time(path, args.repeat, tmp)
+            ratio = cli_tp / rs if cli_tp and rs else None
+            print(f"{path.name[:34]:34} {lines:>6} {fmt(records):>8} {fmt(lint_rate):>10} {fmt(tp_rate):>12} "
+                  f"{fmt(cli_lint, '.3f'):>10} {fmt(cli_tp, '.3f'):>9} "
+                  f"{fmt(lines / cli_tp if cli_tp else None):>10} {fmt(rs, '.3f'):>8} {fmt(ratio, '.2f'):>9}")
+        print()
+        print("peak memory (tracemalloc, MiB): parse holds the IR; interpret+serialise is measured above it")
+        print(f"{'program':40} {'lines':>7} {'parse peak':>11} {'interp peak':>12}")
+        base = paths[0]
+        text = read_text(base)
+        for label, t in ((base.name, text), (f"{base.name} x10", repeated(text, 10))):
+            try:
+                p, i = peaks(t, base.name)
+                print(f"{label[:40]:40} {t.count(chr(10)):>7} {p:>11.1f} {i:>12.2f}")
+            except Exception as e:
+                print(f"{label[:40]:40} {t.count(chr(10)):>7} {'n/a':>11} {'n/a':>12}")
+                notes.append(f"memory: {type(e).__name__}: {e}")
+    for n in notes:
+        print("note:", n)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
