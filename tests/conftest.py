@@ -7,7 +7,6 @@ the reference comparison cannot silently vanish from the pipeline.
 from __future__ import annotations
 
 import os
-import shutil
 from pathlib import Path
 
 import pytest
@@ -39,9 +38,9 @@ def data_dir() -> Path:
 def rs274() -> Path:
     """Path of LinuxCNC's stand-alone rs274: skip without it, but fail when CI is set."""
     import rs274 as harness
-    found = shutil.which("rs274") or (harness.RS274 if Path(harness.RS274).exists() else None)
+    found = harness.RS274 if Path(harness.RS274).exists() else None
     if found is None:
-        msg = "LinuxCNC rs274 not installed (Debian package linuxcnc-uspace)"
+        msg = f"LinuxCNC rs274 not found at {harness.RS274} (Debian package linuxcnc-uspace; or set RS274=path)"
         if os.environ.get("CI"):
             pytest.fail(msg + " and CI is set: the reference comparison must run in CI", pytrace=False)
         pytest.skip(msg)

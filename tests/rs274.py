@@ -23,13 +23,14 @@ decimals; offsets are printed separately when they change. Facts established wit
 from __future__ import annotations
 
 import math
+import os
 import re
 import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Optional
 
-RS274 = "/usr/bin/rs274"
+RS274 = os.environ.get("RS274", "/usr/bin/rs274")   # override to point at another build
 MM_PER_INCH = 25.4
 HALF_UNIT = 0.00005          # half of the last printed digit (4 decimals), in program units
 BASE_TOL_MM = 0.001          # the project's 1 µm position tolerance
