@@ -119,6 +119,7 @@ class Motion:
     via: intermediate point of a 3-point arc (Sinumerik CIP).
     machine_coords: one-shot machine coordinates (ISO G53, Sinumerik SUPA/G53).
     polar: polar words (angle, radius) when the dialect programs them.
+    aperture: opening angle of an arc in degrees (Sinumerik AR=), with centre or end point.
     """
     target: dict[str, AxisValue] = field(default_factory=dict)
     center: Optional[dict[str, AxisValue]] = None
@@ -127,6 +128,7 @@ class Motion:
     via: Optional[dict[str, AxisValue]] = None
     machine_coords: bool = False
     polar: Optional[dict[str, Expr]] = None
+    aperture: Optional[Expr] = None
 
 
 @dataclass(slots=True)
@@ -416,6 +418,7 @@ class Subprogram:
     span: Span
     body: list[Node]
     params: list[Param] = field(default_factory=list)
+    attrs: list[str] = field(default_factory=list)   # Sinumerik PROC SAVE / DISPLOF / SBLOF
 
 
 @dataclass(slots=True)

@@ -7,7 +7,8 @@ emitters know only these names. Adding a value here is how a new concept enters 
 MODAL_GROUPS: dict[str, tuple[str, ...]] = {
     # motion: what a Motion statement does. "cycle" while a canned cycle mode is active is tracked
     # by the "cycle" group instead; "none" after ISO G80 on controllers that cancel motion (LinuxCNC).
-    "motion": ("rapid", "linear", "arc_cw", "arc_ccw", "thread", "none"),
+    "motion": ("rapid", "linear", "arc_cw", "arc_ccw", "thread", "none",
+               "arc_3point", "arc_tangent"),                 # Sinumerik CIP (Motion.via) / CT
     "plane": ("XY", "ZX", "YZ"),
     "distance": ("absolute", "incremental"),
     "arc_distance": ("incremental", "absolute"),          # ISO G91.1 / G90.1
@@ -33,7 +34,12 @@ MODAL_GROUPS: dict[str, tuple[str, ...]] = {
 
 # Cycle-parameter keys used in CycleParams / CycleCall (neutral, all lengths in program units).
 CYCLE_PARAMS = ("bottom", "r_plane", "retract_plane", "safety", "peck", "dwell", "shift",
-                "repeat", "feed", "depth_rel", "first_peck", "decrement", "min_peck", "relief")
+                "repeat", "feed", "depth_rel", "first_peck", "decrement", "min_peck", "relief",
+                "ref_plane", "feed_out")    # Sinumerik RFP (workpiece reference plane), CYCLE85 RFF
 
 # Variable spaces of nodes.Var
 VAR_SPACES = ("num", "R", "name", "system", "arg")
+
+# CycleCall kinds beyond the "cycle" modal values: hole patterns that run the modal cycle at each
+# position (Sinumerik HOLES1/HOLES2) and the swivel-plane cycle (CYCLE800).
+CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle", "swivel")
