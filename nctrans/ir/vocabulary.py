@@ -34,12 +34,11 @@ MODAL_GROUPS: dict[str, tuple[str, ...]] = {
 
 # Cycle-parameter keys used in CycleParams / CycleCall (neutral, all lengths in program units).
 CYCLE_PARAMS = ("bottom", "r_plane", "retract_plane", "safety", "peck", "dwell", "shift",
-                "repeat", "feed", "depth_rel", "first_peck", "decrement", "min_peck", "relief",
-                "ref_plane", "feed_out")    # Sinumerik RFP (workpiece reference plane), CYCLE85 RFF
+                "repeat", "feed", "depth_rel", "first_peck", "decrement", "min_peck", "relief")
 
 # Variable spaces of nodes.Var
 VAR_SPACES = ("num", "R", "name", "system", "arg")
 
 # CycleCall kinds beyond the "cycle" modal values: hole patterns that run the modal cycle at each
-# position (Sinumerik HOLES1/HOLES2) and the swivel-plane cycle (CYCLE800).
-CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle", "swivel")
+# position (Sinumerik HOLES1/HOLES2, parameters in rules/cycles.toml [[pattern]]).
+CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle")
