@@ -12,3 +12,7 @@ Entry point (streaming; memory does not grow with program length):
 - The initial modal state comes from `program.meta["defaults"]` ({group: value}, from the
   dialect's rules table), so the interpreter stays dialect-neutral.
 """
+
+from nctrans.interp.interpreter import interpret
+
+__all__ = ["interpret"]

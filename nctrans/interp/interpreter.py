@@ -1,0 +1,1299 @@
+"""The interpreter loop: IR Program -> stream of ToolpathRecord (the canonical motions).
+
+How it runs
+- Each program or subprogram body is compiled once (cached per Subprogram) into a flat list of
+  instructions with jumps, so GOTO to any block number or label works whatever the structure:
+  BLOCK (the block's statements, each pre-compiled into a handler + data pair), JUMP, JFALSE
+  (conditional jump on a compiled expression), EXEC (a side effect such as a FOR step), CASE.
+- Calls keep an explicit stack of frames (no Python recursion), so the loop is one generator:
+  records are built into a small buffer per instruction and yielded at once; nothing accumulates.
+- Every executed instruction costs one step; when `max_steps` is spent, NC205 names the line and
+  the stream ends. ISO M99 in a main program (ProgramEnd "restart") would loop for ever: the
+  interpreter analyses the one pass and stops with NC205 (choice documented here).
+- Block-skip blocks (`/`) run, as with LinuxCNC's rs274 (block delete switch off).
+
+Coordinates (all mm): program point -> programmable frame (frames.py) -> work point -> + G92 +
+work offset + tool length -> machine point. Records are in machine coordinates. The start of a
+record is the end dict of the previous motion record (shared, never mutated).
+
+Arcs: `turns` is the number of EXTRA full turns (LinuxCNC ARC_FEED |rotation| - 1); an arc whose
+start equals its end in the plane is a full circle. `center` holds the plane's two axes plus the
+normal axis at the arc's end height (as tests/rs274.py reads LinuxCNC).
+
+flatten_hook(record, work_end, work_center): called for every record in stream order, just before
+it is yielded; for motion records work_end / work_center are the end point / centre in WORK
+coordinates (after the programmable frame, before work offset, G92 and tool length), else None.
+"""
+from __future__ import annotations
+
+import math
+import re
+from collections import deque
+from typing import Any, Callable, Iterator, Optional
+
+from nctrans.diagnostics import at_span
+from nctrans.interp import arcs
+from nctrans.interp.evaluate import UNKNOWN, EvalError, Evaluator, Scope, constant
+from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
+from nctrans.interp.state import LINEAR_AXES, ModalState
+from nctrans.ir import nodes as n
+from nctrans.toolpath import ToolpathRecord
+
+try:  # the colleague's modules; without them the feature is skipped
+    from nctrans.interp.cycles import expand_cycle
+except ImportError:  # pragma: no cover
+    expand_cycle = None
+try:
+    from nctrans.interp.cycles import sinumerik_cycle_levels
+except ImportError:  # pragma: no cover
+    sinumerik_cycle_levels = None
+try:
+    from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
+except ImportError:  # pragma: no cover
+    CutterCompensator = PlannedMove = None
+
+BLOCK, JUMP, JFALSE, EXEC, CASE = range(5)
+MAX_CALL_DEPTH = 16
+MOVE_KINDS = frozenset(("rapid", "linear", "arc"))
+NORMAL = {"XY": "Z", "ZX": "Y", "YZ": "X"}
+ROT_AXIS = NORMAL
+_LABEL_NUM = re.compile(r"^N?0*(\d+)$")
+_PROG_NUM = re.compile(r"^[OoPp]?0*(\d+)$")
+CYCLE_LENGTH_KEYS = frozenset(("bottom", "r_plane", "retract_plane", "safety", "peck", "shift",
+                               "depth_rel", "first_peck", "decrement", "min_peck", "relief"))
+
+
+def label_key(text: Any) -> Any:
+    """Block numbers compare numerically ("0100" == "N100" == 100); labels by upper-case name."""
+    s = str(text).strip()
+    m = _LABEL_NUM.match(s.upper())
+    if m:
+        return int(m.group(1))
+    return s.upper()
+
+
+def program_key(name: str) -> str:
+    """Subprogram names compare without the O and leading zeros when numeric ("O0100" == "100")."""
+    s = str(name).strip()
+    m = _PROG_NUM.match(s)
+    if m:
+        return "#" + str(int(m.group(1)))
+    return s.upper()
+
+
+class Unit:
+    """A compiled program body: instructions, label positions, parameters."""
+    __slots__ = ("name", "code", "labels", "params", "file")
+
+    def __init__(self, name: str, file: str, params: list):
+        self.name = name
+        self.file = file
+        self.code: list[tuple] = []
+        self.labels: dict[Any, list[int]] = {}
+        self.params = params
+
+
+class Frame:
+    """A call-stack entry: where to resume in the caller, and how to repeat the callee."""
+    __slots__ = ("unit", "pc", "sidx", "scope", "callee", "repeats", "args", "make_scope", "modal")
+
+    def __init__(self, unit, pc, sidx, scope, callee, repeats, make_scope, modal=False):
+        self.unit, self.pc, self.sidx, self.scope = unit, pc, sidx, scope
+        self.callee, self.repeats, self.make_scope, self.modal = callee, repeats, make_scope, modal
+
+
+class _Stop(Exception):
+    """Internal: end the whole run (program end, alarm)."""
+
+
+class Interpreter:
+    def __init__(self, program: n.Program, machine=None, *, diagnostics: list, resolver=None,
+                 max_steps: int = 2_000_000, flatten_hook=None):
+        if machine is None:
+            from nctrans.machine import default_mill
+            machine = default_mill()
+        self.program = program
+        self.machine = machine
+        self.diags = diagnostics
+        self.resolver = resolver
+        self.max_steps = max_steps
+        self.hook = flatten_hook
+        defaults = program.meta.get("defaults") if isinstance(program.meta, dict) else None
+        self.st = ModalState(defaults if isinstance(defaults, dict) else None)
+        self.ev = Evaluator()
+        self.frame = ProgrammableFrame()
+        self.off = Offsets()
+        if self.st.work_offset:
+            self.off.set_work(self._work_offset(self.st.work_offset))
+        # machine position (last emitted end) and the same point in program coordinates
+        self.mpos: dict[str, float] = {"X": 0.0, "Y": 0.0, "Z": 0.0}
+        self.pos: dict[str, float] = {}
+        self._resync()
+        self.out: list = []
+        self._hookq: deque = deque()
+        self.units: dict[int, Unit] = {}
+        self.sub_index: dict[str, tuple[n.Subprogram, str]] = {}
+        self._index_subprograms(program)
+        self._resolved: dict[str, Any] = {}
+        self.compilers = self._compiler_table()
+        # runtime flags
+        self.moved = False
+        self.feed_reported = False
+        self.comp = None
+        self.comp_radius = 0.0
+        self.comp_exit = False
+        self.modal_call = None          # (SubCall, args snapshot, depth)
+        self.cycle_params: dict[str, float] = {}
+        self.cycle_initial: Optional[float] = None
+        self.modal_cycle = None         # CycleCall with modal=True
+        self.stack: list[Frame] = []
+        self.span: Optional[n.Span] = None
+        self._register_system()
+
+    # ================================================================ diagnostics
+    def diag(self, rule: str, severity: str, message: str, span=None) -> None:
+        self.diags.append(at_span(rule, severity, message, span or self.span))
+
+    # ================================================================ compile
+    def _index_subprograms(self, program: n.Program) -> None:
+        for name, sub in (program.subprograms or {}).items():
+            self.sub_index.setdefault(program_key(name), (sub, program.file))
+            self.sub_index.setdefault(program_key(sub.name), (sub, program.file))
+
+    def unit_for(self, key: int, name: str, body: list, file: str, params: list) -> Unit:
+        unit = self.units.get(key)
+        if unit is None:
+            unit = Unit(name, file, params)
+            self._emit_nodes(body, unit)
+            self.units[key] = unit
+        return unit
+
+    def _emit_nodes(self, nodes_: list, unit: Unit) -> None:
+        code = unit.code
+        for node in nodes_:
+            t = type(node)
+            if t is n.Block:
+                stmts = []
+                for s in node.body:
+                    c = self.compilers.get(type(s))
+                    if c is None:
+                        continue
+                    stmts.append(c(s))
+                pc = len(code)
+                code.append((BLOCK, stmts, node, node.span))
+                for lab in (node.number, node.label):
+                    if lab is not None and lab != "":
+                        unit.labels.setdefault(label_key(lab), []).append(pc)
+            elif t is n.If:
+                j = len(code)
+                code.append(None)
+                self._emit_nodes(node.then, unit)
+                if node.orelse:
+                    k = len(code)
+                    code.append(None)
+                    code[j] = (JFALSE, self._cond(node.cond), len(code), node.span)
+                    self._emit_nodes(node.orelse, unit)
+                    code[k] = (JUMP, len(code), None, node.span)
+                else:
+                    code[j] = (JFALSE, self._cond(node.cond), len(code), node.span)
+            elif t is n.While:
+                top = len(code)
+                code.append(None)
+                self._emit_nodes(node.body, unit)
+                code.append((JUMP, top, None, node.span))
+                code[top] = (JFALSE, self._cond(node.cond), len(code), node.span)
+                if node.label:
+                    unit.labels.setdefault(label_key(node.label), []).append(top)
+            elif t is n.Loop:
+                top = len(code)
+                self._emit_nodes(node.body, unit)
+                code.append((JUMP, top, None, node.span))
+            elif t is n.RepeatUntil:
+                top = len(code)
+                self._emit_nodes(node.body, unit)
+                code.append((JFALSE, self._cond(node.cond), top, node.span))
+            elif t is n.ForLoop:
+                init, test, incr = self._for_parts(node)
+                code.append((EXEC, init, None, node.span))
+                top = len(code)
+                code.append(None)
+                self._emit_nodes(node.body, unit)
+                code.append((EXEC, incr, None, node.span))
+                code.append((JUMP, top, None, node.span))
+                code[top] = (JFALSE, test, len(code), node.span)
+            elif t is n.Case:
+                subj = self.ev.compile(node.subject)
+                branches = [(self.ev.compile(v), lab) for v, lab in node.branches]
+                code.append((CASE, (subj, branches, node.default), None, node.span))
+
+    def _cond(self, expr) -> Callable[[], Any]:
+        f = self.ev.compile(expr)
+
+        def cond():
+            v = f()
+            if v is UNKNOWN:
+                self.diag("NC107", "info", "condition depends on a value unknown at analysis "
+                          "time; taken as false")
+                return False
+            return bool(v) if v is not None else False
+        return cond
+
+    def _for_parts(self, node: n.ForLoop):
+        ev = self.ev
+        get = ev.compile(node.var)
+        put = ev.compile_store(node.var)
+        start, end = ev.compile(node.start), ev.compile(node.end)
+        step = ev.compile(node.step) if node.step is not None else (lambda: 1.0)
+
+        def init():
+            put(start())
+
+        def test():
+            s, v, e = step(), get(), end()
+            if UNKNOWN in (s, v, e):
+                return False
+            return (v or 0) <= (e or 0) if (s or 0) >= 0 else (v or 0) >= (e or 0)
+
+        def incr():
+            put((get() or 0) + (step() or 0))
+        return init, test, incr
+
+    def _compiler_table(self) -> dict:
+        return {
+            n.ModeChange: self._c_mode, n.Motion: self._c_motion, n.Feed: self._c_feed,
+            n.SpindleSpeed: self._c_speed, n.ToolSelect: self._c_tool,
+            n.ToolChange: lambda s: (self._h_toolchange, s), n.OffsetSelect: self._c_offset,
+            n.Dwell: self._c_dwell, n.SetPosition: lambda s: (self._h_setpos, s),
+            n.ResetSetPosition: lambda s: (self._h_resetpos, s),
+            n.FrameOp: lambda s: (self._h_frame, s), n.HomeReturn: lambda s: (self._h_home, s),
+            n.CycleParams: lambda s: (self._h_cycle_params, s),
+            n.CycleCall: lambda s: (self._h_cycle_call, s), n.SubCall: lambda s: (self._h_call, s),
+            n.ModalCallOff: lambda s: (self._h_modal_off, s), n.Return: lambda s: (self._h_return, s),
+            n.ProgramEnd: lambda s: (self._h_end, s), n.Stop: lambda s: (self._h_stop, s),
+            n.Assign: self._c_assign, n.VarDecl: lambda s: (self._h_decl, s),
+            n.Goto: self._c_goto, n.Alarm: lambda s: (self._h_alarm, s),
+            n.DataSetting: lambda s: (self._h_data, s),
+        }
+
+    # ================================================================ helpers
+    def _value(self, f, what: str) -> Optional[float]:
+        """Evaluate a compiled expression that must be a number; None if vacant/unknown."""
+        v = f()
+        if v is None:
+            return None
+        if v is UNKNOWN:
+            self.diag("NC107", "info", f"{what} depends on a value unknown at analysis time; "
+                      "the word is ignored")
+            return None
+        if isinstance(v, str):
+            raise EvalError("NC104", f"string used as {what}")
+        return float(v)
+
+    def _words(self, d: Optional[dict]) -> tuple:
+        """Pre-compile axis words: (axis, constant|None, closure, mode)."""
+        if not d:
+            return ()
+        out = []
+        for axis, av in d.items():
+            if isinstance(av, n.AxisValue):
+                expr, mode = av.value, av.mode
+            else:
+                expr, mode = av, None
+            c = constant(expr)
+            out.append((axis.upper(), c, None if c is not None else self.ev.compile(expr), mode))
+        return tuple(out)
+
+    def _eval_words(self, words: tuple) -> list:
+        """[(axis, value in mm/deg, mode)] with vacant words dropped."""
+        scale = self.st.scale
+        out = []
+        for axis, c, f, mode in words:
+            v = c if c is not None else self._value(f, f"{axis} word")
+            if v is None:
+                continue
+            if axis in LINEAR_AXES:
+                v *= scale
+            out.append((axis, v, mode))
+        return out
+
+    def _target(self, vals: list) -> dict[str, float]:
+        """Program-coordinate target of evaluated words from the current point."""
+        tgt = dict(self.pos)
+        inc_default = self.st.incremental
+        for axis, v, mode in vals:
+            cur = tgt.get(axis)
+            if cur is None:
+                cur = self._new_axis(axis)
+                tgt[axis] = cur
+            inc = inc_default if mode is None else mode == "inc"
+            tgt[axis] = cur + v if inc else v
+        return tgt
+
+    def _new_axis(self, axis: str) -> float:
+        """First use of an axis: it was at machine 0; add it to the machine and program points."""
+        self.mpos = dict(self.mpos)
+        self.mpos[axis] = 0.0
+        self._resync()
+        return self.pos[axis]
+
+    def _resync(self) -> None:
+        """Program point from the machine point (after an offset or frame change)."""
+        tot = self.off.total
+        work = {a: v - tot.get(a, 0.0) for a, v in self.mpos.items()}
+        self.pos = self.frame.to_program(work)
+
+    def _to_machine(self, p: dict[str, float]) -> dict[str, float]:
+        w = p if self.frame.identity else self.frame.to_work(p)
+        tot = self.off.total
+        if not tot:
+            return dict(w)
+        return {a: v + tot.get(a, 0.0) for a, v in w.items()}
+
+    def _work_offset(self, name: str) -> dict[str, float]:
+        if name.upper() == "G53":
+            return {}
+        return self.machine.work_offset(name)
+
+    # ================================================================ records
+    def _record(self, kind: str, **kw) -> None:
+        rec = ToolpathRecord(0, self.span.file if self.span else self.program.file,
+                             self.span.line if self.span else 1, kind, **kw)
+        if self.comp is not None:
+            self._comp_out(self.comp.push(rec))
+        else:
+            self.out.append(rec)
+            if self.hook is not None:
+                self._hookq.append(None)
+
+    def _move(self, kind: str, end: dict[str, float], center=None, cw=None, turns=None) -> None:
+        """Emit a move from the current program point to `end` (program coords); update position."""
+        start = self.pos
+        self.pos = end
+        if self.comp_exit or self.comp is not None or (
+                self.st.comp_side != "off" and CutterCompensator is not None and self.comp_radius):
+            if self._comp_move(kind, start, end, center, cw, turns):
+                return
+        self._finish_move(kind, start, end, center, cw, turns, self._payload())
+
+    def _payload(self) -> tuple:
+        sp = self.span
+        st = self.st
+        return (sp.file if sp else self.program.file, sp.line if sp else 1, st.feed, st.feed_mode,
+                st.spindle_speed, st.tool, st.plane)
+
+    def _finish_move(self, kind, start, end, center, cw, turns, payload, start_given=False) -> None:
+        file, line, feed, feed_mode, speed, tool, plane = payload
+        mend = self._to_machine(end)
+        mstart = self._to_machine(start) if start_given else self.mpos
+        if len(mstart) != len(mend):
+            mstart = {**{a: mend[a] for a in mend if a not in mstart}, **mstart}
+        if kind == "rapid":
+            rec = ToolpathRecord(0, file, line, "rapid", mstart, mend, spindle=speed, tool=tool)
+        else:
+            rec = ToolpathRecord(0, file, line, "linear" if kind == "linear" else "arc", mstart,
+                                 mend, feed=feed, feed_mode=feed_mode, spindle=speed, tool=tool)
+        mc = None
+        if kind == "arc":
+            a1, a2, an = PLANE_AXES[plane]
+            cprog = {a1: center[0], a2: center[1], an: end.get(an, 0.0)}
+            full = dict(end)
+            full.update(cprog)
+            mfull = self._to_machine(full)
+            mc = {a1: mfull[a1], a2: mfull[a2], an: mfull[an]}
+            rec.center = mc
+            rec.plane = plane
+            rec.direction = ("cw" if cw else "ccw") if not self.frame.mirror_swap else (
+                "ccw" if cw else "cw")
+            rec.turns = turns
+        self.mpos = mend
+        self.out.append(rec)
+        if self.hook is not None:
+            tot = self.off.total
+            work = {a: v - tot.get(a, 0.0) for a, v in mend.items()}
+            wc = None if mc is None else {a: v - tot.get(a, 0.0) for a, v in mc.items()}
+            self._hookq.append((work, wc))
+
+    # ---------------------------------------------------------------- cutter compensation
+    def _comp_move(self, kind, start, end, center, cw, turns) -> bool:
+        pm = PlannedMove(kind=kind, start=start, end=end,
+                         center=None if center is None else self._center_dict(center, end),
+                         direction=None if cw is None else ("cw" if cw else "ccw"),
+                         turns=turns, payload=self._payload())
+        if self.comp_exit:
+            comp, self.comp, self.comp_exit = self.comp, None, False
+            if comp is not None:
+                self._comp_out(comp.finish(pm))
+                return True
+            return False
+        if self.comp is None:
+            side = self.st.comp_side
+            r = self.comp_radius
+            if r < 0:           # a negative stored radius swaps the side
+                side, r = ("right" if side == "left" else "left"), -r
+            self.comp = CutterCompensator(side, r, self.st.plane)
+        self._comp_out(self.comp.push(pm))
+        return True
+
+    def _center_dict(self, center, end) -> dict[str, float]:
+        a1, a2, an = PLANE_AXES[self.st.plane]
+        return {a1: center[0], a2: center[1], an: end.get(an, 0.0)}
+
+    def _comp_out(self, items) -> None:
+        for it in items:
+            if PlannedMove is not None and isinstance(it, PlannedMove):
+                c = it.center
+                plane = it.payload[6]
+                a1, a2, _ = PLANE_AXES[plane]
+                cc = None if c is None else (c[a1], c[a2])
+                cw = None if it.direction is None else it.direction == "cw"
+                self._finish_move(it.kind, it.start, it.end, cc, cw, it.turns, it.payload,
+                                  start_given=True)
+            else:
+                self.out.append(it)
+                if self.hook is not None:
+                    self._hookq.append(None)
+
+    def _comp_flush(self) -> None:
+        if self.comp is not None:
+            comp, self.comp = self.comp, None
+            self._comp_out(comp.finish(None))
+
+    # ================================================================ statement compilers/handlers
+    def _c_mode(self, s: n.ModeChange):
+        return (self._h_mode, s)
+
+    def _h_mode(self, s: n.ModeChange):
+        st = self.st
+        g, v = s.group, s.value
+        if g == "motion":
+            if st.cycle != "off":
+                self._cycle_off()
+            st.set(g, v)
+        elif g == "cycle":
+            if v == "off":
+                self._cycle_off()
+            else:
+                if st.cycle == "off" or self.cycle_initial is None:
+                    self.cycle_initial = self.pos.get(NORMAL[st.plane], 0.0)
+                st.set(g, v)
+        elif g == "work_offset":
+            st.set(g, v)
+            self.off.set_work(self._work_offset(v))
+            self._resync()
+        elif g == "tool_length":
+            st.set(g, v)
+            self._apply_length()
+        elif g == "cutter_comp":
+            prev = st.comp_side
+            st.set(g, v)
+            if v == "off" and prev != "off" and self.comp is not None:
+                self.comp_exit = True
+            elif v != "off" and self.comp is not None and prev != v:
+                # side switch while active: finish with the next move, restart after
+                self.comp_exit = True
+        elif g == "spindle":
+            st.set(g, v)
+            self._record("spindle", spindle_dir=v, spindle=st.spindle_speed)
+        elif g == "coolant":
+            st.set(g, v)
+            self._record("coolant", coolant=v)
+        elif g == "units":
+            st.set(g, v)
+        elif g == "plane":
+            st.set(g, v)
+        else:
+            st.set(g, v)
+
+    def _cycle_off(self) -> None:
+        self.st.set("cycle", "off")
+        self.cycle_params = {}
+        self.cycle_initial = None
+
+    def _apply_length(self) -> None:
+        st = self.st
+        if st.length_mode == "off":
+            z = 0.0
+        else:
+            idx = st.length_index if st.length_index is not None else st.tool
+            z = self.machine.length_offset(int(idx)) if idx else 0.0
+            if st.length_mode == "minus":
+                z = -z
+        self.off.set_tool(z)
+        self._resync()
+
+    def _c_feed(self, s: n.Feed):
+        c = constant(s.value)
+        f = None if c is not None else self.ev.compile(s.value)
+        return (self._h_feed, (c, f))
+
+    def _h_feed(self, d):
+        c, f = d
+        v = c if c is not None else self._value(f, "feed")
+        if v is None:
+            return
+        if v < 0:
+            self.diag("NC105", "error", f"negative feed {v:g}")
+            return
+        st = self.st
+        st.feed = v if st.feed_mode == "inverse_time" else v * st.scale
+        self.feed_reported = False
+
+    def _c_speed(self, s: n.SpindleSpeed):
+        return (self._h_speed, self.ev.compile(s.value))
+
+    def _h_speed(self, f):
+        v = self._value(f, "spindle speed")
+        if v is None:
+            return
+        if v < 0:
+            self.diag("NC105", "error", f"negative spindle speed {v:g}")
+            return
+        st = self.st
+        changed = v != st.spindle_speed
+        st.spindle_speed = v
+        if changed and st.spindle_dir in ("cw", "ccw"):
+            self._record("spindle", spindle_dir=st.spindle_dir, spindle=v)
+
+    def _c_tool(self, s: n.ToolSelect):
+        return (self._h_tool, self.ev.compile(s.tool))
+
+    def _h_tool(self, f):
+        v = self._value(f, "tool number")
+        if v is not None:
+            self.st.tool_selected = int(round(v))
+
+    def _h_toolchange(self, s):
+        st = self.st
+        if st.tool_selected is None:
+            self.diag("NC105", "warning", "tool change without a selected tool")
+        st.tool = st.tool_selected
+        self._record("tool_change", tool=st.tool)
+
+    def _c_offset(self, s: n.OffsetSelect):
+        return (self._h_offset, (s.kind, self.ev.compile(s.index)))
+
+    def _h_offset(self, d):
+        kind, f = d
+        v = self._value(f, "offset number")
+        if v is None:
+            return
+        i = int(round(v))
+        if kind == "length":
+            self.st.length_index = i
+            if self.st.length_mode != "off":
+                self._apply_length()
+        else:
+            self.st.radius_index = i
+            self.comp_radius = self.machine.radius_offset(i) if i else 0.0
+
+    def _c_dwell(self, s: n.Dwell):
+        sec = None if s.seconds is None else self.ev.compile(s.seconds)
+        rev = None if s.revolutions is None else self.ev.compile(s.revolutions)
+        return (self._h_dwell, (sec, rev))
+
+    def _h_dwell(self, d):
+        sec, rev = d
+        t = 0.0
+        if sec is not None:
+            t = self._value(sec, "dwell") or 0.0
+        elif rev is not None:
+            r = self._value(rev, "dwell") or 0.0
+            s = self.st.spindle_speed
+            if not s:
+                self.diag("NC105", "warning", "dwell in revolutions with no spindle speed")
+                t = 0.0
+            else:
+                t = r * 60.0 / s
+        if t < 0:
+            self.diag("NC105", "error", f"negative dwell {t:g}")
+            return
+        self._record("dwell", dwell_s=t)
+
+    def _c_assign(self, s: n.Assign):
+        return (self._h_assign, (self.ev.compile_store(s.target), self.ev.compile(s.value)))
+
+    def _h_assign(self, d):
+        put, f = d
+        put(f())
+
+    def _h_decl(self, s: n.VarDecl):
+        self.ev.declare(s)
+
+    def _c_goto(self, s: n.Goto):
+        cond = None if s.cond is None else self._cond(s.cond)
+        return (self._h_goto, (s.target, s.direction, cond))
+
+    def _h_goto(self, d):
+        target, direction, cond = d
+        if cond is not None and not cond():
+            return None
+        return ("goto", target, direction)
+
+    def _h_return(self, s: n.Return):
+        return ("return", s.to_label)
+
+    def _h_end(self, s: n.ProgramEnd):
+        self._comp_flush()
+        self._record("stop", stop_kind="end")
+        if s.kind == "restart" and not self.stack:
+            self.diag("NC205", "warning", f"analysis truncated at line {self.span.line}: the "
+                      "program restarts (return in a main program); one pass analysed")
+        raise _Stop
+
+    def _h_stop(self, s: n.Stop):
+        self._record("stop", stop_kind="optional" if s.optional else "stop")
+
+    def _h_alarm(self, s: n.Alarm):
+        try:
+            num = self.ev.compile(s.number)()
+        except EvalError:
+            num = "?"
+        self.diag("NC205", "warning", f"analysis truncated at line {self.span.line}: the "
+                  f"program raises alarm {num}")
+        raise _Stop
+
+    def _h_data(self, s):
+        """G10 data setting: write work offsets or tool-offset registers into the machine copy."""
+        vals = {}
+        for k, e in s.values.items():
+            v = self._value(self.ev.compile(e), f"{k} value")
+            if v is not None:
+                vals[k.upper()] = v
+        idx = self._value(self.ev.compile(s.index), "offset number")
+        if idx is None:
+            return
+        idx = int(round(idx))
+        inc = self.st.incremental
+        if self.machine is not None and not getattr(self, "_machine_copied", False):
+            self.machine = self.machine.model_copy(deep=True)
+            self._machine_copied = True
+        m = self.machine
+        if s.kind == "work_offset":
+            if s.extended:
+                name = f"G54.1P{idx}"
+            elif idx == 0:
+                name = "EXT"
+            elif 1 <= idx <= 6:
+                name = f"G{53 + idx}"
+            else:
+                self.diag("NC105", "error", f"work offset number {idx} out of range")
+                return
+            cur = dict(m.offsets.get(name, {}))
+            for a, v in vals.items():
+                v *= self.st.scale if a in LINEAR_AXES else 1.0
+                cur[a] = cur.get(a, 0.0) + v if inc else v
+            m.offsets[name] = cur
+            if self.st.work_offset and self.st.work_offset.upper() == name:
+                self.off.set_work(self._work_offset(name))
+                self._resync()
+        elif s.kind.startswith("tool_"):
+            v = vals.get("VALUE", 0.0) * self.st.scale
+            store = m.length_offsets if "length" in s.kind else m.radius_offsets
+            old = store.get(idx, m.length_offset(idx) if "length" in s.kind else m.radius_offset(idx))
+            store[idx] = old + v if inc else v
+
+    # ---------------------------------------------------------------- motion
+    def _c_motion(self, s: n.Motion):
+        words = self._words(s.target)
+        center = self._words(s.center)
+        radius = None if s.radius is None else self.ev.compile(s.radius)
+        turns = None if s.turns is None else self.ev.compile(s.turns)
+        polar = None
+        if s.polar:
+            polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
+        return (self._h_motion, (words, center, radius, turns, s.machine_coords, polar))
+
+    def _h_motion(self, d):
+        words, center, radius, turns, machine, polar = d
+        st = self.st
+        self.moved = True
+        vals = self._eval_words(words)
+        if polar:
+            vals = self._polar(vals, polar)
+        if self.modal_cycle is not None and st.cycle == "off" and not machine:
+            self._motion_plain(vals, center, radius, turns)
+            if any(a in PLANE_AXES[st.plane][:2] for a, _, _ in vals):
+                self._run_cycle_call(self.modal_cycle)
+            return
+        if st.cycle != "off" and not machine:
+            self._cycle_hole(vals)
+            return
+        if machine:
+            self._machine_move(vals)
+            return
+        self._motion_plain(vals, center, radius, turns)
+
+    def _motion_plain(self, vals, center, radius, turns):
+        st = self.st
+        motion = st.motion
+        if motion == "rapid":
+            if vals:
+                self._move("rapid", self._target(vals))
+            return
+        if motion == "linear" or motion == "thread":
+            if vals:
+                self._need_feed()
+                self._move("linear", self._target(vals))
+            return
+        if motion in ("arc_cw", "arc_ccw"):
+            self._arc(vals, center, radius, turns, motion == "arc_cw")
+            return
+        if vals:
+            self.diag("NC207", "error", "axis words while no motion mode is active")
+
+    def _need_feed(self) -> None:
+        st = self.st
+        if not st.feed and not self.feed_reported:
+            self.feed_reported = True
+            self.diag("NC202", "error", "feed move with no feed rate programmed")
+
+    def _polar(self, vals, polar):
+        """Polar words (radius, angle in the active plane about program zero)."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        r = self._value(polar["radius"], "polar radius") if "radius" in polar else None
+        ang = self._value(polar["angle"], "polar angle") if "angle" in polar else None
+        if r is None and ang is None:
+            return vals
+        p1, p2 = self.pos.get(a1, 0.0), self.pos.get(a2, 0.0)
+        if r is None:
+            r = math.hypot(p1, p2)
+        else:
+            r *= self.st.scale
+        if ang is None:
+            ang = math.degrees(math.atan2(p2, p1))
+        rest = [w for w in vals if w[0] not in (a1, a2)]
+        return rest + [(a1, r * math.cos(math.radians(ang)), "abs"),
+                       (a2, r * math.sin(math.radians(ang)), "abs")]
+
+    def _machine_move(self, vals) -> None:
+        """G53: the words are machine coordinates of the controlled point, this block only."""
+        mend = dict(self.mpos)
+        for a, v, _ in vals:
+            mend[a] = v
+        kind = "linear" if self.st.motion == "linear" else "rapid"
+        if kind == "linear":
+            self._need_feed()
+        tot = self.off.total
+        end = self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()})
+        self._move(kind, end)
+
+    def _arc(self, vals, center, radius, turns, cw) -> None:
+        st = self.st
+        plane = st.plane
+        a1, a2, an = PLANE_AXES[plane]
+        start = self.pos
+        end = self._target(vals)
+        s1, s2 = start.get(a1, 0.0), start.get(a2, 0.0)
+        e1, e2 = end.get(a1, 0.0), end.get(a2, 0.0)
+        inch = st.scale != 1.0
+        nturns = 0
+        if turns is not None:
+            t = self._value(turns, "turns")
+            if t is not None:
+                nturns = max(int(round(t)), 0)
+        self._need_feed()
+        try:
+            if radius is not None:
+                r = self._value(radius, "arc radius")
+                if r is None:
+                    raise arcs.ArcError("arc radius is vacant")
+                c1, c2 = arcs.center_from_radius(s1, s2, e1, e2, r * st.scale, cw, inch)
+            else:
+                cvals = self._eval_words(center)
+                if not cvals:
+                    raise arcs.ArcError("arc without centre or radius")
+                c1, c2 = s1, s2
+                cd = {a: v for a, v, _ in cvals}
+                absolute = {a: (m == "abs") if m else st.arc_absolute for a, _, m in cvals}
+                ci = {"X": "X", "Y": "Y", "Z": "Z", "I": "X", "J": "Y", "K": "Z"}
+                for a, v in cd.items():
+                    ax = ci.get(a, a)
+                    if ax == a1:
+                        c1 = v if absolute[a] else s1 + v
+                    elif ax == a2:
+                        c2 = v if absolute[a] else s2 + v
+                err = arcs.check_center(s1, s2, e1, e2, c1, c2, inch)
+                if err:
+                    raise arcs.ArcError(err)
+        except arcs.ArcError as ex:
+            self.diag("NC203", "error", str(ex))    # the controller alarms: no motion
+            return
+        self._move("arc", end, (c1, c2), cw, nturns)
+
+    # ---------------------------------------------------------------- cycles
+    def _h_cycle_params(self, s: n.CycleParams):
+        scale = self.st.scale
+        for k, e in s.values.items():
+            v = self._value(self.ev.compile(e), f"cycle {k}")
+            if v is None:
+                continue
+            self.cycle_params[k] = v * scale if k in CYCLE_LENGTH_KEYS else v
+
+    def _cycle_hole(self, vals) -> None:
+        st = self.st
+        plane = st.plane
+        a1, a2, ax = PLANE_AXES[plane]
+        p = self.cycle_params
+        repeat = p.pop("repeat", 1)
+        for a, v, mode in vals:
+            if a == ax:
+                p["bottom"] = v
+        if not vals and "bottom" not in p:
+            return
+        if expand_cycle is None:
+            return
+        missing = [k for k in ("bottom", "r_plane") if k not in p]
+        if missing:
+            self.diag("NC206", "error", f"canned cycle without {' and '.join(missing)}")
+            return
+        initial = self.cycle_initial if self.cycle_initial is not None else self.pos.get(ax, 0.0)
+        if st.incremental:
+            zr = initial + p["r_plane"]
+            zb = zr + p["bottom"]
+        else:
+            zr, zb = p["r_plane"], p["bottom"]
+        retract = initial if st.cycle_retract == "initial" else zr
+        plane_vals = [(a, v, m) for a, v, m in vals if a != ax]
+        hole = self._target(plane_vals)
+        hole[ax] = self.pos.get(ax, 0.0)
+        step = None
+        if st.incremental:
+            step = {a: v for a, v, m in plane_vals if m != "abs"}
+        self._expand(st.cycle, hole, zr, zb, retract, p, int(round(repeat)), step)
+
+    def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None) -> None:
+        st = self.st
+        feed = p.get("feed")
+        feed = feed * st.scale if feed is not None else (st.feed or 0.0)
+        if not feed:
+            self._need_feed()
+        if repeat < 1:
+            return
+        steps = expand_cycle(kind, plane=st.plane, position=dict(self.pos), hole=hole,
+                             approach=approach, bottom=bottom, retract=retract,
+                             peck=p.get("peck"), dwell_s=p.get("dwell"), shift=p.get("shift"),
+                             feed=feed, spindle_dir=st.spindle_dir, units_mm=st.scale == 1.0,
+                             repeat=repeat, step=step)
+        saved = st.feed
+        st.feed = feed
+        try:
+            for s in steps:
+                k = s[0]
+                if k in ("rapid", "linear"):
+                    pt = dict(s[1])
+                    self._move(k, pt)
+                elif k == "dwell":
+                    self._record("dwell", dwell_s=float(s[1] or 0.0))
+                elif k == "spindle":
+                    self._record("spindle", spindle_dir=s[1], spindle=st.spindle_speed)
+                elif k == "stop":
+                    self._record("stop", stop_kind="stop")
+        finally:
+            st.feed = saved
+        if kind == "bore_manual":        # the operator retracted by hand (see cycles.py)
+            ax = PLANE_AXES[st.plane][2]
+            pos = dict(self.pos)
+            pos[ax] = max(retract, approach) if approach >= bottom else min(retract, approach)
+            self.pos = pos
+            self.mpos = self._to_machine(pos)
+
+    def _h_cycle_call(self, s: n.CycleCall):
+        if s.modal:
+            self.modal_cycle = s
+            return
+        self._run_cycle_call(s)
+
+    def _run_cycle_call(self, s: n.CycleCall) -> None:
+        if expand_cycle is None or sinumerik_cycle_levels is None:
+            return
+        st = self.st
+        ax = PLANE_AXES[st.plane][2]
+        params = {}
+        for k, e in s.params.items():
+            v = self._value(self.ev.compile(e), f"cycle {k}")
+            if v is not None:
+                params[k] = v * st.scale if k in CYCLE_LENGTH_KEYS else v
+        if "bottom" not in params and "depth_rel" not in params:
+            self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
+            return
+        approach, bottom, retract = sinumerik_cycle_levels(params, current=self.pos.get(ax, 0.0))
+        hole = dict(self.pos)
+        self._expand(s.kind, hole, approach, bottom, retract, params)
+
+    # ---------------------------------------------------------------- offsets and frames
+    def _h_setpos(self, s: n.SetPosition):
+        vals = self._eval_words(self._words(s.target))
+        if not vals:
+            return
+        target = self._target(vals)
+        work = self.frame.to_work(target)
+        g92 = dict(self.off.g92)
+        wo = self.off.work
+        for a, _, _ in vals:
+            tl = self.off.tool_z if a == "Z" else 0.0
+            g92[a] = self.mpos.get(a, 0.0) - wo.get(a, 0.0) - tl - work[a]
+        self.off.set_g92(g92)
+        self.pos = target
+
+    def _h_resetpos(self, s):
+        self.off.set_g92({})
+        self._resync()
+
+    def _h_frame(self, s: n.FrameOp):
+        st = self.st
+        scale = st.scale
+        fr = self.frame
+        op = s.op
+
+        def num(e, what, lin=True):
+            v = self._value(self.ev.compile(e), what)
+            return None if v is None else v * (scale if lin else 1.0)
+
+        def center():
+            out = {}
+            for a, av in (s.center or {}).items():
+                e = av.value if isinstance(av, n.AxisValue) else av
+                v = num(e, f"{a} centre", a.upper() in LINEAR_AXES)
+                if v is not None:
+                    out[a.upper()] = v
+            return out
+
+        if op == "all":
+            if s.clear:
+                fr.clear()
+        elif op == "trans":
+            if s.clear:
+                fr.set_local({})
+            else:
+                vals = {}
+                for a, e in s.values.items():
+                    v = num(e, f"{a} shift", a.upper() in LINEAR_AXES)
+                    if v is not None:
+                        vals[a.upper()] = v
+                fr.set_local(vals, additive=s.additive)
+        elif op == "rot":
+            if s.clear:
+                fr.set_rotation(None, 0.0, {})
+            else:
+                plane = st.plane
+                if s.angle is not None:
+                    ang = num(s.angle, "rotation angle", False) or 0.0
+                    axis = ROT_AXIS[plane]
+                    piv = center()
+                    a1, a2, _ = PLANE_AXES[plane]
+                    if not s.additive:   # ISO G68: a missing centre coordinate is the current point
+                        for a in (a1, a2):
+                            piv.setdefault(a, self.pos.get(a, 0.0))
+                    fr.set_rotation(axis, ang, piv, additive=s.additive)
+                else:
+                    first = True
+                    for a, e in s.values.items():
+                        ang = num(e, f"{a} rotation", False)
+                        if ang is not None:
+                            fr.set_rotation(a.upper(), ang, center(),
+                                            additive=s.additive or not first)
+                            first = False
+        elif op == "scale":
+            if s.clear:
+                fr.set_scale({}, {})
+            else:
+                f = {a.upper(): num(e, f"{a} scale", False) for a, e in s.values.items()}
+                fr.set_scale({a: v for a, v in f.items() if v is not None}, center())
+        elif op == "mirror":
+            if s.clear:
+                fr.set_mirror({})
+            else:
+                piv = center()
+                axes = {a.upper(): piv.get(a.upper(), 0.0) for a in s.values}
+                for a, v in piv.items():
+                    axes.setdefault(a, v)
+                fr.set_mirror(axes)
+        self._resync()
+
+    def _h_home(self, s: n.HomeReturn):
+        """G28/G30: rapid to the intermediate point, then to the reference point (machine 0 for
+        every reference point, as LinuxCNC's default #5161.. / #5181..) on the named axes;
+        with no axis words every axis goes home directly."""
+        vals = self._eval_words(self._words(s.via))
+        if vals:
+            self._move("rapid", self._target(vals))
+            axes = [a for a, _, _ in vals]
+        else:
+            axes = list(self.mpos)
+        tot = self.off.total
+        mend = dict(self.mpos)
+        for a in axes:
+            mend[a] = 0.0
+        self._move("rapid", self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()}))
+
+    # ---------------------------------------------------------------- calls
+    def _h_call(self, s: n.SubCall):
+        if s.modal == "after_move":
+            self.modal_call = (s, self._call_args(s), len(self.stack))
+            return None
+        return ("call", s)
+
+    def _h_modal_off(self, s):
+        self.modal_call = None
+
+    def _call_args(self, s: n.SubCall) -> tuple[list, dict]:
+        pos = [self.ev.compile(e)() for e in s.args]
+        named = {k.upper(): self.ev.compile(e)() for k, e in s.named_args.items()}
+        # ISO-style call arguments are in program units; they are passed as written
+        return pos, named
+
+    def _find_unit(self, name: str) -> Optional[Unit]:
+        key = program_key(name)
+        hit = self.sub_index.get(key)
+        if hit is None and self.resolver is not None:
+            if key not in self._resolved:
+                from_file = self.span.file if self.span else self.program.file
+                try:
+                    prog = self.resolver(name, from_file)
+                except Exception as ex:   # a resolver bug must not end the analysis
+                    self.diag("NC103", "warning", f"cannot load subprogram {name}: {ex}")
+                    prog = None
+                self._resolved[key] = prog
+                if prog is not None:
+                    self._index_subprograms(prog)
+                    if key not in self.sub_index:
+                        sub = n.Subprogram(name, n.Span(prog.file, 1), prog.body)
+                        self.sub_index[key] = (sub, prog.file)
+            hit = self.sub_index.get(key)
+        if hit is None:
+            return None
+        sub, file = hit
+        return self.unit_for(id(sub), sub.name, sub.body, file, sub.params)
+
+    def _make_scope(self, s: n.SubCall, unit: Unit, args: tuple) -> Callable[[], Scope]:
+        pos, named = args
+        share = s.kind == "m98" and not pos and not named
+        caller = self.ev.scope
+
+        def make():
+            sc = Scope(num=caller.num if share else None, args=dict(named))
+            for p, v in zip(unit.params, pos):
+                sc.names[p.name.upper()] = v
+            for k, v in named.items():
+                var = s.bindings.get(k)
+                if var is None:
+                    continue
+                if var.space == "num" and isinstance(var.key, int):
+                    sc.num[var.key] = v
+                elif var.space in ("name", "arg"):
+                    (sc.names if var.space == "name" else sc.args)[str(var.key).upper()] = v
+                elif var.space == "R" and isinstance(var.key, int):
+                    self.ev.R[var.key] = v
+            return sc
+        return make
+
+    # ================================================================ system variables
+    def _register_system(self) -> None:
+        sysv = self.ev.system
+        st = self.st
+        for i, a in enumerate("XYZABC"):
+            sysv[5001 + i] = (lambda a=a: self.pos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
+            sysv[5041 + i] = sysv[5001 + i]
+            sysv[5021 + i] = (lambda a=a: self.mpos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
+        sysv["$P_TOOLNO"] = lambda: float(st.tool or 0)
+        sysv["$P_TOOL"] = lambda: float(st.radius_index or 0)
+        sysv["$P_F"] = lambda: st.feed or 0.0
+        sysv["$P_S"] = lambda: st.spindle_speed or 0.0
+
+    # ================================================================ the loop
+    def run(self) -> Iterator[ToolpathRecord]:
+        prog = self.program
+        main = self.unit_for(id(prog), prog.name or "main", prog.body, prog.file, [])
+        unit, code = main, main.code
+        pc = sidx = 0
+        steps = 0
+        max_steps = self.max_steps
+        out = self.out
+        seq = 0
+        hook = self.hook
+        hookq = self._hookq
+        diag = self.diag
+        try:
+            while True:
+                if pc >= len(code):
+                    # falling off the end of a body: implicit return / end of program
+                    if not self.stack:
+                        break
+                    unit, code, pc, sidx = self._return(None)
+                    continue
+                ins = code[pc]
+                op = ins[0]
+                steps += 1
+                if steps > max_steps:
+                    sp = ins[3]
+                    diag("NC205", "warning", f"analysis truncated at line {sp.line if sp else 0}: "
+                         f"step budget of {max_steps} exhausted", sp)
+                    break
+                if op == BLOCK:
+                    self.span = ins[3]
+                    stmts = ins[1]
+                    ctl = None
+                    if sidx == 0:
+                        self.moved = False
+                    nst = len(stmts)
+                    while sidx < nst:
+                        h, data = stmts[sidx]
+                        sidx += 1
+                        try:
+                            ctl = h(data)
+                        except EvalError as ex:
+                            diag(ex.rule, ex.severity, ex.message)
+                            ctl = None
+                        if ctl is not None:
+                            break
+                    if ctl is None:
+                        sidx = 0
+                        pc += 1
+                        if self.moved and self.modal_call is not None and \
+                                len(self.stack) <= self.modal_call[2]:
+                            ctl = ("modal_call",)
+                    if ctl is not None:
+                        unit, code, pc, sidx = self._control(ctl, unit, pc, sidx)
+                elif op == JUMP:
+                    pc = ins[1]
+                elif op == JFALSE:
+                    self.span = ins[3]
+                    try:
+                        ok = ins[1]()
+                    except EvalError as ex:
+                        diag(ex.rule, ex.severity, ex.message)
+                        ok = False
+                    pc = pc + 1 if ok else ins[2]
+                elif op == EXEC:
+                    self.span = ins[3]
+                    try:
+                        ins[1]()
+                    except EvalError as ex:
+                        diag(ex.rule, ex.severity, ex.message)
+                    pc += 1
+                elif op == CASE:
+                    self.span = ins[3]
+                    subj, branches, default = ins[1]
+                    target = default
+                    try:
+                        v = subj()
+                        for f, lab in branches:
+                            if f() == v:
+                                target = lab
+                                break
+                    except EvalError as ex:
+                        diag(ex.rule, ex.severity, ex.message)
+                    pc += 1
+                    if target is not None:
+                        unit, code, pc, sidx = self._control(("goto", target, "forward"),
+                                                             unit, pc - 1, 0)
+                if out:
+                    for rec in out:
+                        seq += 1
+                        rec.seq = seq
+                        if hook is not None:
+                            w = hookq.popleft() if hookq else None
+                            hook(rec, *(w or (None, None)))
+                        yield rec
+                    out.clear()
+        except _Stop:
+            pass
+        self._comp_flush()
+        for rec in out:
+            seq += 1
+            rec.seq = seq
+            if hook is not None:
+                w = hookq.popleft() if hookq else None
+                hook(rec, *(w or (None, None)))
+            yield rec
+        out.clear()
+
+    def _control(self, ctl, unit, pc, sidx):
+        """Apply a control result from a statement: goto, call, return."""
+        kind = ctl[0]
+        if kind == "goto":
+            target = self._find_label(unit, ctl[1], ctl[2], pc)
+            if target is None:
+                self.diag("NC102", "error", f"jump target {ctl[1]} not found")
+                if self.stack:
+                    return self._return(None)
+                raise _Stop
+            return unit, unit.code, target, 0
+        if kind == "return":
+            if not self.stack:
+                raise _Stop
+            return self._return(ctl[1])
+        if kind in ("call", "modal_call"):
+            if kind == "call":
+                s = ctl[1]
+                args = None
+            else:
+                s, args, _ = self.modal_call
+            callee = self._find_unit(s.name)
+            if callee is None:
+                self.diag("NC103", "warning", f"subprogram {s.name} not found; the call is skipped")
+                return unit, unit.code, pc, sidx
+            if len(self.stack) >= MAX_CALL_DEPTH:
+                self.diag("NC105", "error", f"subprogram calls nested deeper than "
+                          f"{MAX_CALL_DEPTH}; call of {s.name} skipped")
+                return unit, unit.code, pc, sidx
+            try:
+                if args is None:
+                    args = self._call_args(s)
+                rep = 1
+                if s.repeat is not None:
+                    r = self._value(self.ev.compile(s.repeat), "repeat count")
+                    rep = 1 if r is None else int(round(r))
+            except EvalError as ex:
+                self.diag(ex.rule, ex.severity, ex.message)
+                return unit, unit.code, pc, sidx
+            if rep < 1:
+                return unit, unit.code, pc, sidx
+            make = self._make_scope(s, callee, args)
+            self.stack.append(Frame(unit, pc, sidx, self.ev.scope, callee, rep - 1, make))
+            self.ev.scope = make()
+            return callee, callee.code, 0, 0
+        return unit, unit.code, pc, sidx
+
+    def _return(self, to_label):
+        fr = self.stack[-1]
+        if fr.repeats > 0 and to_label is None:
+            fr.repeats -= 1
+            self.ev.scope = fr.make_scope()
+            return fr.callee, fr.callee.code, 0, 0
+        self.stack.pop()
+        self.ev.scope = fr.scope
+        unit, pc, sidx = fr.unit, fr.pc, fr.sidx
+        if to_label is not None:
+            target = self._find_label(unit, to_label, "any", pc)
+            if target is None:
+                self.diag("NC102", "error", f"return target {to_label} not found in the caller")
+            else:
+                return unit, unit.code, target, 0
+        return unit, unit.code, pc, sidx
+
+    @staticmethod
+    def _find_label(unit: Unit, target, direction: str, pc: int) -> Optional[int]:
+        pcs = unit.labels.get(label_key(target))
+        if not pcs:
+            return None
+        if direction in ("forward", "any"):
+            for p in pcs:
+                if p > pc:
+                    return p
+            if direction == "forward":
+                return None
+        best = None
+        for p in pcs:
+            if p <= pc:
+                best = p
+        if best is None and direction == "any":
+            return pcs[0]
+        return best
+
+
+def interpret(program: n.Program, machine=None, *, diagnostics: list, resolver=None,
+              max_steps: int = 2_000_000, flatten_hook=None) -> Iterator[ToolpathRecord]:
+    """Run `program` and yield its canonical motions one by one (see the module docstring)."""
+    return Interpreter(program, machine, diagnostics=diagnostics, resolver=resolver,
+                       max_steps=max_steps, flatten_hook=flatten_hook).run()
