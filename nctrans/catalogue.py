@@ -1,0 +1,105 @@
+"""The lint-rule catalogue (`rules/lint-rules.toml`), validated with pydantic.
+
+One source for `nctrans rules`, the SARIF `tool.driver.rules` and rule-code checks, so the
+documentation and what the tool reports cannot drift apart.
+"""
+from __future__ import annotations
+
+import re
+import tomllib
+from functools import lru_cache
+from pathlib import Path
+from typing import Literal, Optional
+
+from pydantic import BaseModel, ConfigDict, field_validator
+
+CATALOGUE_PATH = Path(__file__).resolve().parent.parent / "rules" / "lint-rules.toml"
+_CODE = re.compile(r"^NC\d{3}$")
+
+FAMILIES = {
+    "NC0": "syntax and lexical errors",
+    "NC1": "names, types and values",
+    "NC2": "modal and motion logic",
+    "NC3": "machine",
+    "NC4": "portability and conversion",
+    "NC5": "style",
+}
+
+
+class Rule(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    code: str
+    name: str
+    severity: Literal["error", "warning", "info"]
+    summary: str
+    why: str
+    bad: str
+    good: str
+    fix: Optional[str] = None
+
+    @field_validator("code")
+    @classmethod
+    def _code_form(cls, v: str) -> str:
+        if not _CODE.match(v):
+            raise ValueError(f"rule code {v!r} is not NC followed by three digits")
+        return v
+
+
+class Catalogue(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    rule: list[Rule]
+
+    def model_post_init(self, _ctx) -> None:
+        seen: dict[str, Rule] = {}
+        for r in self.rule:
+            if r.code in seen:
+                raise ValueError(f"rule {r.code} is defined twice")
+            seen[r.code] = r
+        self._by_code = seen
+
+    def get(self, code: str) -> Optional[Rule]:
+        return self._by_code.get(code.upper())
+
+    def codes(self) -> list[str]:
+        return [r.code for r in self.rule]
+
+
+@lru_cache(maxsize=None)
+def load(path: Path = CATALOGUE_PATH) -> Catalogue:
+    with path.open("rb") as fh:
+        return Catalogue.model_validate(tomllib.load(fh))
+
+
+def format_catalogue(cat: Catalogue) -> str:
+    """The catalogue as a plain table grouped by family."""
+    lines: list[str] = []
+    family = None
+    for r in sorted(cat.rule, key=lambda r: r.code):
+        if r.code[:3] != family:
+            family = r.code[:3]
+            if lines:
+                lines.append("")
+            lines.append(f"{family}xx  {FAMILIES.get(family, '')}")
+        lines.append(f"  {r.code}  {r.severity:<7}  {r.name:<26} {r.summary}")
+    lines.append("")
+    lines.append("`nctrans rules NCxxx` shows one rule in full.")
+    return "\n".join(lines)
+
+
+def format_rule(r: Rule) -> str:
+    """One rule's documentation: summary, why, a failing and a passing example, the fix."""
+    return "\n".join([
+        f"{r.code} {r.name} ({r.severity})",
+        "",
+        r.summary,
+        "",
+        f"Why: {r.why}",
+        "",
+        "Bad:",
+        f"    {r.bad}" if r.bad else "    (an empty file)",
+        "",
+        "Good:",
+        f"    {r.good}",
+        "",
+        f"Fix: {r.fix}" if r.fix else "Fix: no automatic fix; edit the program as in the good example.",
+    ])
