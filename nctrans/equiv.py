@@ -1,0 +1,291 @@
+"""Are two toolpaths the same machining? (`nctrans equiv`)
+
+Two record streams are cut into the same shape of sequence: *runs* of consecutive motion of one
+class (rapid or feed), separated by *gaps* holding what changed in between (tool changes, spindle
+speed and direction, coolant, dwells, stops) and by feed-rate changes. Runs compare geometrically:
+arcs are discretised into chords (sag well under the tolerance), and each run's points must lie
+within `tol` mm of the other run's polyline, in order, both ways, with matching end points. So an
+arc in one program equals the same arc written as short lines in the other. Gaps compare by order
+and value of their events, after dropping events that change nothing (S1000 M3 on one line equals
+S1000 then M3). Zero-length moves are ignored. The first difference is returned with both sides'
+file:line.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Iterable, Optional
+
+from nctrans.toolpath import ToolpathRecord
+from nctrans.toolpath_io import PLANE_AXES, arc_sweep
+
+DEFAULT_TOL = 0.001
+_ZERO = 1e-9
+_MAX_CHORDS = 20000
+_REL = 1e-6       # relative tolerance for event values (feed, speed, dwell)
+
+
+@dataclass
+class Difference:
+    message: str
+    a: Optional[ToolpathRecord]
+    b: Optional[ToolpathRecord]
+
+    def where(self, rec: Optional[ToolpathRecord], label: str) -> str:
+        return f"{rec.file}:{rec.line}" if rec is not None else f"{label}: (end of toolpath)"
+
+    def format(self) -> str:
+        return f"{self.where(self.a, 'A')}: {self.where(self.b, 'B')}: {self.message}"
+
+
+@dataclass
+class _Run:
+    cls: str                                  # "rapid" | "feed"
+    axes: tuple[str, ...]
+    points: list[tuple[float, ...]]
+    recs: list[ToolpathRecord]                # the record each point came from
+    feed: Optional[tuple] = None              # (feed, feed_mode) for feed runs
+
+
+@dataclass
+class _Gap:
+    events: list[tuple[str, object, ToolpathRecord]] = field(default_factory=list)
+
+
+# --------------------------------------------------------------------------- discretisation
+
+def _point(d: Optional[dict], axes: tuple[str, ...]) -> tuple[float, ...]:
+    d = d or {}
+    return tuple(float(d.get(a, 0.0)) for a in axes)
+
+
+def arc_points(r: ToolpathRecord, axes: tuple[str, ...], tol: float) -> list[tuple[float, ...]]:
+    """Points along an arc (excluding its start, including its end) whose chords deviate from the
+    arc by at most tol/4. Non-plane axes (helix, rotaries) move linearly with the angle; a radius
+    that differs between start and end (rounding) is interpolated like a spiral."""
+    t0, sweep, r0, (a1, a2) = arc_sweep(r)
+    s, e, c = r.start or {}, r.end or {}, r.center or {}
+    r1 = math.hypot(e.get(a1, 0.0) - c.get(a1, 0.0), e.get(a2, 0.0) - c.get(a2, 0.0))
+    rmax = max(r0, r1)
+    sag = tol / 4
+    if rmax <= sag:
+        n = 1
+    else:
+        step = 2 * math.acos(max(-1.0, 1 - sag / rmax))
+        n = max(1, min(_MAX_CHORDS, math.ceil(abs(sweep) / step)))
+    start = _point(s, axes)
+    end = _point(e, axes)
+    i1, i2 = axes.index(a1), axes.index(a2)
+    c1, c2 = c.get(a1, 0.0), c.get(a2, 0.0)
+    pts = []
+    for k in range(1, n + 1):
+        f = k / n
+        if k == n:
+            pts.append(end)
+            break
+        ang = t0 + sweep * f
+        rad = r0 + (r1 - r0) * f
+        p = [sv + (ev - sv) * f for sv, ev in zip(start, end)]
+        p[i1] = c1 + rad * math.cos(ang)
+        p[i2] = c2 + rad * math.sin(ang)
+        pts.append(tuple(p))
+    return pts
+
+
+# --------------------------------------------------------------------------- sequence building
+
+def _close(a, b) -> bool:
+    if isinstance(a, float) or isinstance(b, float):
+        if a is None or b is None:
+            return False
+        return abs(a - b) <= max(1e-9, _REL * max(abs(a), abs(b)))
+    return a == b
+
+
+def _axes_of(records: list[ToolpathRecord]) -> tuple[str, ...]:
+    seen: dict[str, None] = {}
+    for r in records:
+        for pt in (r.start, r.end):
+            if pt:
+                for a in pt:
+                    seen.setdefault(a, None)
+    order = "XYZABCUVW"
+    return tuple(sorted(seen, key=lambda a: (order.find(a) if a in order else 99, a)))
+
+
+def _is_zero_move(r: ToolpathRecord, axes: tuple[str, ...]) -> bool:
+    s, e = _point(r.start, axes), _point(r.end, axes)
+    if any(abs(x - y) > _ZERO for x, y in zip(s, e)):
+        return False
+    if r.kind == "arc":       # start == end: a full circle unless the radius is nil
+        t0, sweep, radius, _ = arc_sweep(r)
+        return radius <= _ZERO
+    return True
+
+
+def build_sequence(records: Iterable[ToolpathRecord], axes: tuple[str, ...], tol: float) -> list:
+    """Records -> alternating list of _Gap and _Run (a gap before every run, one at the end)."""
+    seq: list = []
+    gap = _Gap()
+    run: Optional[_Run] = None
+    # state that events are compared against: only real changes become events
+    state: dict[str, object] = {}
+
+    def event(key: str, value, rec: ToolpathRecord) -> None:
+        nonlocal gap, run
+        if key in state and _close(state[key], value) and key not in ("dwell", "stop", "tool_change"):
+            return
+        state[key] = value
+        if run is not None:
+            seq.append(run)
+            run = None
+        gap.events.append((key, value, rec))
+
+    for r in records:
+        k = r.kind
+        if k in ("rapid", "linear", "arc"):
+            if _is_zero_move(r, axes):
+                continue
+            cls = "rapid" if k == "rapid" else "feed"
+            if cls == "feed":
+                feed = (r.feed, r.feed_mode or "per_min")
+                if state.get("feed") is None or not (_close(state["feed"][0], feed[0])
+                                                      and state["feed"][1] == feed[1]):
+                    event("feed", feed, r)
+            if run is None or run.cls != cls:
+                if run is not None:
+                    seq.append(run)
+                seq.append(gap)
+                gap = _Gap()
+                run = _Run(cls, axes, [_point(r.start, axes)], [r])
+            pts = arc_points(r, axes, tol) if k == "arc" else [_point(r.end, axes)]
+            run.points.extend(pts)
+            run.recs.extend([r] * len(pts))
+        elif k == "tool_change":
+            event("tool_change", r.tool, r)
+        elif k == "spindle":
+            if r.spindle is not None:
+                event("spindle_speed", r.spindle, r)
+            if r.spindle_dir is not None:
+                event("spindle_dir", r.spindle_dir, r)
+        elif k == "coolant":
+            event("coolant", r.coolant, r)
+        elif k == "dwell":
+            event("dwell", r.dwell_s, r)
+        elif k == "stop":
+            event("stop", r.stop_kind, r)
+    if run is not None:
+        seq.append(run)
+    seq.append(gap)
+    return seq
+
+
+# --------------------------------------------------------------------------- geometry
+
+def _dist_point_segment(p, a, b) -> float:
+    ab = [y - x for x, y in zip(a, b)]
+    ap = [y - x for x, y in zip(a, p)]
+    L2 = sum(v * v for v in ab)
+    t = 0.0 if L2 == 0 else max(0.0, min(1.0, sum(u * v for u, v in zip(ab, ap)) / L2))
+    return math.sqrt(sum((pv - (av + t * bv)) ** 2 for pv, av, bv in zip(p, a, ab)))
+
+
+def _follows(P: list, Q: list, tol: float) -> Optional[tuple[int, int]]:
+    """None when every point of P lies within tol of polyline Q, visiting Q's segments in order;
+    else (index into P of the first point that does not, index of Q's segment reached)."""
+    if len(Q) == 1:
+        for i, p in enumerate(P):
+            if math.dist(p, Q[0]) > tol:
+                return i, 0
+        return None
+    j = 0
+    last = len(Q) - 2
+    for i, p in enumerate(P):
+        while _dist_point_segment(p, Q[j], Q[j + 1]) > tol:
+            if j == last:
+                return i, j
+            j += 1
+    return None
+
+
+def _compare_runs(ra: _Run, rb: _Run, tol: float) -> Optional[Difference]:
+    if ra.cls != rb.cls:
+        return Difference(f"{ra.cls} motion in A where B has {rb.cls} motion", ra.recs[0], rb.recs[0])
+    if math.dist(ra.points[0], rb.points[0]) > tol:
+        return Difference(f"{ra.cls} motion starts at {_fmt(ra.points[0], ra.axes)} in A, "
+                          f"{_fmt(rb.points[0], rb.axes)} in B", ra.recs[0], rb.recs[0])
+    bad = _follows(ra.points, rb.points, tol)
+    if bad is not None:
+        i, j = bad
+        return Difference(f"path leaves tolerance {tol:g} mm: A passes {_fmt(ra.points[i], ra.axes)}, "
+                          f"B is near {_fmt(rb.points[j + 1 if j + 1 < len(rb.points) else j], rb.axes)}",
+                          ra.recs[i], rb.recs[min(j + 1, len(rb.recs) - 1)])
+    bad = _follows(rb.points, ra.points, tol)
+    if bad is not None:
+        j, i = bad
+        return Difference(f"path leaves tolerance {tol:g} mm: B passes {_fmt(rb.points[j], rb.axes)}, "
+                          f"A is near {_fmt(ra.points[i + 1 if i + 1 < len(ra.points) else i], ra.axes)}",
+                          ra.recs[min(i + 1, len(ra.recs) - 1)], rb.recs[j])
+    if math.dist(ra.points[-1], rb.points[-1]) > tol:
+        return Difference(f"{ra.cls} motion ends at {_fmt(ra.points[-1], ra.axes)} in A, "
+                          f"{_fmt(rb.points[-1], rb.axes)} in B", ra.recs[-1], rb.recs[-1])
+    return None
+
+
+def _fmt(p, axes) -> str:
+    return " ".join(f"{a}{v:.4f}" for a, v in zip(axes, p))
+
+
+def _fmt_event(key: str, value) -> str:
+    if key == "feed":
+        f, mode = value
+        return f"feed {f:g} {mode}" if f is not None else f"feed unset {mode}"
+    return f"{key.replace('_', ' ')} {value}"
+
+
+def _compare_gaps(ga: _Gap, gb: _Gap, ra: Optional[ToolpathRecord], rb: Optional[ToolpathRecord]
+                  ) -> Optional[Difference]:
+    for (ka, va, reca), (kb, vb, recb) in zip(ga.events, gb.events):
+        same = ka == kb and (_close(va[0], vb[0]) and va[1] == vb[1] if ka == "feed" else _close(va, vb))
+        if not same:
+            return Difference(f"{_fmt_event(ka, va)} in A, {_fmt_event(kb, vb)} in B", reca, recb)
+    na, nb = len(ga.events), len(gb.events)
+    if na > nb:
+        k, v, rec = ga.events[nb]
+        return Difference(f"{_fmt_event(k, v)} in A has no counterpart in B", rec, gb.events[-1][2] if nb else rb)
+    if nb > na:
+        k, v, rec = gb.events[na]
+        return Difference(f"{_fmt_event(k, v)} in B has no counterpart in A", ga.events[-1][2] if na else ra, rec)
+    return None
+
+
+def compare(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: float = DEFAULT_TOL
+            ) -> Optional[Difference]:
+    """The first difference between toolpaths a and b, or None when they are equivalent."""
+    la, lb = list(a), list(b)
+    axes = _axes_of(la + lb)
+    sa, sb = build_sequence(la, axes, tol), build_sequence(lb, axes, tol)
+    last_a = last_b = None
+    for ia, ib in zip(sa, sb):
+        if isinstance(ia, _Run) and isinstance(ib, _Run):
+            d = _compare_runs(ia, ib, tol)
+            last_a, last_b = ia.recs[-1], ib.recs[-1]
+        elif isinstance(ia, _Gap) and isinstance(ib, _Gap):
+            d = _compare_gaps(ia, ib, last_a, last_b)
+            if ia.events:
+                last_a = ia.events[-1][2]
+            if ib.events:
+                last_b = ib.events[-1][2]
+        else:  # cannot happen: both sequences alternate gap/run from a gap
+            d = Difference("toolpaths differ in structure", last_a, last_b)
+        if d is not None:
+            return d
+    if len(sa) != len(sb):
+        longer, name = (sa, "A") if len(sa) > len(sb) else (sb, "B")
+        extra = longer[min(len(sa), len(sb))]
+        rec = extra.recs[0] if isinstance(extra, _Run) else (extra.events[0][2] if extra.events else None)
+        what = f"{extra.cls} motion" if isinstance(extra, _Run) else "events"
+        if name == "A":
+            return Difference(f"A continues with {what}; B has ended", rec, last_b)
+        return Difference(f"B continues with {what}; A has ended", last_a, rec)
+    return None
