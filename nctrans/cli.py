@@ -1,0 +1,500 @@
+"""The command line (CONTRACT.md "Commands"): argument parsing and wiring only.
+
+Every stage lives elsewhere (pipeline, output, equiv, toolpath_io, catalogue, detect); this module
+reads arguments, calls them, prints, and maps outcomes to the contract's exit codes:
+0 success, 1 diagnostics at or above --fail-on (or equiv found a difference), 2 usage error,
+unreadable file, unknown dialect or internal failure - always with a message, never a traceback
+(set NCTRANS_DEBUG=1 to get the traceback of an internal failure).
+"""
+from __future__ import annotations
+
+import argparse
+import inspect
+import os
+import sys
+import tempfile
+from pathlib import Path
+from typing import Iterable, Optional
+
+from nctrans import __version__
+from nctrans import catalogue as _catalogue
+from nctrans import detect as _detect
+from nctrans import equiv as _equiv
+from nctrans import output as _output
+from nctrans import pipeline
+from nctrans import source as _source
+from nctrans import toolpath_io
+from nctrans.diagnostics import SEVERITY_RANK, Diagnostic
+
+EXIT_OK, EXIT_DIAGNOSTICS, EXIT_USAGE = 0, 1, 2
+NOT_IMPLEMENTED = ("check", "backplot", "audit", "fuzz", "lsp")
+
+
+class UsageError(Exception):
+    """A problem with how nctrans was called (exit 2)."""
+
+
+# --------------------------------------------------------------------------- printing helpers
+
+def _err(msg: str) -> None:
+    print(f"nctrans: {msg}", file=sys.stderr)
+
+
+def _fancy(stream) -> bool:
+    return hasattr(stream, "isatty") and stream.isatty() and not os.environ.get("NO_COLOR")
+
+
+def _print_text_diags(diags: list[Diagnostic], stream) -> None:
+    """gcc-style lines; coloured with rich when the stream is a terminal."""
+    diags = sorted(diags, key=_output.sort_key)
+    if not diags:
+        return
+    if _fancy(stream):
+        from rich.console import Console
+        from rich.markup import escape
+        con = Console(file=stream, highlight=False, soft_wrap=True)
+        colour = {"error": "bold red", "warning": "yellow", "info": "cyan"}
+        for d in diags:
+            con.print(f"[bold]{escape(d.file)}:{d.line}:{d.column}:[/bold] "
+                      f"[{colour.get(d.severity, 'white')}]{d.severity}[/][dim]\\[{d.rule}][/dim] {escape(d.message)}")
+    else:
+        stream.write(_output.format_text(diags))
+        stream.flush()
+
+
+def _progress(total: int, description: str):
+    """A rich progress bar on stderr for long runs on a terminal; None in CI or when piped."""
+    if total < 2 or os.environ.get("CI") or not sys.stderr.isatty():
+        return None
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    prog = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                    console=Console(stderr=True), transient=True)
+    prog.start()
+    prog.add_task(description, total=total)
+    return prog
+
+
+def _at_or_above(diags: Iterable[Diagnostic], severity: str) -> bool:
+    rank = SEVERITY_RANK[severity]
+    return any(SEVERITY_RANK.get(d.severity, 2) >= rank for d in diags)
+
+
+def _debug() -> bool:
+    return os.environ.get("NCTRANS_DEBUG", "") not in ("", "0")
+
+
+def _internal(where: str, exc: BaseException) -> None:
+    if _debug():
+        raise exc
+    _err(f"internal error{where}: {type(exc).__name__}: {exc} (NCTRANS_DEBUG=1 shows the traceback)")
+
+
+def _check_dialect(name: Optional[str]) -> None:
+    if name is not None:
+        pipeline.get_dialect(name)
+
+
+# --------------------------------------------------------------------------- convert
+
+def _target_extension(dialect: str) -> str:
+    exts = _detect.EXTENSIONS.get(dialect) or (".nc",)
+    return exts[0]
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        if a.exists() and b.exists():
+            return os.path.samefile(a, b)
+    except OSError:
+        pass
+    return a.resolve() == b.resolve()
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write `text` to `path` through a temporary file in the same directory and os.replace, so a
+    reader never sees a half-written program and a failure leaves any old file intact."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def _flatten(program, machine, diags: list[Diagnostic], ld: pipeline.Loaded):
+    """Call nctrans.lower.flatten.flatten when a colleague's module provides it."""
+    try:
+        from nctrans.lower.flatten import flatten
+    except ImportError:
+        raise UsageError("--flatten is not available in this build yet") from None
+    offered = {"diagnostics": diags, "resolver": pipeline.make_resolver(ld.source_dir, ld.dialect),
+               "source_dir": ld.source_dir}
+    try:
+        params = inspect.signature(flatten).parameters
+        kwargs = {k: v for k, v in offered.items() if k in params}
+    except (TypeError, ValueError):
+        kwargs = {}
+    result = flatten(program, machine, **kwargs)
+    if isinstance(result, tuple):
+        result = result[0]
+    if hasattr(result, "program"):
+        extra = getattr(result, "diagnostics", None)
+        if extra and extra is not diags:
+            diags.extend(extra)
+        result = result.program
+    return result
+
+
+def _strict(diags: list[Diagnostic]) -> list[Diagnostic]:
+    out = []
+    for d in diags:
+        if d.rule == "NC401" and d.severity != "error":
+            d = Diagnostic(d.rule, "error", f"{d.message} (refused by --strict)", d.file, d.line, d.column,
+                           d.end_line, d.end_column, d.fix)
+        out.append(d)
+    return out
+
+
+def cmd_convert(args) -> int:
+    sources: list[str] = args.src
+    _check_dialect(args.from_)
+    target = pipeline.get_dialect(args.to)
+    if args.output and args.out_dir:
+        raise UsageError("give either -o or --out-dir, not both")
+    if args.output and len(sources) > 1:
+        raise UsageError("-o takes one source; use --out-dir for several")
+    if len(sources) > 1 and not args.out_dir:
+        raise UsageError("several sources need --out-dir")
+    if sources.count(_source.STDIN) > 1:
+        raise UsageError("'-' (stdin) can be given once")
+    # decide every output path first, and refuse before doing any work
+    outputs: dict[str, Optional[Path]] = {}
+    inputs = [Path(s) for s in sources if s != _source.STDIN]
+    for s in sources:
+        if args.output:
+            out = None if args.output == "-" else Path(args.output)
+        elif args.out_dir:
+            stem = "stdin" if s == _source.STDIN else Path(s).stem
+            out = Path(args.out_dir) / (stem + _target_extension(target.name))
+        else:
+            out = None
+        if out is not None:
+            if out.is_dir():
+                raise UsageError(f"{out}: is a directory (use --out-dir)")
+            for i in inputs:
+                if _same_file(out, i):
+                    raise UsageError(f"refusing to overwrite the input {i} with the output {out}")
+            for other, o in outputs.items():
+                if o is not None and _same_file(o, out):
+                    raise UsageError(f"{s} and {other} would both be written to {out}")
+        outputs[s] = out
+    machine = pipeline.load_machine(args.machine, args.from_) if args.flatten else None
+    status = EXIT_OK
+    for s in sources:
+        try:
+            ld = pipeline.load(s, args.from_)
+        except pipeline.PipelineError as e:
+            _err(str(e))
+            status = EXIT_USAGE
+            continue
+        diags = ld.diagnostics
+        text = None
+        if ld.program is not None and not _at_or_above(diags, "error"):
+            program = ld.program
+            if args.flatten:
+                program = _flatten(program, machine or pipeline.load_machine(None, ld.dialect), diags, ld)
+            if target.name == ld.dialect and not args.flatten:
+                program = program   # same dialect: a normalising round trip through the IR
+            res = target.emit(program)
+            diags.extend(res.diagnostics)
+            text = res.text
+        if args.strict:
+            diags[:] = _strict(diags)
+        _print_text_diags(diags, sys.stderr)
+        if text is None or _at_or_above(diags, "error"):
+            _err(f"{ld.label}: not converted (errors above)")
+            status = max(status, EXIT_DIAGNOSTICS)
+            continue
+        out = outputs[s]
+        if out is None:
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        else:
+            try:
+                write_atomic(out, text)
+            except OSError as e:
+                _err(f"{out}: cannot write: {e.strerror or e}")
+                status = EXIT_USAGE
+    return status
+
+
+# --------------------------------------------------------------------------- lint
+
+def _rule_filter(select: list[str], ignore: list[str]):
+    sel = [p.strip().upper() for group in select for p in group.split(",") if p.strip()]
+    ign = [p.strip().upper() for group in ignore for p in group.split(",") if p.strip()]
+
+    def keep(d: Diagnostic) -> bool:
+        code = d.rule.upper()
+        if sel and not any(code.startswith(p) for p in sel):
+            return False
+        return not any(code.startswith(p) for p in ign)
+    return keep
+
+
+def cmd_lint(args) -> int:
+    _check_dialect(args.from_)
+    machine = pipeline.load_machine(args.machine, args.from_) if args.machine else None
+    files = list(pipeline.iter_inputs(args.paths))
+    if not files:
+        _err("no NC files found in " + " ".join(args.paths))
+        sys.stdout.write(_output.render(args.format, [], 0) if args.format != "text" else "")
+        return EXIT_OK
+    if _source.STDIN in files and files.count(_source.STDIN) > 1:
+        raise UsageError("'-' (stdin) can be given once")
+    keep = _rule_filter(args.select or [], args.ignore or [])
+    all_diags: list[Diagnostic] = []
+    status = EXIT_OK
+    if not pipeline.interpreter_available():
+        _err("note: the interpreter is not available in this build; only parse diagnostics are reported")
+    bar = _progress(len(files), "lint")
+    done = 0
+    try:
+        for f in files:
+            try:
+                ld = pipeline.load(f, args.from_)
+                m = machine or pipeline.load_machine(None, ld.dialect)
+                diags = pipeline.lint(ld, m)
+                done += 1
+            except pipeline.PipelineError as e:
+                _err(str(e))
+                status = EXIT_USAGE
+                continue
+            except Exception as e:  # a bug on one file must not lose the report for the others
+                _internal(f" on {f}", e)
+                status = EXIT_USAGE
+                continue
+            finally:
+                if bar is not None:
+                    bar.advance(bar.task_ids[0])
+            all_diags.extend(d for d in diags if keep(d))
+    finally:
+        if bar is not None:
+            bar.stop()
+    if args.format == "text":
+        _print_text_diags(all_diags, sys.stdout)
+    else:
+        sys.stdout.write(_output.render(args.format, all_diags, done))
+        sys.stdout.flush()
+    if status == EXIT_OK and _at_or_above(all_diags, args.fail_on):
+        status = EXIT_DIAGNOSTICS
+    return status
+
+
+# --------------------------------------------------------------------------- toolpath
+
+def cmd_toolpath(args) -> int:
+    _check_dialect(args.from_)
+    ld = pipeline.load(args.src, args.from_)
+    machine = pipeline.load_machine(args.machine, ld.dialect)
+    if ld.program is None:
+        _print_text_diags(ld.diagnostics, sys.stderr)
+        return EXIT_DIAGNOSTICS
+    records = pipeline.toolpath_of(ld, machine)
+    out = sys.stdout
+    if args.summary:
+        summ = toolpath_io.Summary(machine)
+        for r in records:
+            summ.add(r)
+        _print_text_diags(ld.diagnostics, sys.stderr)
+        out.write(summ.format(len(ld.diagnostics)))
+    else:
+        writer = toolpath_io.write_csv if args.format == "csv" else toolpath_io.write_jsonl
+        writer(records, out)
+        out.flush()
+        _print_text_diags(ld.diagnostics, sys.stderr)
+    return EXIT_DIAGNOSTICS if _at_or_above(ld.diagnostics, "error") else EXIT_OK
+
+
+# --------------------------------------------------------------------------- equiv
+
+def cmd_equiv(args) -> int:
+    if not args.tol > 0:
+        raise UsageError("--tol must be a positive number of mm")
+    _check_dialect(args.from_a)
+    _check_dialect(args.from_b)
+    if args.a == _source.STDIN and args.b == _source.STDIN:
+        raise UsageError("only one of A and B can be '-' (stdin)")
+    la = pipeline.load(args.a, args.from_a)
+    lb = pipeline.load(args.b, args.from_b)
+    ma = pipeline.load_machine(args.machine, la.dialect)
+    mb = ma if args.machine else pipeline.load_machine(None, lb.dialect)
+    ra = list(pipeline.toolpath_of(la, ma))
+    rb = list(pipeline.toolpath_of(lb, mb))
+    _print_text_diags(la.diagnostics + lb.diagnostics, sys.stderr)
+    if la.program is None or lb.program is None:
+        _err("cannot compare: an input did not parse")
+        return EXIT_DIAGNOSTICS
+    diff = _equiv.compare(ra, rb, args.tol)
+    if diff is not None:
+        print(f"different: {diff.format()}")
+        return EXIT_DIAGNOSTICS
+    print(f"equivalent within {args.tol:g} mm ({len(ra)} and {len(rb)} toolpath records)")
+    if _at_or_above(la.diagnostics + lb.diagnostics, "error"):
+        return EXIT_DIAGNOSTICS
+    return EXIT_OK
+
+
+# --------------------------------------------------------------------------- detect, rules, stubs
+
+def cmd_detect(args) -> int:
+    status = EXIT_OK
+    for f in args.files:
+        label = _source.label_for(f)
+        try:
+            src = _source.read_source(f)
+        except _source.SourceError as e:
+            _err(str(e))
+            status = EXIT_USAGE
+            continue
+        if not src.ok:
+            _print_text_diags(src.diagnostics, sys.stderr)
+            status = max(status, EXIT_DIAGNOSTICS)
+            continue
+        g = _detect.detect(src.text, None if f == _source.STDIN else f)
+        if g.ambiguous:
+            print(f"{label}: ambiguous ({g.describe()}): use --from DIALECT")
+            status = EXIT_USAGE
+        else:
+            print(f"{label}: {g.dialect} (confidence {g.confidence:.2f})")
+    return status
+
+
+def cmd_rules(args) -> int:
+    cat = _catalogue.load()
+    if args.rule:
+        r = cat.get(args.rule)
+        if r is None:
+            raise UsageError(f"no rule {args.rule!r} (`nctrans rules` lists them)")
+        print(_catalogue.format_rule(r))
+    else:
+        print(_catalogue.format_catalogue(cat))
+    return EXIT_OK
+
+
+def cmd_not_implemented(args) -> int:
+    print(f"nctrans {args.command}: not implemented yet (issue pending)", file=sys.stderr)
+    return EXIT_USAGE
+
+
+# --------------------------------------------------------------------------- parser
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="nctrans",
+                                 description="Transpiler and static analyzer between CNC part-program dialects.")
+    ap.add_argument("--version", action="version", version=f"nctrans {__version__}")
+    sub = ap.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = sub.add_parser("convert", help="translate programs into another dialect")
+    p.add_argument("src", nargs="+", metavar="SRC", help="source files ('-' = stdin)")
+    p.add_argument("--to", required=True, metavar="DIALECT", help="target dialect")
+    p.add_argument("--from", dest="from_", metavar="DIALECT", help="source dialect (detected when omitted)")
+    p.add_argument("-o", dest="output", metavar="OUT", help="output file for a single source ('-' = stdout)")
+    p.add_argument("--out-dir", metavar="DIR", help="directory for the outputs (one per source)")
+    p.add_argument("--strict", action="store_true", help="turn every lowering (NC401) into an error")
+    p.add_argument("--flatten", action="store_true", help="emit plain motion only (no macros, loops, calls, cycles)")
+    p.add_argument("--machine", metavar="MACHINE.toml", help="machine for --flatten (offsets, tools)")
+    p.set_defaults(func=cmd_convert)
+
+    p = sub.add_parser("lint", help="report diagnostics")
+    p.add_argument("paths", nargs="+", metavar="PATH", help="files or directories (recursed); '-' = stdin")
+    p.add_argument("--from", dest="from_", metavar="DIALECT")
+    p.add_argument("--format", choices=_output.FORMATS, default="text")
+    p.add_argument("--machine", metavar="MACHINE.toml")
+    p.add_argument("--select", action="append", metavar="RULES", help="only these rules (prefixes, comma-separated)")
+    p.add_argument("--ignore", action="append", metavar="RULES", help="drop these rules (prefixes, comma-separated)")
+    p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error")
+    p.set_defaults(func=cmd_lint)
+
+    p = sub.add_parser("toolpath", help="print the canonical toolpath")
+    p.add_argument("src", metavar="SRC")
+    p.add_argument("--from", dest="from_", metavar="DIALECT")
+    p.add_argument("--machine", metavar="MACHINE.toml")
+    p.add_argument("--format", choices=("jsonl", "csv"), default="jsonl")
+    p.add_argument("--summary", action="store_true",
+                   help="print a short summary (counts, lengths, bounding box, tools, cycle time) instead")
+    p.set_defaults(func=cmd_toolpath)
+
+    p = sub.add_parser("equiv", help="compare two programs' toolpaths")
+    p.add_argument("a", metavar="A")
+    p.add_argument("b", metavar="B")
+    p.add_argument("--from-a", metavar="DIALECT")
+    p.add_argument("--from-b", metavar="DIALECT")
+    p.add_argument("--machine", metavar="MACHINE.toml")
+    p.add_argument("--tol", type=float, default=_equiv.DEFAULT_TOL, metavar="MM")
+    p.set_defaults(func=cmd_equiv)
+
+    p = sub.add_parser("detect", help="guess the dialect of files")
+    p.add_argument("files", nargs="+", metavar="FILE")
+    p.set_defaults(func=cmd_detect)
+
+    p = sub.add_parser("rules", help="the lint-rule catalogue, or one rule's documentation")
+    p.add_argument("rule", nargs="?", metavar="RULE")
+    p.set_defaults(func=cmd_rules)
+
+    for name in NOT_IMPLEMENTED:
+        p = sub.add_parser(name, help="(not implemented yet)", add_help=False)
+        p.add_argument("rest", nargs=argparse.REMAINDER)
+        p.set_defaults(func=cmd_not_implemented)
+    return ap
+
+
+def _main(argv: Optional[list[str]]) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not args.command:
+        parser.print_help(sys.stderr)
+        return EXIT_USAGE
+    try:
+        return args.func(args)
+    except (UsageError, pipeline.PipelineError) as e:
+        _err(str(e))
+        return EXIT_USAGE
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    """Entry point: never lets a traceback out (unless NCTRANS_DEBUG=1)."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        _err("interrupted")
+        return EXIT_USAGE
+    except BrokenPipeError:
+        # the reader went away (| head): stop quietly; keep Python from complaining at exit
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return EXIT_DIAGNOSTICS
+    except SystemExit:
+        raise
+    except Exception as e:
+        _internal("", e)
+        return EXIT_USAGE
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,211 @@
+"""The glue every command runs: read a file -> decode -> pick the dialect -> parse -> interpret.
+
+Used by the CLI and by other tools (bench, audit, lsp) so each runs the stages the same way.
+User-facing failures that are not diagnostics of the program (a missing file, an unknown dialect,
+an ambiguous guess) raise `PipelineError` with the message to print; the CLI maps it to exit 2.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Iterable, Iterator, Optional
+
+from nctrans import detect as _detect
+from nctrans import source as _source
+from nctrans.diagnostics import Diagnostic
+from nctrans.dialects import base
+from nctrans.ir.nodes import Program
+from nctrans.machine import Machine, MachineError, default_lathe, default_mill
+from nctrans.machine import load as _load_machine
+from nctrans.toolpath import ToolpathRecord
+
+# how sure detection must be that a file is another dialect than --from says before NC005 fires
+WRONG_DIALECT_CONFIDENCE = 0.85
+WRONG_DIALECT_EVIDENCE = 6.0
+
+
+class PipelineError(Exception):
+    """A failure to report to the user as a message with exit code 2 (not a program diagnostic)."""
+
+
+@dataclass
+class Loaded:
+    """Everything known about one input after reading and parsing."""
+    path: str
+    label: str
+    source: _source.SourceText
+    dialect: Optional[str]
+    program: Optional[Program]
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    guess: Optional[_detect.Guess] = None
+
+    @property
+    def source_dir(self) -> Optional[str]:
+        return None if self.path == _source.STDIN else str(Path(self.path).resolve().parent)
+
+
+def get_dialect(name: str) -> base.Dialect:
+    """The registered dialect `name`; PipelineError for an unknown or not-yet-available one."""
+    if name not in base.names():
+        raise PipelineError(f"unknown dialect {name!r} (known: {', '.join(base.names())})")
+    try:
+        d = base.get(name)
+    except (ImportError, AttributeError):
+        d = None
+    if d is None:
+        raise PipelineError(f"dialect {name!r} is not available in this build yet")
+    return d
+
+
+def _wrong_dialect(src: _source.SourceText, dialect: str, guess: _detect.Guess) -> Optional[Diagnostic]:
+    """NC005 when the text is clearly another dialect than the one it is parsed as."""
+    other = guess.dialect
+    if other is None or other == dialect or guess.confidence < WRONG_DIALECT_CONFIDENCE:
+        return None
+    if guess.evidence.get(other, 0.0) < WRONG_DIALECT_EVIDENCE:
+        return None
+    line, col, text = guess.first_marker.get(other, (1, 1, ""))
+    what = f" ({text!r} at line {line})" if text else ""
+    return Diagnostic("NC005", "error",
+                      f"this looks like {other}, not {dialect}{what}: use --from {other}",
+                      src.file, line, col, line, col + max(len(text), 1))
+
+
+def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Optional[str] = None) -> Loaded:
+    """Parse already-read text: choose the dialect (given or detected), parse, collect diagnostics."""
+    label = src.file
+    diags = list(src.diagnostics)
+    if not src.ok:
+        return Loaded(path, label, src, dialect, None, diags)
+    guess = _detect.detect(src.text, None if path == _source.STDIN else path)
+    if dialect is None:
+        if guess.ambiguous:
+            raise PipelineError(f"{label}: cannot tell the dialect ({guess.describe()}): use --from DIALECT")
+        dialect = guess.dialect
+    d = get_dialect(dialect)
+    result = d.parse(src.text, label)
+    diags.extend(result.diagnostics)
+    if not any(x.rule == "NC005" for x in diags):
+        wrong = _wrong_dialect(src, dialect, guess)
+        if wrong is not None:
+            diags.append(wrong)
+    return Loaded(path, label, src, dialect, result.program, diags, guess)
+
+
+def load(path: str, dialect: Optional[str] = None) -> Loaded:
+    """Read, decode, detect and parse one file ('-' = stdin). PipelineError if it cannot be read."""
+    try:
+        src = _source.read_source(path)
+    except _source.SourceError as e:
+        raise PipelineError(str(e)) from None
+    return load_source(src, path, dialect)
+
+
+def load_program(path_or_dash: str, dialect: Optional[str] = None
+                 ) -> tuple[Optional[Program], list[Diagnostic], Optional[str]]:
+    """(Program or None, diagnostics, dialect name) for one file; see `load` for the full record."""
+    ld = load(path_or_dash, dialect)
+    return ld.program, ld.diagnostics, ld.dialect
+
+
+def load_machine(path: Optional[str], dialect: Optional[str] = None) -> Machine:
+    """The machine from MACHINE.toml, or the built-in default (a lathe for turning dialects)."""
+    if path is None:
+        return default_lathe() if dialect == "iso-t" else default_mill()
+    try:
+        return _load_machine(path)
+    except MachineError as e:
+        raise PipelineError(str(e)) from None
+
+
+def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> Optional[Callable]:
+    """A subprogram resolver (name, from_file) -> Program|None searching the source's directory.
+
+    Uses nctrans.interp.resolver when it is there; without it calls to other files stay
+    unresolved (NC103 from the interpreter)."""
+    if source_dir is None:
+        return None
+    try:
+        from nctrans.interp import resolver as _res
+    except ImportError:
+        return None
+    factory = getattr(_res, "Resolver", None) or getattr(_res, "make_resolver", None)
+    if factory is None:
+        return None
+    for kwargs in ({"search_path": [source_dir], "dialect": dialect}, {"search_path": [source_dir]}):
+        try:
+            return factory(**kwargs)
+        except TypeError:
+            continue
+    try:
+        return factory([source_dir])
+    except TypeError:
+        return None
+
+
+def _interpret():
+    try:
+        from nctrans.interp import interpret
+    except ImportError:
+        return None
+    return interpret
+
+
+def interpreter_available() -> bool:
+    return _interpret() is not None
+
+
+def run_toolpath(program: Program, machine: Optional[Machine], diagnostics: list[Diagnostic], *,
+                 source_dir: Optional[str] = None, dialect: Optional[str] = None,
+                 max_steps: Optional[int] = None) -> Iterator[ToolpathRecord]:
+    """Stream the program's toolpath; interpreter diagnostics are appended to `diagnostics`."""
+    interpret = _interpret()
+    if interpret is None:
+        raise PipelineError("the interpreter is not available in this build yet")
+    kwargs = {"diagnostics": diagnostics, "resolver": make_resolver(source_dir, dialect)}
+    if max_steps is not None:
+        kwargs["max_steps"] = max_steps
+    return interpret(program, machine, **kwargs)
+
+
+def toolpath_of(ld: Loaded, machine: Optional[Machine] = None) -> Iterator[ToolpathRecord]:
+    """Toolpath of a loaded file (nothing when it did not parse); diagnostics go to ld.diagnostics."""
+    if ld.program is None:
+        return iter(())
+    return run_toolpath(ld.program, machine, ld.diagnostics, source_dir=ld.source_dir, dialect=ld.dialect)
+
+
+def lint(ld: Loaded, machine: Optional[Machine] = None) -> list[Diagnostic]:
+    """Parse diagnostics plus the interpreter's (records are drained and dropped)."""
+    if ld.program is not None and interpreter_available():
+        for _ in toolpath_of(ld, machine):
+            pass
+    return ld.diagnostics
+
+
+# --------------------------------------------------------------------------- paths
+
+def all_extensions() -> set[str]:
+    exts: set[str] = set()
+    for name in base.names():
+        exts.update(_detect._extensions(name))
+    for group in _detect.EXTENSIONS.values():
+        exts.update(group)
+    return exts
+
+
+def iter_inputs(paths: Iterable[str]) -> Iterator[str]:
+    """Files to process: files as given, directories recursed (NC file endings only, hidden entries
+    skipped, sorted for stable output), '-' for stdin. Missing paths are yielded too, so the caller
+    reports them through the normal read error."""
+    exts = all_extensions()
+    for p in paths:
+        if p != _source.STDIN and os.path.isdir(p):
+            for root, dirs, files in os.walk(p):
+                dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+                for f in sorted(files):
+                    if not f.startswith(".") and Path(f).suffix.lower() in exts:
+                        yield os.path.join(root, f)
+        else:
+            yield p
