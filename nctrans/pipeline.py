@@ -119,29 +119,39 @@ def load_machine(path: Optional[str], dialect: Optional[str] = None) -> Machine:
         raise PipelineError(str(e)) from None
 
 
-def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> Optional[Callable]:
-    """A subprogram resolver (name, from_file) -> Program|None searching the source's directory.
-
-    Uses nctrans.interp.resolver when it is there; without it calls to other files stay
-    unresolved (NC103 from the interpreter)."""
-    if source_dir is None:
-        return None
+def _display_path(path: Path) -> str:
+    """A path as diagnostics show it: relative to the working directory when inside it."""
     try:
-        from nctrans.interp import resolver as _res
+        return str(path.relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
+
+
+def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> Optional[Callable]:
+    """The interpreter's subprogram resolver, searching the source's directory (the working
+    directory for stdin). Called files are parsed in the caller's dialect; their own diagnostics
+    are reported when they are linted themselves, not again through every caller."""
+    try:
+        from nctrans.interp.resolver import Resolver
     except ImportError:
         return None
-    factory = getattr(_res, "Resolver", None) or getattr(_res, "make_resolver", None)
-    if factory is None:
-        return None
-    for kwargs in ({"search_path": [source_dir], "dialect": dialect}, {"search_path": [source_dir]}):
+
+    def parse_file(path: Path) -> Optional[Program]:
         try:
-            return factory(**kwargs)
-        except TypeError:
-            continue
-    try:
-        return factory([source_dir])
-    except TypeError:
-        return None
+            src = _source.decode(_source.read_bytes(path), _display_path(Path(path)))
+        except _source.SourceError:
+            return None
+        if not src.ok:
+            return None
+        name = dialect or _detect.detect(src.text, str(path)).dialect
+        if name is None:
+            return None
+        try:
+            return get_dialect(name).parse(src.text, src.file).program
+        except PipelineError:
+            return None
+
+    return Resolver([source_dir or os.getcwd()], parse_file)
 
 
 def _interpret():
