@@ -66,6 +66,8 @@ CYCLE_LENGTH_KEYS = frozenset(("bottom", "r_plane", "retract_plane", "safety", "
 def label_key(text: Any) -> Any:
     """Block numbers compare numerically ("0100" == "N100" == 100); labels by upper-case name."""
     s = str(text).strip()
+    if s.isdigit():
+        return int(s)
     m = _LABEL_NUM.match(s.upper())
     if m:
         return int(m.group(1))
@@ -173,17 +175,14 @@ class Interpreter:
         for node in nodes_:
             t = type(node)
             if t is n.Block:
-                stmts = []
-                for s in node.body:
-                    c = self.compilers.get(type(s))
-                    if c is None:
-                        continue
-                    stmts.append(c(s))
+                # statements compile on first execution (see run): the first record of a huge
+                # program comes after one cheap flattening pass, not a full compile
                 pc = len(code)
-                code.append((BLOCK, stmts, node, node.span))
-                for lab in (node.number, node.label):
-                    if lab is not None and lab != "":
-                        unit.labels.setdefault(label_key(lab), []).append(pc)
+                code.append((BLOCK, None, node, node.span))
+                if node.number is not None and node.number != "":
+                    unit.labels.setdefault(label_key(node.number), []).append(pc)
+                if node.label:
+                    unit.labels.setdefault(label_key(node.label), []).append(pc)
             elif t is n.If:
                 j = len(code)
                 code.append(None)
@@ -225,6 +224,15 @@ class Interpreter:
                 subj = self.ev.compile(node.subject)
                 branches = [(self.ev.compile(v), lab) for v, lab in node.branches]
                 code.append((CASE, (subj, branches, node.default), None, node.span))
+
+    def _compile_block(self, block: n.Block) -> list:
+        out = []
+        comp = self.compilers
+        for s in block.body:
+            c = comp.get(type(s))
+            if c is not None:
+                out.append(c(s))
+        return out
 
     def _cond(self, expr) -> Callable[[], Any]:
         f = self.ev.compile(expr)
@@ -294,11 +302,15 @@ class Interpreter:
         if not d:
             return ()
         out = []
+        AV, Num = n.AxisValue, n.Num
         for axis, av in d.items():
-            if isinstance(av, n.AxisValue):
+            if type(av) is AV:
                 expr, mode = av.value, av.mode
             else:
                 expr, mode = av, None
+            if type(expr) is Num:
+                out.append((axis.upper(), float(expr.value), None, mode))
+                continue
             c = constant(expr)
             out.append((axis.upper(), c, None if c is not None else self.ev.compile(expr), mode))
         return tuple(out)
@@ -694,6 +706,22 @@ class Interpreter:
 
     # ---------------------------------------------------------------- motion
     def _c_motion(self, s: n.Motion):
+        if (s.center is None and s.radius is None and s.turns is None and not s.polar
+                and not s.machine_coords and s.via is None
+                and getattr(s, "aperture", None) is None):
+            fast = []
+            AV, Num = n.AxisValue, n.Num
+            for axis, av in s.target.items():
+                if type(av) is AV and type(av.value) is Num and av.mode in (None, "abs", "inc"):
+                    a = axis.upper()
+                    fast.append((a, float(av.value.value), av.mode, a in LINEAR_AXES))
+                else:
+                    break
+            else:
+                return (self._h_fast, [tuple(fast), s, None])
+        return (self._h_motion, self._c_motion_full(s))
+
+    def _c_motion_full(self, s: n.Motion) -> tuple:
         words = self._words(s.target)
         center = self._words(s.center)
         radius = None if s.radius is None else self.ev.compile(s.radius)
@@ -701,7 +729,61 @@ class Interpreter:
         polar = None
         if s.polar:
             polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
-        return (self._h_motion, (words, center, radius, turns, s.machine_coords, polar))
+        return (words, center, radius, turns, s.machine_coords, polar)
+
+    def _slow(self, d):
+        full = d[2]
+        if full is None:
+            full = d[2] = self._c_motion_full(d[1])
+        return self._h_motion(full)
+
+    def _h_fast(self, d):
+        """The hot path: a rapid/linear move with literal words and no frame, comp or cycle."""
+        words = d[0]
+        st = self.st
+        if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
+                or self.comp_exit or st.comp_side != "off" or not self.frame.identity):
+            return self._slow(d)
+        motion = st.motion
+        if motion == "rapid":
+            feed = None
+        elif motion == "linear":
+            feed = st.feed
+            if not feed:
+                self._need_feed()
+        else:
+            return self._slow(d)
+        self.moved = True
+        if not words:
+            return None
+        tgt = self.pos.copy()
+        scale = st.scale
+        inc = st.incremental
+        for axis, v, mode, lin in words:
+            if lin and scale != 1.0:
+                v = v * scale
+            cur = tgt.get(axis)
+            if cur is None:                  # first use of an axis: the general path adds it
+                return self._slow(d)
+            if (inc if mode is None else mode == "inc"):
+                v += cur
+            tgt[axis] = v
+        self.pos = tgt
+        tot = self.off.total
+        mend = {a: v + tot.get(a, 0.0) for a, v in tgt.items()} if tot else tgt.copy()
+        mstart = self.mpos
+        self.mpos = mend
+        sp = self.span
+        if feed is None:
+            rec = ToolpathRecord(0, sp.file, sp.line, "rapid", mstart, mend, None, None, None,
+                                 None, None, None, st.spindle_speed, st.tool)
+        else:
+            rec = ToolpathRecord(0, sp.file, sp.line, "linear", mstart, mend, None, None, None,
+                                 None, feed, st.feed_mode, st.spindle_speed, st.tool)
+        self.out.append(rec)
+        if self.hook is not None:
+            self._hookq.append(({a: v - tot.get(a, 0.0) for a, v in mend.items()}, None))
+        return None
 
     def _h_motion(self, d):
         words, center, radius, turns, machine, polar = d
@@ -1132,6 +1214,9 @@ class Interpreter:
                 if op == BLOCK:
                     self.span = ins[3]
                     stmts = ins[1]
+                    if stmts is None:
+                        stmts = self._compile_block(ins[2])
+                        code[pc] = (BLOCK, stmts, ins[2], ins[3])
                     ctl = None
                     if sidx == 0:
                         self.moved = False
