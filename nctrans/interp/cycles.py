@@ -74,6 +74,10 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
     clear level is then R), `approach` (R) under G99. `repeat` (ISO K/L) drills that many holes in
     one block, each shifted by `step` (the G91 plane increments) from the previous one; `hole` is
     the first. Points are full axis dicts. Never raises on user values; see `cycle_problems`.
+    `feed` and `units_mm` do not change the steps (feeds are the caller's; the LinuxCNC peck
+    clearance is 0.254 mm in both unit systems). One approximation: under G98 with Zi exactly at R,
+    the plane move happens at the current height (LinuxCNC: at Zi), which differs only if a G99
+    hole with another R came earlier in the same series.
     """
     ax = DRILL_AXIS[plane]
     a1, a2 = PLANE_AXES[plane]
