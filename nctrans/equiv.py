@@ -190,14 +190,14 @@ def _dist_point_segment(p, a, b) -> float:
     return math.sqrt(sum((pv - (av + t * bv)) ** 2 for pv, av, bv in zip(p, a, ab)))
 
 
-def _follows(P: list, Q: list, tol: float) -> Optional[tuple[int, int]]:
-    """None when every point of P lies within tol of polyline Q, visiting Q's segments in order;
-    else (index into P of the first point that does not, index of Q's segment reached)."""
+def _walk(P: list, Q: list, tol: float) -> tuple[Optional[int], int]:
+    """Walk P's points along polyline Q, visiting Q's segments in order. Returns (index of the first
+    point of P farther than tol from Q, or None; index of the segment of Q reached)."""
     if len(Q) == 1:
         for i, p in enumerate(P):
             if math.dist(p, Q[0]) > tol:
                 return i, 0
-        return None
+        return None, 0
     j = 0
     last = len(Q) - 2
     for i, p in enumerate(P):
@@ -205,30 +205,50 @@ def _follows(P: list, Q: list, tol: float) -> Optional[tuple[int, int]]:
             if j == last:
                 return i, j
             j += 1
-    return None
+    return None, j
 
 
-def _compare_runs(ra: _Run, rb: _Run, tol: float) -> Optional[Difference]:
+def _beyond(Q: list, j: int, p, tol: float) -> int:
+    """Index of the first point of Q after segment j that is farther than tol from p."""
+    for k in range(j + 1, len(Q)):
+        if math.dist(Q[k], p) > tol:
+            return k
+    return len(Q) - 1
+
+
+def _compare_runs(ra: _Run, rb: _Run, tol: float, next_a: str = "", next_b: str = "") -> Optional[Difference]:
+    """First difference between two runs; next_a/next_b say what follows each (for messages)."""
+    cls = ra.cls
     if ra.cls != rb.cls:
         return Difference(f"{ra.cls} motion in A where B has {rb.cls} motion", ra.recs[0], rb.recs[0])
-    if math.dist(ra.points[0], rb.points[0]) > tol:
-        return Difference(f"{ra.cls} motion starts at {_fmt(ra.points[0], ra.axes)} in A, "
-                          f"{_fmt(rb.points[0], rb.axes)} in B", ra.recs[0], rb.recs[0])
-    bad = _follows(ra.points, rb.points, tol)
-    if bad is not None:
-        i, j = bad
-        return Difference(f"path leaves tolerance {tol:g} mm: A passes {_fmt(ra.points[i], ra.axes)}, "
-                          f"B is near {_fmt(rb.points[j + 1 if j + 1 < len(rb.points) else j], rb.axes)}",
-                          ra.recs[i], rb.recs[min(j + 1, len(rb.recs) - 1)])
-    bad = _follows(rb.points, ra.points, tol)
-    if bad is not None:
-        j, i = bad
-        return Difference(f"path leaves tolerance {tol:g} mm: B passes {_fmt(rb.points[j], rb.axes)}, "
-                          f"A is near {_fmt(ra.points[i + 1 if i + 1 < len(ra.points) else i], ra.axes)}",
-                          ra.recs[min(i + 1, len(ra.recs) - 1)], rb.recs[j])
-    if math.dist(ra.points[-1], rb.points[-1]) > tol:
-        return Difference(f"{ra.cls} motion ends at {_fmt(ra.points[-1], ra.axes)} in A, "
-                          f"{_fmt(rb.points[-1], rb.axes)} in B", ra.recs[-1], rb.recs[-1])
+    A, B = ra.points, rb.points
+    if math.dist(A[0], B[0]) > tol:
+        return Difference(f"{cls} motion starts at {_fmt(A[0], ra.axes)} in A, "
+                          f"{_fmt(B[0], rb.axes)} in B", ra.recs[0], rb.recs[0])
+    fa, ja = _walk(A, B, tol)
+    fb, jb = _walk(B, A, tol)
+    ends_apart = math.dist(A[-1], B[-1]) > tol
+    if fa is None and ends_apart:           # A stops where B goes on
+        k = _beyond(B, ja, A[-1], tol)
+        return Difference(f"A's {cls} motion ends at {_fmt(A[-1], ra.axes)}"
+                          f"{' and ' + next_a + ' follows' if next_a else ''}; "
+                          f"B's goes on to {_fmt(B[k], rb.axes)}", ra.recs[-1], rb.recs[k])
+    if fb is None and ends_apart:           # B stops where A goes on
+        k = _beyond(A, jb, B[-1], tol)
+        return Difference(f"B's {cls} motion ends at {_fmt(B[-1], rb.axes)}"
+                          f"{' and ' + next_b + ' follows' if next_b else ''}; "
+                          f"A's goes on to {_fmt(A[k], ra.axes)}", ra.recs[k], rb.recs[-1])
+    if fa is not None:
+        k = min(ja + 1, len(B) - 1)
+        return Difference(f"path leaves tolerance {tol:g} mm: A passes {_fmt(A[fa], ra.axes)}, "
+                          f"B is near {_fmt(B[k], rb.axes)}", ra.recs[fa], rb.recs[k])
+    if fb is not None:
+        k = min(jb + 1, len(A) - 1)
+        return Difference(f"path leaves tolerance {tol:g} mm: B passes {_fmt(B[fb], rb.axes)}, "
+                          f"A is near {_fmt(A[k], ra.axes)}", ra.recs[k], rb.recs[fb])
+    if ends_apart:
+        return Difference(f"{cls} motion ends at {_fmt(A[-1], ra.axes)} in A, "
+                          f"{_fmt(B[-1], rb.axes)} in B", ra.recs[-1], rb.recs[-1])
     return None
 
 
@@ -259,6 +279,17 @@ def _compare_gaps(ga: _Gap, gb: _Gap, ra: Optional[ToolpathRecord], rb: Optional
     return None
 
 
+def _what_next(seq: list, n: int) -> str:
+    """What follows item n of a sequence, in words (for messages)."""
+    for item in seq[n + 1:]:
+        if isinstance(item, _Run):
+            return f"{item.cls} motion"
+    for item in seq[n + 1:]:
+        if item.events:
+            return _fmt_event(*item.events[0][:2])
+    return "the end of the toolpath"
+
+
 def compare(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: float = DEFAULT_TOL
             ) -> Optional[Difference]:
     """The first difference between toolpaths a and b, or None when they are equivalent."""
@@ -266,9 +297,9 @@ def compare(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: float
     axes = _axes_of(la + lb)
     sa, sb = build_sequence(la, axes, tol), build_sequence(lb, axes, tol)
     last_a = last_b = None
-    for ia, ib in zip(sa, sb):
+    for n, (ia, ib) in enumerate(zip(sa, sb)):
         if isinstance(ia, _Run) and isinstance(ib, _Run):
-            d = _compare_runs(ia, ib, tol)
+            d = _compare_runs(ia, ib, tol, _what_next(sa, n), _what_next(sb, n))
             last_a, last_b = ia.recs[-1], ib.recs[-1]
         elif isinstance(ia, _Gap) and isinstance(ib, _Gap):
             d = _compare_gaps(ia, ib, last_a, last_b)
