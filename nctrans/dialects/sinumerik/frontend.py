@@ -1,0 +1,1031 @@
+"""Sinumerik 840D front end: program text -> neutral IR (nctrans.ir.nodes).
+
+Pipeline (spec section 11.1), one NC block at a time so one bad block costs one NC0xx diagnostic
+and never the rest of the program:
+1. split the line: block skip `/n`, block number `N10`/`:10`, label `NAME:`, `;` comment;
+   file headers `%_N_NAME_MPF` and `;$PATH=` go to Program.meta;
+2. expand `DEFINE ... AS` macros of the file (textual, spec 6.5);
+3. keep verbatim what the IR has no concept for: synchronized actions, REDEF/APR/APW data
+   attributes, data sections (CTABDEF..CTABEND, CONTPRON..EXECUTE, CPROTDEF..EXECUTE), ISO-mode
+   sections (G291..G290, parsed by the iso-m front end when it is installed);
+4. lex (lexer.py) and parse the statement part with the LALR grammar grammars/sinumerik.lark;
+5. lower the words to IR statements in execution order, then nest control structures.
+
+Numbers stay in program units (the interpreter applies G70/G71). Codes map to neutral values
+through rules/sinumerik.toml; standard cycles through rules/cycles.toml.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Optional
+
+from lark import Lark, Token, Tree
+from lark.exceptions import UnexpectedInput, UnexpectedToken, UnexpectedCharacters, UnexpectedEOF
+from lark.lexer import Lexer
+
+from nctrans.diagnostics import Diagnostic
+from nctrans.dialects.base import ParseResult
+from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
+from nctrans.ir import nodes as ir
+from nctrans.ir.vocabulary import MODAL_GROUPS
+from nctrans.rules import load_table, normalise_code
+
+GRAMMAR = Path(__file__).resolve().parents[3] / "grammars" / "sinumerik.lark"
+DIALECT = "sinumerik"
+
+
+class _BlockLexer(Lexer):
+    """Adapter: lark calls this with the statement text; tokens come from lexer.tokenize."""
+
+    def __init__(self, lexer_conf):   # noqa: D401 - lark's interface
+        pass
+
+    def lex(self, data):
+        yield from tokenize(data)
+
+
+@lru_cache(maxsize=1)
+def parser() -> Lark:
+    return Lark(GRAMMAR.read_text(encoding="utf-8"), parser="lalr", lexer=_BlockLexer,
+                maybe_placeholders=True)
+
+
+@lru_cache(maxsize=1)
+def table():
+    return load_table(DIALECT)
+
+
+@lru_cache(maxsize=1)
+def _cycles():
+    """name -> (kind, [neutral keys], kind_by) from rules/cycles.toml (shared with the interpreter)."""
+    from nctrans.interp.cycles import cycle_table
+    t = cycle_table()
+    out = {}
+    for c in t.cycle:
+        out[c.name] = (c.kind, [t.neutral(p) for p in c.params], c.kind_by and (
+            t.neutral(c.kind_by.param), c.kind_by.values))
+    for p in t.pattern:
+        out[p.name] = ("holes_line" if p.shape == "row" else "holes_circle",
+                       [t.neutral(x) for x in p.params], None)
+    return out
+
+
+# --------------------------------------------------------------------------- line splitting
+
+_SKIP = re.compile(r"\s*/(\d)?")
+_BLOCKNO = re.compile(r"\s*(?:[Nn](\d+)|:(\d+))(?=[^\d._=\[\w]|$)")
+_BLOCKNO_GLUED = re.compile(r"\s*[Nn](\d+)(?=[A-Za-z])")
+_LABEL = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*:(?![=:])")
+_SYNC = re.compile(r"^\s*(?:(?:ID|IDS)\s*=|(?:WHEN|WHENEVER|FROM|EVERY|DO)\b)", re.IGNORECASE)
+_DATA_ATTR = re.compile(r"^\s*(?:REDEF|APR|APW)\b", re.IGNORECASE)
+_DEFINE = re.compile(r"^\s*DEFINE\s+([A-Za-z_$][A-Za-z0-9_]*)\s+AS\b\s?(.*)$", re.IGNORECASE)
+_HEADER = re.compile(r"^\s*%(\S*)")
+_PATH = re.compile(r"^\s*;\s*\$PATH\s*=\s*(\S*)", re.IGNORECASE)
+_UNIT_NAME = re.compile(r"^_N_(\w+?)_(MPF|SPF)$", re.IGNORECASE)
+_PCALL_PATH = re.compile(r"\b(PCALL\s+)(/[^\s(]*/)([A-Za-z_]\w*)", re.IGNORECASE)
+_WORD_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_SECTION_START = re.compile(r"^\s*(CTABDEF|CONTPRON|CONTDCON|CPROTDEF|NPROTDEF)\s*\(", re.IGNORECASE)
+_G291 = re.compile(r"(?<![\w.])G291(?![\w.])", re.IGNORECASE)
+_G290 = re.compile(r"(?<![\w.])G290(?![\w.])", re.IGNORECASE)
+_SECTION_END = {"CTABDEF": "CTABEND", "CONTPRON": "EXECUTE", "CONTDCON": "EXECUTE",
+                "CPROTDEF": "EXECUTE", "NPROTDEF": "EXECUTE"}
+_SECTION_REASON = {"CTABDEF": "curve table definition", "CONTPRON": "contour table",
+                   "CONTDCON": "contour table", "CPROTDEF": "protection zone definition",
+                   "NPROTDEF": "protection zone definition"}
+
+
+def split_comment(line: str) -> tuple[str, Optional[str]]:
+    """(code, comment): the first `;` outside a double-quoted string starts the comment."""
+    inq = False
+    for i, ch in enumerate(line):
+        if ch == '"':
+            inq = not inq
+        elif ch == ";" and not inq:
+            return line[:i], line[i + 1:].rstrip()
+    return line, None
+
+
+@dataclass
+class Line:
+    """One source line split into its parts. `col` is the 1-based column where `code` starts."""
+    lineno: int
+    raw: str
+    code: str
+    col: int
+    skip: Optional[int] = None
+    number: Optional[str] = None
+    label: Optional[str] = None
+    comment: Optional[str] = None
+
+
+def split_line(lineno: int, raw: str) -> Line:
+    code, comment = split_comment(raw)
+    pos = 0
+    skip = None
+    m = _SKIP.match(code)
+    if m:
+        skip = int(m.group(1)) if m.group(1) else 0
+        pos = m.end()
+    number = None
+    m = _BLOCKNO.match(code, pos) or _BLOCKNO_GLUED.match(code, pos)
+    if m:
+        number = m.group(1) if m.group(1) is not None else (m.group(2) if m.re is _BLOCKNO else None)
+        if m.re is _BLOCKNO and m.group(2) is not None:
+            number = m.group(2)
+        pos = m.end()
+    label = None
+    m = _LABEL.match(code, pos)
+    if m:
+        label = m.group(1).upper()
+        pos = m.end()
+    rest = code[pos:]
+    lead = len(rest) - len(rest.lstrip())
+    return Line(lineno, raw, rest.strip(), pos + lead + 1, skip, number, label, comment)
+
+
+# --------------------------------------------------------------------------- expressions
+
+_BINOPS = {"+": "+", "-": "-", "*": "*", "/": "/", "DIV": "div", "MOD": "mod", "AND": "and",
+           "OR": "or", "XOR": "xor", "B_AND": "band", "B_OR": "bor", "B_XOR": "bxor",
+           "==": "==", "<>": "!=", "<": "<", ">": ">", "<=": "<=", ">=": ">=", "=<": "<=",
+           "=>": ">=", "<<": "concat"}
+_PREFIX = {"-": "-", "+": "+", "NOT": "not", "B_NOT": "bnot"}
+_RPARAM = re.compile(r"R(\d+)$")
+
+
+def _num(tok: Token) -> ir.Num:
+    return ir.Num(number_value(str(tok)), str(tok))
+
+
+def expr(t) -> Optional[ir.Expr]:
+    """Lower an expression tree (or token) to IR."""
+    if t is None:
+        return None
+    if isinstance(t, Token):
+        if t.type in ("NUMBER", "HEXBIN", "TRUE", "FALSE"):
+            return _num(t)
+        if t.type == "STR":
+            return ir.Str(str(t))
+        if t.type == "RPARAM":
+            return ir.Var("R", int(str(t)[1:]))
+        if t.type == "IDENT":
+            return ir.Var("name", str(t))
+        raise ValueError(f"unexpected token {t!r}")
+    d = t.data
+    ch = t.children
+    if d == "number":
+        return _num(ch[0])
+    if d == "string":
+        return ir.Str(str(ch[0]))
+    if d == "rparam":
+        return ir.Var("R", int(str(ch[0])[1:]))
+    if d == "name":
+        name = str(ch[0])
+        idx = _args(ch[2]) if len(ch) > 1 and ch[2] is not None else None
+        if name == "R" and idx:
+            return ir.Var("R", None, idx)
+        return ir.Var("name", name, idx)
+    if d == "sysvar":
+        idx = _args(ch[2]) if len(ch) > 1 and ch[2] is not None else None
+        return ir.Var("system", str(ch[0]), idx)
+    if d == "func":
+        return func(str(ch[0]), _args(ch[2]))
+    if d == "paren":
+        args = _args(ch[1])
+        if len(args) == 1 and args[0] is not None:
+            return args[0]
+        return ir.Func("LIST", args)
+    if d == "prefix":
+        op = str(ch[0])
+        operand = expr(ch[1])
+        if op == "-" and isinstance(operand, ir.Num) and operand.value >= 0 and not (
+                operand.text or "").startswith(("-", "+")) and (operand.text or "").upper() not in ("TRUE", "FALSE"):
+            return ir.Num(-operand.value, "-" + (operand.text or repr(operand.value)))
+        return ir.Unary(_PREFIX[op], operand)
+    if d == "to_string":
+        return ir.Binary("concat", ir.Str(""), expr(ch[1]))
+    if len(ch) == 3 and isinstance(ch[1], Token):
+        return ir.Binary(_BINOPS[str(ch[1])], expr(ch[0]), expr(ch[2]))
+    raise ValueError(f"unexpected tree {d}")
+
+
+def _args(t) -> list[Optional[ir.Expr]]:
+    """arglist -> expressions; an omitted argument (`f(1,,3)`) is None."""
+    if t is None:
+        return []
+    return [expr(a.children[0]) if a.children and a.children[0] is not None else None
+            for a in t.children if isinstance(a, Tree)]
+
+
+def func(name: str, args: list) -> ir.Expr:
+    fn = table().options.get("functions", {})
+    if name == "POT" and len(args) == 1:
+        return ir.Func("pow", [args[0], ir.Num(2.0, "2")])
+    if name in fn:
+        return ir.Func(fn[name], args)
+    return ir.Func(name, args)
+
+
+# --------------------------------------------------------------------------- block lowering
+
+_ORDER = {"Assign": 0, "VarDecl": 0, "ModeChange": 1, "Feed": 2, "SpindleSpeed": 2,
+          "ToolSelect": 2, "OffsetSelect": 2, "ToolChange": 3, "Message": 5, "Alarm": 5,
+          "Passthrough": 5, "FrameOp": 5, "HomeReturn": 5, "Dwell": 6, "Motion": 6, "CycleCall": 6,
+          "CycleParams": 6, "SubCall": 7, "ModalCallOff": 7, "Stop": 8, "ProgramEnd": 8,
+          "Return": 8, "Goto": 8}
+
+
+def _priority(st) -> int:
+    kind = type(st).__name__
+    if kind == "ModeChange":
+        if st.group in ("spindle", "coolant"):
+            return 7 if st.value == "off" else 4
+        return 1
+    if kind == "SubCall" and st.modal != "none":
+        return 7
+    return _ORDER.get(kind, 5)
+
+
+def _axis_value(e: ir.Expr) -> ir.AxisValue:
+    """X=AC(v) / X=IC(v) / DC/ACP/ACN (absolute with a direction the IR does not keep)."""
+    if isinstance(e, ir.Func) and len(e.args) == 1 and e.args[0] is not None:
+        if e.name == "AC":
+            return ir.AxisValue(e.args[0], "abs")
+        if e.name == "IC":
+            return ir.AxisValue(e.args[0], "inc")
+        if e.name in ("DC", "ACP", "ACN", "CAC", "CACP", "CACN", "CDC"):
+            return ir.AxisValue(e.args[0], "abs")
+        if e.name == "CIC":
+            return ir.AxisValue(e.args[0], "inc")
+    return ir.AxisValue(e)
+
+
+@dataclass
+class _Words:
+    """What one block programs, gathered before it becomes statements."""
+    out: list = field(default_factory=list)
+    target: dict = field(default_factory=dict)
+    center: dict = field(default_factory=dict)
+    via: dict = field(default_factory=dict)
+    polar: dict = field(default_factory=dict)
+    radius: Optional[ir.Expr] = None
+    aperture: Optional[ir.Expr] = None
+    turns: Optional[ir.Expr] = None
+    rpl: Optional[ir.Expr] = None
+    feed: Optional[ir.Expr] = None
+    speed: list = field(default_factory=list)
+    repeat: Optional[ir.Expr] = None
+    dwell: bool = False
+    machine: bool = False
+    frame: Optional[str] = None
+
+
+class Lowerer:
+    """Lowers parsed blocks of one file; collects diagnostics and program metadata."""
+
+    def __init__(self, file: str):
+        self.file = file
+        self.diags: list[Diagnostic] = []
+        self.meta: dict = {}
+        t = table()
+        self.axes = set(t.options.get("axes", []))
+        self.centre = t.options.get("centre_words", {})
+        self.via = t.options.get("via_words", {})
+        self.pass_words = t.options.get("passthrough_words", {})
+        self.commands = t.options.get("machine_commands", {})
+        self.whole_block = set(t.options.get("whole_block_commands", []))
+        self.unsupported = t.options.get("unsupported_functions", {})
+
+    # ---- diagnostics
+    def error(self, rule: str, msg: str, line: int, col: int, end_col: int = 0) -> None:
+        self.diags.append(Diagnostic(rule, "error", msg, self.file, line, col, line,
+                                     end_col or col + 1))
+
+    # ---- codes
+    def code(self, code: str, w: _Words, text: str) -> None:
+        rule = table().lookup(code)
+        if rule is None:
+            reason = self.unsupported.get(code)
+            if reason is None and code.startswith("M"):
+                reason = "auxiliary function"
+                w.out.append(ir.Passthrough(text, reason, ""))
+                return
+            w.out.append(ir.Passthrough(text, reason or "unknown function", DIALECT))
+            return
+        g = rule.group
+        if g in MODAL_GROUPS:
+            w.out.append(ir.ModeChange(g, rule.value, code))
+        elif g == "stop":
+            w.out.append(ir.Stop(optional=rule.value == "optional"))
+        elif g == "end":
+            w.out.append(ir.ProgramEnd(rule.value))
+        elif g == "return":
+            w.out.append(ir.Return())
+        elif g == "tool_change":
+            w.out.append(ir.ToolChange())
+        elif g == "dwell":
+            w.dwell = True
+        elif g == "machine_coords":
+            w.machine = True
+        elif g == "frame":
+            w.frame = rule.value
+        else:
+            w.out.append(ir.Passthrough(text, g, DIALECT))
+
+    def address(self, letter: str, num: ir.Num, w: _Words, text: str) -> None:
+        """A word `letter number` (X10, G1, M3, F100, L47 ...)."""
+        if letter == "G":
+            self.code(normalise_code("G", num.text or num.value), w, text)
+        elif letter == "M":
+            try:
+                code = normalise_code("M", num.text)
+            except ValueError:
+                code = "M" + (num.text or "")
+            self.code(code, w, text)
+        elif letter in self.axes:
+            w.target[letter] = ir.AxisValue(num)
+        elif letter in self.centre:
+            w.center[letter] = ir.AxisValue(num)
+        elif letter == "F":
+            w.feed = num
+        elif letter == "S":
+            w.speed.append((1, num))
+        elif letter == "T":
+            w.out.append(ir.ToolSelect(num))
+        elif letter == "D":
+            w.out.append(ir.OffsetSelect("radius", num))
+        elif letter == "L":
+            w.out.append(ir.SubCall("L" + (num.text or str(int(num.value))), kind="l"))
+        elif letter == "P":
+            w.repeat = num
+        elif letter == "N":
+            pass
+        else:
+            reason = self.pass_words.get(letter, f"address {letter}")
+            w.out.append(ir.Passthrough(text, reason, DIALECT if letter != "H" else ""))
+
+    def named(self, name: str, value: ir.Expr, w: _Words, text: str) -> None:
+        """A word `NAME=expr`: axis, arc parameter, extended address or an assignment."""
+        if name in self.axes:
+            w.target[name] = _axis_value(value)
+        elif name in self.centre:
+            w.center[name] = _axis_value(value)
+        elif name in self.via:
+            w.via[self.via[name]] = _axis_value(value)
+        elif name == "CR":
+            w.radius = value
+        elif name == "AR":
+            w.aperture = value
+        elif name == "AP":
+            w.polar["angle"] = value
+        elif name == "RP":
+            w.polar["radius"] = value
+        elif name == "TURN":
+            w.turns = value
+        elif name == "RPL":
+            w.rpl = value
+        elif name == "F":
+            w.feed = value
+        elif name == "S" or re.fullmatch(r"S\d+", name):
+            w.speed.append((int(name[1:] or 1), value))
+        elif name == "T" or re.fullmatch(r"T\d+", name):
+            w.out.append(ir.ToolSelect(value))
+        elif name == "D":
+            w.out.append(ir.OffsetSelect("radius", value))
+        elif _RPARAM.match(name):
+            w.out.append(ir.Assign(ir.Var("R", int(name[1:])), value))
+        elif name in self.pass_words:
+            w.out.append(ir.Passthrough(text, self.pass_words[name], DIALECT))
+        elif re.fullmatch(r"[A-Z]\d+", name):
+            reason = self.pass_words.get(name[0], f"extended address {name[0]}")
+            w.out.append(ir.Passthrough(text, reason, DIALECT))
+        else:
+            w.out.append(ir.Assign(ir.Var("name", name), value))
+
+    def call(self, name: str, args: Optional[list], w: _Words, text: str, modal: bool = False) -> None:
+        """A call by name (with or without arguments), a procedure or a keyword function."""
+        if args is None and not modal:
+            if table().lookup(name) is not None or name in self.unsupported:
+                self.code(name, w, text)
+                return
+        if name in self.commands and not modal:
+            w.out.append(ir.Passthrough(text, self.commands[name], DIALECT))
+            return
+        if name == "MSG" and not modal:
+            w.out.append(ir.Message(args[0] if args and args[0] is not None else ir.Str("")))
+            return
+        if name == "SETAL" and not modal and args:
+            w.out.append(ir.Alarm(args[0], args[1] if len(args) > 1 else None))
+            return
+        cyc = _cycles().get(name)
+        if cyc is not None and args is not None:
+            kind, keys, kind_by = cyc
+            params = {k: a for k, a in zip(keys, args) if a is not None}
+            if kind_by:
+                sel = params.get(kind_by[0])
+                if isinstance(sel, ir.Num):
+                    kind = kind_by[1].get(str(int(sel.value)), kind)
+            w.out.append(ir.CycleCall(kind, params, modal=modal, name=name))
+            if len(args) > len(keys):
+                self.meta.setdefault("cycle_extra_args", []).append(name)
+            return
+        kind = "l" if re.fullmatch(r"L\d+", name) else "proc"
+        if modal:
+            kind = "mcall"
+        w.out.append(ir.SubCall(name, list(args or []), modal="after_move" if modal else "none",
+                                kind=kind))
+
+    def frame_op(self, w: _Words) -> None:
+        op = w.frame
+        additive = op.endswith("_add")
+        base = op.replace("_add", "")
+        values = {k: v.value for k, v in w.target.items()}
+        if not values and w.rpl is None:
+            if additive:
+                return
+            w.out.append(ir.FrameOp("all", clear=True))
+            return
+        if base == "rot" and w.rpl is not None:
+            w.out.append(ir.FrameOp("rot", values, angle=w.rpl, additive=additive))
+            w.rpl = None
+        else:
+            w.out.append(ir.FrameOp(base, values, additive=additive))
+        w.target.clear()
+
+    def statements(self, stmts: list, line: Line) -> list:
+        """The statements of one (non-control) block in execution order."""
+        w = _Words()
+        code = line.code
+        for st in stmts:
+            d = st.data
+            ch = st.children
+            text = _slice(code, st)
+            if d == "word":
+                if ch[1] is None:
+                    w.out.append(ir.Passthrough(text, "address without value", DIALECT))
+                else:
+                    self.address(str(ch[0]), _num(ch[1]), w, text)
+            elif d == "assign":
+                lv = ch[0]
+                values = [expr(c) for c in ch[2:] if isinstance(c, Tree) or (
+                    isinstance(c, Token) and c.type not in ("COLON",))]
+                value = values[0] if len(values) == 1 else ir.Func("frame_chain", values)
+                lt = lv.children[0]
+                idx = lv.children[2] if len(lv.children) > 2 else None
+                if lt.type == "RPARAM":
+                    w.out.append(ir.Assign(ir.Var("R", int(str(lt)[1:])), value))
+                elif lt.type == "SYSVAR":
+                    w.out.append(ir.Assign(ir.Var("system", str(lt), _args(idx) if idx else None), value))
+                elif idx is not None:
+                    name = str(lt)
+                    if name in self.pass_words:
+                        w.out.append(ir.Passthrough(text, self.pass_words[name], DIALECT))
+                    elif name == "R":
+                        w.out.append(ir.Assign(ir.Var("R", None, _args(idx)), value))
+                    else:
+                        w.out.append(ir.Assign(ir.Var("name", name, _args(idx)), value))
+                else:
+                    self.named(str(lt), value, w, text)
+            elif d == "call_name":
+                self.call(str(ch[0]), None, w, text)
+            elif d == "call_args":
+                name = str(ch[0])
+                if name in self.whole_block:
+                    return [ir.Passthrough(code, self.commands.get(name, "machine command"), DIALECT)]
+                self.call(name, _args(ch[2]), w, text)
+            elif d == "mcall_off":
+                w.out.append(ir.ModalCallOff())
+            elif d == "mcall_name":
+                self.call(str(ch[1]), [], w, text, modal=True)
+            elif d == "mcall_args":
+                self.call(str(ch[1]), _args(ch[3]), w, text, modal=True)
+            elif d == "mcall_l":
+                w.out.append(ir.SubCall("L" + str(ch[2]), modal="after_move", kind="mcall"))
+            elif d == "call_stmt":
+                target = expr(ch[1]) if ch[1] is not None else None
+                if isinstance(target, ir.Str) and ch[2] is None:
+                    w.out.append(ir.SubCall(target.value.upper(), kind="call"))
+                else:
+                    w.out.append(ir.Passthrough(text, "indirect call", DIALECT))
+            elif d == "pcall_stmt":
+                w.out.append(ir.SubCall(str(ch[1]), _args(ch[3]) if ch[3] is not None else [],
+                                        kind="pcall"))
+            elif d in ("isocall_stmt", "extcall_stmt"):
+                target = expr(ch[1]) if ch[1] is not None else None
+                if isinstance(target, ir.Str):
+                    w.out.append(ir.SubCall(target.value.upper(), kind=d.split("_")[0]))
+                else:
+                    w.out.append(ir.Passthrough(text, "indirect call", DIALECT))
+            elif d == "ret_stmt":
+                if ch[1] is None:
+                    w.out.append(ir.Return())
+                else:
+                    w.out.append(ir.Passthrough(text, "parameterized return", DIALECT))
+            elif d == "endproc_stmt":
+                w.out.append(ir.Return())
+            elif d == "frame_stmt":
+                w.frame = table().lookup(str(ch[0])).value
+            elif d == "procattr_stmt":
+                w.out.append(ir.Passthrough(text, self.commands.get(str(ch[0]), "program attribute"),
+                                            DIALECT))
+            elif d == "goto_stmt":
+                w.out.append(_goto(ch[0], ch[1], None))
+            elif d == "def_stmt":
+                w.out.extend(self.vardecls(st))
+            elif d == "extern_stmt":
+                w.out.append(ir.Passthrough(text, "declaration", DIALECT))
+                self.meta.setdefault("externs", []).append(str(ch[1]))
+            else:
+                self.error("NC002", f"{_KW.get(d, d)} must stand in its own block", line.lineno,
+                           line.col)
+        # frame instructions take the block's axis words as their values
+        if w.frame:
+            self.frame_op(w)
+        if w.dwell:
+            secs = w.feed
+            revs = w.speed[0][1] if w.speed else None
+            w.feed, w.speed = None, []
+            w.out.append(ir.Dwell(secs, revs))
+        if w.feed is not None:
+            w.out.append(ir.Feed(w.feed))
+        for sp, v in w.speed:
+            w.out.append(ir.SpindleSpeed(v, sp))
+        if w.target or w.center or w.via or w.polar or w.radius is not None or w.aperture is not None \
+                or w.turns is not None:
+            w.out.append(ir.Motion(dict(w.target), dict(w.center) or None, w.radius, w.turns,
+                                   dict(w.via) or None, w.machine, dict(w.polar) or None, w.aperture))
+        elif w.rpl is not None:
+            w.out.append(ir.Passthrough("RPL", "plane rotation outside ROT", DIALECT))
+        if w.repeat is not None:
+            calls = [s for s in w.out if isinstance(s, ir.SubCall)]
+            if calls:
+                calls[-1].repeat = w.repeat
+            else:
+                w.out.append(ir.Passthrough(f"P{w.repeat.text}", "address P", DIALECT))
+        return sorted(w.out, key=_priority)
+
+    def vardecls(self, st: Tree) -> list:
+        ch = st.children
+        scope = "local"
+        type_spec = None
+        decls = []
+        for c in ch:
+            if isinstance(c, Token) and c.type == "SCOPE":
+                scope = str(c).lower()
+            elif isinstance(c, Tree) and c.data == "type_spec":
+                type_spec = c
+            elif isinstance(c, Tree) and c.data == "decl":
+                decls.append(c)
+        typ, length = _type(type_spec)
+        out = []
+        for dcl in decls:
+            name = str(dcl.children[0])
+            dims = []
+            if dcl.children[2] is not None:
+                for a in _args(dcl.children[2]):
+                    dims.append(int(a.value) if isinstance(a, ir.Num) else 0)
+            init = None
+            if dcl.children[5] is not None:
+                v = expr(dcl.children[5])
+                if isinstance(v, ir.Func) and v.name in ("LIST", "SET"):
+                    init = [a if a is not None else ir.Num(0.0, "0") for a in v.args]
+                else:
+                    init = [v]
+            out.append(ir.VarDecl(name, typ, dims, init, length, scope))
+        return out
+
+
+_KW = {"if_stmt": "IF", "else_stmt": "ELSE", "endif_stmt": "ENDIF", "while_stmt": "WHILE",
+       "endwhile_stmt": "ENDWHILE", "for_stmt": "FOR", "endfor_stmt": "ENDFOR", "loop_stmt": "LOOP",
+       "endloop_stmt": "ENDLOOP", "repeat_stmt": "REPEAT", "until_stmt": "UNTIL", "case_stmt": "CASE",
+       "proc_stmt": "PROC"}
+_DIRECTION = {"GOTOF": "forward", "GOTOB": "backward", "GOTO": "any", "GOTOC": "any_quiet"}
+
+
+def _target(t: Tree) -> str:
+    ch = t.children
+    if len(ch) == 2:            # N100 is a block number, L1 a label
+        return str(ch[1]) if str(ch[0]) == "N" else str(ch[0]) + str(ch[1])
+    tok = ch[0]
+    return str(tok) if tok.type != "STR" else str(tok).upper()
+
+
+def _goto(kw: Token, target: Tree, cond) -> ir.Goto:
+    return ir.Goto(_target(target), _DIRECTION[str(kw)], cond)
+
+
+def _type(type_spec: Tree) -> tuple[str, Optional[int]]:
+    typ = str(type_spec.children[0])
+    if typ == "DOUBLE":
+        typ = "REAL"
+    length = None
+    if len(type_spec.children) > 2 and type_spec.children[2] is not None:
+        length = int(number_value(str(type_spec.children[2])))
+    return typ, length
+
+
+def _slice(code: str, st: Tree) -> str:
+    """Source text of a statement (for Passthrough), from its first to its last token."""
+    toks = [t for t in st.scan_values(lambda v: isinstance(v, Token))]
+    if not toks:
+        return ""
+    return code[toks[0].start_pos:max(t.end_pos for t in toks)].strip()
+
+
+# --------------------------------------------------------------------------- program assembly
+
+@dataclass
+class _Open:
+    kind: str
+    node: object
+    body: list
+    line: int
+
+
+class _Unit:
+    """One program unit (the file, or one `%_N_NAME_SPF` member of an archive)."""
+
+    def __init__(self, name: Optional[str]):
+        self.name = name
+        self.pre: list = []          # nodes before PROC
+        self.proc: Optional[ir.Subprogram] = None
+        self.root: list = self.pre
+        self.stack: list[_Open] = []
+
+    @property
+    def current(self) -> list:
+        return self.stack[-1].body if self.stack else self.root
+
+
+def _span(file: str, line: Line) -> ir.Span:
+    return ir.Span(file, line.lineno, 1, line.lineno, len(line.raw) + 1)
+
+
+def _passthrough_block(file: str, line: Line, text: str, reason: str, dialect: str = DIALECT) -> ir.Block:
+    return ir.Block(_span(file, line), [ir.Passthrough(text, reason, dialect)] if text else [],
+                    line.number, line.label, line.skip, line.comment)
+
+
+def _iso_section(file: str, lines: list[Line]) -> Optional[list]:
+    """Parse an ISO-mode section with the iso-m front end, or None when it is not installed."""
+    try:
+        from nctrans.dialects import base
+        iso = base.get("iso-m")
+    except Exception:        # the iso-m package may not be importable yet
+        return None
+    if iso is None or not lines:
+        return None
+    first = lines[0].lineno
+    text = "\n" * (first - 1) + "\n".join(l.raw for l in lines) + "\n"
+    try:
+        res = iso.parse(text, file)
+    except Exception:
+        return None
+    return list(res.program.body)
+
+
+def parse(text: str, file: str = "<stdin>") -> ParseResult:
+    """Sinumerik source -> IR Program with NC0xx diagnostics (never raises on bad input)."""
+    from nctrans.source import from_text
+    src = from_text(text, file)
+    low = Lowerer(file)
+    meta = low.meta
+    meta["defaults"] = table().defaults()
+    diags = low.diags
+    diags.extend(src.diagnostics)
+    units: list[_Unit] = [_Unit(None)]
+    macros: dict[str, str] = {}
+    raw_lines = src.text.split("\n")
+    if raw_lines and raw_lines[-1] == "":
+        raw_lines.pop()
+    section: Optional[tuple[str, str, list]] = None      # (start kw, end kw, lines) of a data section
+    iso_lines: Optional[list[Line]] = None
+    zones: list = []
+    seen_code = False
+
+    for n, raw in enumerate(raw_lines, 1):
+        unit = units[-1]
+        if not raw.strip():
+            continue
+        m = _HEADER.match(raw)
+        if m and not raw.lstrip().startswith("%%"):
+            name = m.group(1)
+            um = _UNIT_NAME.match(name)
+            if seen_code or units[-1].pre or units[-1].proc:
+                units.append(_Unit(um.group(1).upper() if um else name.upper()))
+                units[-1].header = name
+            else:
+                meta["header"] = name
+                if um:
+                    meta["program_name"] = um.group(1).upper()
+                    meta["program_type"] = um.group(2).upper()
+            continue
+        m = _PATH.match(raw)
+        if m:
+            if len(units) == 1:
+                meta["path"] = m.group(1)
+            else:
+                units[-1].path = m.group(1)
+            continue
+        line = split_line(n, raw)
+        span = _span(file, line)
+        code = line.code
+        # macro expansion (identifier macros of this file)
+        if macros and code:
+            code = _expand(code, macros)
+            line.code = code
+        # ---- verbatim sections
+        if iso_lines is not None:
+            if _G290.search(code):
+                blocks = _iso_section(file, iso_lines)
+                if blocks is None:
+                    for il in iso_lines:
+                        unit.current.append(_passthrough_block(file, il, il.code, "ISO dialect section",
+                                                               "iso-m"))
+                else:
+                    unit.current.extend(blocks)
+                iso_lines = None
+                unit.current.append(_passthrough_block(file, line, code, "Siemens mode"))
+            else:
+                iso_lines.append(line)
+            continue
+        if section is not None:
+            start, end, body = section
+            unit.current.append(_passthrough_block(file, line, code, _SECTION_REASON[start]))
+            body.append(line)
+            if re.match(rf"^\s*{end}\b", code, re.IGNORECASE):
+                if start in ("CPROTDEF", "NPROTDEF"):
+                    zones.append(_zone(low, start, body))
+                section = None
+            continue
+        if not code:
+            unit.current.append(ir.Block(span, [], line.number, line.label, line.skip, line.comment))
+            continue
+        seen_code = True
+        m = _DEFINE.match(code)
+        if m:
+            macros[m.group(1).upper()] = m.group(2).strip()
+            meta.setdefault("macros", {})[m.group(1).upper()] = m.group(2).strip()
+            unit.current.append(_passthrough_block(file, line, code, "macro definition"))
+            continue
+        if _SYNC.match(code):
+            unit.current.append(_passthrough_block(file, line, code, "synchronized action"))
+            continue
+        if _DATA_ATTR.match(code):
+            unit.current.append(_passthrough_block(file, line, code, "data attribute"))
+            continue
+        if _G291.search(code):
+            unit.current.append(_passthrough_block(file, line, code, "ISO dialect mode"))
+            iso_lines = []
+            continue
+        m = _SECTION_START.match(code)
+        if m:
+            kw = m.group(1).upper()
+            section = (kw, _SECTION_END[kw], [line])
+            unit.current.append(_passthrough_block(file, line, code, _SECTION_REASON[kw]))
+            continue
+        code = _PCALL_PATH.sub(lambda mm: mm.group(1) + mm.group(3), code)
+        # ---- parse the statement part
+        try:
+            tree = parser().parse(code)
+        except LexError as e:
+            low.error(e.rule, e.message, n, line.col + e.pos)
+            unit.current.append(_passthrough_block(file, line, code, "syntax error"))
+            continue
+        except UnexpectedInput as e:
+            _syntax_error(low, e, code, line)
+            unit.current.append(_passthrough_block(file, line, code, "syntax error"))
+            continue
+        stmts = [c for c in tree.children if isinstance(c, Tree)]
+        _assemble(low, unit, units, stmts, line, span)
+
+    if iso_lines is not None:
+        for il in iso_lines:
+            units[-1].current.append(_passthrough_block(file, il, il.code, "ISO dialect section", "iso-m"))
+    if section is not None:
+        diags.append(Diagnostic("NC006", "error", f"{section[0]} section without {section[1]}", file,
+                                section[2][0].lineno, 1))
+    if zones:
+        meta["protection_zones"] = zones
+
+    prog = ir.Program(file, DIALECT, [], {}, meta)
+    for i, unit in enumerate(units):
+        while unit.stack:
+            op = unit.stack.pop()
+            diags.append(Diagnostic("NC006", "error", f"{op.kind} is not closed (program ends first)",
+                                    file, op.line, 1))
+        if i == 0:
+            prog.body = unit.pre
+            if unit.proc is not None:
+                prog.subprograms[unit.proc.name] = unit.proc
+                prog.name = unit.proc.name
+                meta["entry"] = unit.proc.name
+            else:
+                prog.name = meta.get("program_name")
+        else:
+            sub = unit.proc or ir.Subprogram(unit.name or f"UNIT{i}", ir.Span(file, 1), [])
+            if unit.proc is not None and unit.pre:
+                sub.body = unit.pre + sub.body
+            elif unit.proc is None:
+                sub.body = unit.pre
+            prog.subprograms[sub.name] = sub
+    if not src.text.strip():
+        pass
+    return ParseResult(prog, diags)
+
+
+def _expand(code: str, macros: dict[str, str]) -> str:
+    out, pos = [], 0
+    inq = False
+    i = 0
+    while i < len(code):
+        ch = code[i]
+        if ch == '"':
+            inq = not inq
+            i += 1
+            continue
+        if not inq and (ch.isalpha() or ch == "_"):
+            m = _WORD_RE.match(code, i)
+            w = m.group().upper()
+            if w in macros:
+                out.append(code[pos:i])
+                out.append(macros[w])
+                pos = m.end()
+            i = m.end()
+            continue
+        i += 1
+    out.append(code[pos:])
+    return "".join(out)
+
+
+def _syntax_error(low: Lowerer, e: UnexpectedInput, code: str, line: Line) -> None:
+    depth = 0
+    inq = False
+    for ch in code:
+        if ch == '"':
+            inq = not inq
+        elif not inq:
+            depth += {"(": 1, ")": -1, "[": 1, "]": -1}.get(ch, 0)
+    col = line.col + (getattr(e, "column", 1) or 1) - 1
+    if isinstance(e, UnexpectedToken) and e.token is not None and e.token.type != "$END":
+        col = line.col + e.token.start_pos
+    if depth != 0:
+        low.error("NC003", "bracket opened and not closed" if depth > 0 else "unmatched closing bracket",
+                  line.lineno, col)
+        return
+    expected = sorted(getattr(e, "expected", None) or getattr(e, "allowed", None) or [])
+    if isinstance(e, UnexpectedToken):
+        got = "end of block" if e.token.type == "$END" else repr(str(e.token))
+        msg = f"unexpected {got}"
+    else:
+        msg = "unexpected input"
+    if expected:
+        msg += "; expected one of: " + ", ".join(expected[:8])
+    low.error("NC002", msg, line.lineno, col)
+
+
+def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, span: ir.Span) -> None:
+    """Turn one parsed block into a Block or a control-structure event on the unit's stack."""
+    file = low.file
+    if not stmts:
+        unit.current.append(ir.Block(span, [], line.number, line.label, line.skip, line.comment))
+        return
+    head = stmts[0]
+    d = head.data
+    if d == "proc_stmt":
+        if unit.proc is not None:
+            low.error("NC002", "second PROC in one program", line.lineno, line.col)
+            return
+        ch = head.children
+        params = []
+        for c in ch:
+            if isinstance(c, Tree) and c.data == "formal":
+                by_ref = any(isinstance(x, Token) and x.type == "VAR" for x in c.children)
+                ts = next(x for x in c.children if isinstance(x, Tree) and x.data == "type_spec")
+                name = next(str(x) for x in c.children if isinstance(x, Token) and x.type == "IDENT")
+                arr = [x for x in c.children if isinstance(x, Tree) and x.data == "arglist"]
+                dims = [int(a.value) if isinstance(a, ir.Num) else 0 for a in _args(arr[0])] if arr else []
+                typ, _len = _type(ts)
+                params.append(ir.Param(name, typ, by_ref, dims))
+        attrs = [str(c) for c in ch if isinstance(c, Token) and c.type == "PROCATTR"]
+        unit.proc = ir.Subprogram(str(ch[1]), span, [], params, attrs)
+        unit.root = unit.proc.body
+        if line.label or line.comment:
+            unit.root.append(ir.Block(span, [], None, line.label, None, line.comment))
+        return
+    ctrl = d in _KW or (d == "if_stmt")
+    if not ctrl:
+        for st in stmts[1:]:
+            if st.data in _KW:
+                low.error("NC002", f"{_KW[st.data]} must stand at the start of its own block",
+                          line.lineno, line.col)
+                return
+        body = low.statements(stmts, line)
+        unit.current.append(ir.Block(span, body, line.number, line.label, line.skip, line.comment))
+        return
+    # control structures: a label/number/comment on the line is kept in an empty block before it
+    if line.label or line.number or line.comment:
+        unit.current.append(ir.Block(span, [], line.number, line.label, line.skip, line.comment))
+    ch = head.children
+    rest = stmts[1:]
+    if d == "if_stmt":
+        cond = expr(ch[1])
+        if ch[2] is not None:
+            unit.current.append(ir.Block(span, [_goto(ch[2], ch[3], cond)], None, None, line.skip))
+            if rest:
+                low.error("NC002", "statement after the jump target", line.lineno, line.col)
+            return
+        node = ir.If(span, cond, [])
+        if rest:          # IF cond stmt... in one block: a one-block conditional
+            node.then.append(ir.Block(span, low.statements(rest, line)))
+            unit.current.append(node)
+            return
+        unit.current.append(node)
+        unit.stack.append(_Open("IF", node, node.then, line.lineno))
+    elif d == "else_stmt":
+        if unit.stack and unit.stack[-1].kind == "IF" and unit.stack[-1].body is unit.stack[-1].node.then:
+            unit.stack[-1].body = unit.stack[-1].node.orelse
+        else:
+            low.error("NC002", "ELSE without IF", line.lineno, line.col)
+    elif d == "while_stmt":
+        node = ir.While(span, expr(ch[1]), [])
+        unit.current.append(node)
+        unit.stack.append(_Open("WHILE", node, node.body, line.lineno))
+    elif d == "for_stmt":
+        lv = ch[1].children[0]
+        var = ir.Var("R", int(str(lv)[1:])) if _RPARAM.match(str(lv)) else (
+            ir.Var("system", str(lv)) if lv.type == "SYSVAR" else ir.Var("name", str(lv)))
+        node = ir.ForLoop(span, var, expr(ch[3]), expr(ch[5]), [])
+        unit.current.append(node)
+        unit.stack.append(_Open("FOR", node, node.body, line.lineno))
+    elif d == "loop_stmt":
+        node = ir.Loop(span, [])
+        unit.current.append(node)
+        unit.stack.append(_Open("LOOP", node, node.body, line.lineno))
+    elif d == "repeat_stmt":
+        node = ir.RepeatUntil(span, [], ir.Num(1.0, "1"))
+        unit.current.append(node)
+        unit.stack.append(_Open("REPEAT", node, node.body, line.lineno))
+    elif d in ("endif_stmt", "endwhile_stmt", "endfor_stmt", "endloop_stmt", "until_stmt"):
+        want = {"endif_stmt": "IF", "endwhile_stmt": "WHILE", "endfor_stmt": "FOR",
+                "endloop_stmt": "LOOP", "until_stmt": "REPEAT"}[d]
+        if unit.stack and unit.stack[-1].kind == want:
+            op = unit.stack.pop()
+            if d == "until_stmt":
+                op.node.cond = expr(ch[1])
+        else:
+            open_kind = unit.stack[-1].kind if unit.stack else "nothing"
+            low.error("NC002", f"{_KW[d]} does not close {open_kind} (no open {want})", line.lineno,
+                      line.col)
+    elif d == "case_stmt":
+        branches = []
+        default = None
+        for c in ch:
+            if isinstance(c, Tree) and c.data == "case_branch":
+                branches.append((expr(c.children[0]), _target(c.children[2])))
+        if ch[-3] is not None and isinstance(ch[-1], Tree) and ch[-1].data == "target" \
+                and isinstance(ch[-3], Token) and ch[-3].type == "DEFAULT":
+            default = _target(ch[-1])
+        unit.current.append(ir.Case(span, expr(ch[1]), branches, default))
+    if rest and d not in ("if_stmt",):
+        low.error("NC002", f"{_KW.get(d, d)} must stand in its own block", line.lineno, line.col)
+
+
+def _zone(low: Lowerer, start: str, lines: list[Line]) -> dict:
+    """A CPROTDEF/NPROTDEF .. EXECUTE definition as data (spec 8.3): header values and the contour."""
+    zone: dict = {"scope": "chan" if start == "CPROTDEF" else "nck", "line": lines[0].lineno,
+                  "contour": []}
+    try:
+        head = parser().parse(lines[0].code)
+        call = head.children[0]
+        args = _args(call.children[2])
+        keys = ["number", "tool_oriented", "applim", "applus", "appminus"]
+        for k, a in zip(keys, args):
+            zone[k] = a.value if isinstance(a, ir.Num) else None
+    except Exception:          # the header is kept verbatim in the program anyway
+        pass
+    motion = "linear"
+    for l in lines[1:-1]:
+        if not l.code:
+            continue
+        try:
+            stmts = [c for c in parser().parse(l.code).children if isinstance(c, Tree)]
+            body = Lowerer(low.file).statements(stmts, l)
+        except Exception:
+            continue
+        for st in body:
+            if isinstance(st, ir.ModeChange) and st.group == "motion":
+                motion = st.value
+            if isinstance(st, ir.Motion):
+                el = {"motion": motion, "line": l.lineno}
+                for k, v in st.target.items():
+                    if isinstance(v.value, ir.Num):
+                        el[k] = v.value.value
+                for k, v in (st.center or {}).items():
+                    if isinstance(v.value, ir.Num):
+                        el[k] = v.value.value
+                zone["contour"].append(el)
+    return zone
