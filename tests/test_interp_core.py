@@ -34,7 +34,9 @@ def test_rapid_linear_and_feed():
 def test_inch_units_scale_lengths_feed_not_rotary():
     b = B()
     b(mode("units", "inch"), n.Feed(num(10)), move("linear", X=1, Y=2, A=90))
-    (rec,), _ = run(b.program())
+    b(move("arc_ccw", X=0, Y=3, center=dict(I=-1, J=0)))
+    (rec, arc), diags = run(b.program())
+    assert not diags and approx(arc.center, X=0, Y=50.8)
     assert approx(rec.end, X=25.4, Y=50.8, A=90.0)
     assert rec.start["A"] == 0.0           # a new axis appears in start and end
     assert math.isclose(rec.feed, 254.0)
@@ -467,3 +469,23 @@ def test_property_records_chain_and_incremental_equals_absolute(steps):
         assert math.isclose(a.end["Y"], b_.end["Y"], abs_tol=1e-6)
     for prev, cur in zip(ra, ra[1:]):
         assert prev.end == cur.start
+
+
+def test_cutter_comp_routes_moves_through_the_compensator():
+    pytest.importorskip("nctrans.interp.cutter_comp")
+    m = Machine(tools=[Tool(number=1, radius=1.0)])
+    b = B()
+    b(n.Feed(num(100)), move("linear", X=0, Y=-5))
+    b(mode("cutter_comp", "left"), n.OffsetSelect("radius", num(1)), move(X=0, Y=0))
+    b(move(X=10, Y=0))(move(X=10, Y=10))
+    b(mode("cutter_comp", "off"), move(X=20, Y=20))
+    b(mode("coolant", "off"))
+    recs, diags = run(b.program(), m)
+    assert not diags
+    ms = moves(recs)
+    for prev, cur in zip(ms, ms[1:]):
+        assert all(math.isclose(prev.end[a], cur.start[a], abs_tol=1e-9) for a in "XY")
+    # left of the path going +X is +Y: the compensated edge runs at Y = 1
+    assert any(r.kind == "linear" and math.isclose(r.end["Y"], 1.0) for r in ms)
+    assert ms[-1].end == {"X": 20.0, "Y": 20.0, "Z": 0.0}
+    assert recs[-1].kind == "coolant"

@@ -59,6 +59,7 @@ NORMAL = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 ROT_AXIS = NORMAL
 _LABEL_NUM = re.compile(r"^N?0*(\d+)$")
 _PROG_NUM = re.compile(r"^[OoPp]?0*(\d+)$")
+LENGTH_WORDS = LINEAR_AXES | frozenset("IJK")     # words converted by inch mode
 CYCLE_LENGTH_KEYS = frozenset(("bottom", "r_plane", "retract_plane", "safety", "peck", "shift",
                                "depth_rel", "first_peck", "decrement", "min_peck", "relief"))
 
@@ -323,7 +324,7 @@ class Interpreter:
             v = c if c is not None else self._value(f, f"{axis} word")
             if v is None:
                 continue
-            if axis in LINEAR_AXES:
+            if axis in LENGTH_WORDS:
                 v *= scale
             out.append((axis, v, mode))
         return out
@@ -434,7 +435,7 @@ class Interpreter:
         if self.comp_exit:
             comp, self.comp, self.comp_exit = self.comp, None, False
             if comp is not None:
-                self._comp_out(comp.finish(pm))
+                self._comp_out(comp.finish(pm), comp)
                 return True
             return False
         if self.comp is None:
@@ -442,6 +443,9 @@ class Interpreter:
             r = self.comp_radius
             if r < 0:           # a negative stored radius swaps the side
                 side, r = ("right" if side == "left" else "left"), -r
+            if kind == "arc":
+                self.diag("NC204", "error", "cutter compensation starts on an arc; the first "
+                          "move after G41/G42 must be a rapid or linear move")
             self.comp = CutterCompensator(side, r, self.st.plane)
         self._comp_out(self.comp.push(pm))
         return True
@@ -450,7 +454,16 @@ class Interpreter:
         a1, a2, an = PLANE_AXES[self.st.plane]
         return {a1: center[0], a2: center[1], an: end.get(an, 0.0)}
 
-    def _comp_out(self, items) -> None:
+    def _comp_out(self, items, comp=None) -> None:
+        comp = comp or self.comp
+        probs = getattr(comp, "problems", None)
+        if probs:
+            from nctrans.diagnostics import Diagnostic
+            for payload, msg in probs:
+                file, line = (payload[0], payload[1]) if isinstance(payload, tuple) else (
+                    self.program.file, 1)
+                self.diags.append(Diagnostic("NC204", "error", msg, file, line))
+            probs.clear()
         for it in items:
             if PlannedMove is not None and isinstance(it, PlannedMove):
                 c = it.center
@@ -468,7 +481,7 @@ class Interpreter:
     def _comp_flush(self) -> None:
         if self.comp is not None:
             comp, self.comp = self.comp, None
-            self._comp_out(comp.finish(None))
+            self._comp_out(comp.finish(None), comp)
 
     # ================================================================ statement compilers/handlers
     def _c_mode(self, s: n.ModeChange):
