@@ -489,3 +489,23 @@ def test_cutter_comp_routes_moves_through_the_compensator():
     assert any(r.kind == "linear" and math.isclose(r.end["Y"], 1.0) for r in ms)
     assert ms[-1].end == {"X": 20.0, "Y": 20.0, "Z": 0.0}
     assert recs[-1].kind == "coolant"
+
+
+def test_three_point_tangent_and_aperture_arcs():
+    b = B()
+    b(n.Feed(num(100)), move("linear", X=10, Y=0))
+    m = n.Motion({"X": av(-10), "Y": av(0)}, via={"X": av(0), "Y": av(10)})
+    b(n.ModeChange("motion", "arc_3point"), m)                   # ccw half circle over the top
+    b(n.ModeChange("motion", "arc_tangent"), n.Motion({"X": av(-20), "Y": av(10)}))
+    b(n.ModeChange("motion", "arc_cw"), n.Motion({"X": av(0), "Y": av(10)}, aperture=num(180)))
+    b(n.ModeChange("motion", "arc_ccw"), n.Motion({}, center={"I": av(0), "J": av(-10)},
+                                                  aperture=num(90)))
+    recs, diags = run(b.program())
+    assert not diags
+    c3, ct, ap, apc = recs[1:]
+    assert c3.direction == "ccw" and approx(c3.center, X=0, Y=0)
+    # leaving (-10,0) downwards (tangent of the ccw circle there is -Y): the centre lies on the
+    # x axis to the left; through (-20,10) it is (-20,0) and the turn is cw
+    assert ct.direction == "cw" and approx(ct.center, X=-20, Y=0)
+    assert approx(ap.center, X=-10, Y=10) and ap.direction == "cw"
+    assert approx(apc.end, X=-10, Y=0) and approx(apc.center, X=0, Y=0)   # ccw 90° from the top

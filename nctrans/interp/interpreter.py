@@ -142,6 +142,8 @@ class Interpreter:
         # runtime flags
         self.moved = False
         self.feed_reported = False
+        self.last_from: Optional[dict] = None     # previous move (tangent of Sinumerik CT)
+        self.last_arc = None
         self.comp = None
         self.comp_radius = 0.0
         self.comp_exit = False
@@ -382,6 +384,8 @@ class Interpreter:
         """Emit a move from the current program point to `end` (program coords); update position."""
         start = self.pos
         self.pos = end
+        self.last_from = start
+        self.last_arc = (center, cw) if kind == "arc" else None
         if self.comp_exit or self.comp is not None or (
                 self.st.comp_side != "off" and CutterCompensator is not None and self.comp_radius):
             if self._comp_move(kind, start, end, center, cw, turns):
@@ -742,7 +746,10 @@ class Interpreter:
         polar = None
         if s.polar:
             polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
-        return (words, center, radius, turns, s.machine_coords, polar)
+        via = self._words(s.via)
+        ap = getattr(s, "aperture", None)
+        aperture = None if ap is None else self.ev.compile(ap)
+        return (words, center, radius, turns, s.machine_coords, polar, via, aperture)
 
     def _slow(self, d):
         full = d[2]
@@ -781,6 +788,8 @@ class Interpreter:
             if (inc if mode is None else mode == "inc"):
                 v += cur
             tgt[axis] = v
+        self.last_from = self.pos
+        self.last_arc = None
         self.pos = tgt
         tot = self.off.total
         mend = {a: v + tot.get(a, 0.0) for a, v in tgt.items()} if tot else tgt.copy()
@@ -799,14 +808,14 @@ class Interpreter:
         return None
 
     def _h_motion(self, d):
-        words, center, radius, turns, machine, polar = d
+        words, center, radius, turns, machine, polar, via, aperture = d
         st = self.st
         self.moved = True
         vals = self._eval_words(words)
         if polar:
             vals = self._polar(vals, polar)
         if self.modal_cycle is not None and st.cycle == "off" and not machine:
-            self._motion_plain(vals, center, radius, turns)
+            self._motion_plain(vals, d)
             if any(a in PLANE_AXES[st.plane][:2] for a, _, _ in vals):
                 self._run_cycle_call(self.modal_cycle)
             return
@@ -816,9 +825,10 @@ class Interpreter:
         if machine:
             self._machine_move(vals)
             return
-        self._motion_plain(vals, center, radius, turns)
+        self._motion_plain(vals, d)
 
-    def _motion_plain(self, vals, center, radius, turns):
+    def _motion_plain(self, vals, d):
+        _, center, radius, turns, _, _, via, aperture = d
         st = self.st
         motion = st.motion
         if motion == "rapid":
@@ -831,7 +841,13 @@ class Interpreter:
                 self._move("linear", self._target(vals))
             return
         if motion in ("arc_cw", "arc_ccw"):
-            self._arc(vals, center, radius, turns, motion == "arc_cw")
+            self._arc(vals, center, radius, turns, motion == "arc_cw", aperture)
+            return
+        if motion == "arc_3point":
+            self._arc_3point(vals, via)
+            return
+        if motion == "arc_tangent":
+            self._arc_tangent(vals)
             return
         if vals:
             self.diag("NC207", "error", "axis words while no motion mode is active")
@@ -872,7 +888,62 @@ class Interpreter:
         end = self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()})
         self._move(kind, end)
 
-    def _arc(self, vals, center, radius, turns, cw) -> None:
+    def _arc_3point(self, vals, via) -> None:
+        """Sinumerik CIP: the circle through start, intermediate point and end."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        start = self.pos
+        end = self._target(vals)
+        mid = self._target(self._eval_words(via)) if via else None
+        self._need_feed()
+        if mid is None:
+            self.diag("NC203", "error", "3-point arc without an intermediate point")
+            return
+        p = [(q.get(a1, 0.0), q.get(a2, 0.0)) for q in (start, mid, end)]
+        (x1, y1), (x2, y2), (x3, y3) = p
+        den = 2 * (x1 * (y2 - y3) + x2 * (y3 - y1) + x3 * (y1 - y2))
+        if abs(den) < 1e-12:
+            self.diag("NC203", "error", "3-point arc through collinear points")
+            return
+        s1, s2, s3 = x1 * x1 + y1 * y1, x2 * x2 + y2 * y2, x3 * x3 + y3 * y3
+        cx = (s1 * (y2 - y3) + s2 * (y3 - y1) + s3 * (y1 - y2)) / den
+        cy = (s1 * (x3 - x2) + s2 * (x1 - x3) + s3 * (x2 - x1)) / den
+        cw = ((x2 - x1) * (y3 - y2) - (y2 - y1) * (x3 - x2)) < 0
+        self._move("arc", end, (cx, cy), cw, 0)
+
+    def _tangent(self) -> Optional[tuple[float, float]]:
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        e1, e2 = self.pos.get(a1, 0.0), self.pos.get(a2, 0.0)
+        if self.last_arc is not None:
+            (c1, c2), cw = self.last_arc
+            r1, r2 = e1 - c1, e2 - c2
+            t = (r2, -r1) if cw else (-r2, r1)
+        elif self.last_from is not None:
+            t = (e1 - self.last_from.get(a1, 0.0), e2 - self.last_from.get(a2, 0.0))
+        else:
+            return None
+        ln = math.hypot(*t)
+        return None if ln < 1e-12 else (t[0] / ln, t[1] / ln)
+
+    def _arc_tangent(self, vals) -> None:
+        """Sinumerik CT: an arc leaving tangentially from the previous path."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        t = self._tangent()
+        end = self._target(vals)
+        self._need_feed()
+        s1, s2 = self.pos.get(a1, 0.0), self.pos.get(a2, 0.0)
+        d1, d2 = end.get(a1, 0.0) - s1, end.get(a2, 0.0) - s2
+        if t is None:
+            self.diag("NC203", "error", "tangential arc without a previous direction")
+            return
+        nl = (-t[1], t[0])                       # left normal
+        dn = d1 * nl[0] + d2 * nl[1]
+        if abs(dn) < 1e-12:                      # end straight ahead: a line
+            self._move("linear", end)
+            return
+        k = (d1 * d1 + d2 * d2) / (2 * dn)
+        self._move("arc", end, (s1 + k * nl[0], s2 + k * nl[1]), k < 0, 0)
+
+    def _arc(self, vals, center, radius, turns, cw, aperture=None) -> None:
         st = self.st
         plane = st.plane
         a1, a2, an = PLANE_AXES[plane]
@@ -888,7 +959,34 @@ class Interpreter:
                 nturns = max(int(round(t)), 0)
         self._need_feed()
         try:
-            if radius is not None:
+            if aperture is not None:
+                ang = self._value(aperture, "opening angle")
+                if ang is None or not 0 < ang < 360:
+                    raise arcs.ArcError(f"arc opening angle {ang} outside 0..360")
+                cvals = self._eval_words(center)
+                if cvals and not any(a in (a1, a2) for a, _, _ in vals):
+                    # centre + angle: the end is the start turned about the centre
+                    cd = {a: v for a, v, _ in cvals}
+                    ci = {"I": "X", "J": "Y", "K": "Z"}
+                    c1, c2 = s1, s2
+                    for a, v in cd.items():
+                        ax = ci.get(a, a)
+                        absolute = dict((w, m == "abs") for w, _, m in cvals)[a] or st.arc_absolute
+                        if ax == a1:
+                            c1 = v if absolute else s1 + v
+                        elif ax == a2:
+                            c2 = v if absolute else s2 + v
+                    phi = math.radians(-ang if cw else ang)
+                    r1, r2 = s1 - c1, s2 - c2
+                    end = dict(end)
+                    end[a1] = c1 + r1 * math.cos(phi) - r2 * math.sin(phi)
+                    end[a2] = c2 + r1 * math.sin(phi) + r2 * math.cos(phi)
+                    self._move("arc", end, (c1, c2), cw, nturns)
+                    return
+                half = math.hypot(e1 - s1, e2 - s2) / 2
+                r = half / math.sin(math.radians(ang) / 2)
+                c1, c2 = arcs.center_from_radius(s1, s2, e1, e2, r if ang <= 180 else -r, cw, inch)
+            elif radius is not None:
                 r = self._value(radius, "arc radius")
                 if r is None:
                     raise arcs.ArcError("arc radius is vacant")
