@@ -165,7 +165,7 @@ def test_local_shift_rotation_scale_mirror():
     b(n.FrameOp("rot", center={"X": av(0), "Y": av(0)}, angle=num(90)), move(X=1, Y=0))
     b(n.FrameOp("rot", clear=True), n.FrameOp("scale", {"X": num(2), "Y": num(2)},
                                                center={"X": av(0), "Y": av(0)}), move(X=1, Y=1))
-    b(n.FrameOp("scale", clear=True), n.FrameOp("mirror", {"X": num(0)}), move(X=1, Y=1))
+    b(n.FrameOp("scale", clear=True), n.FrameOp("mirror", {"X": num(1)}, center={"X": av(0)}), move(X=1, Y=1))
     b(n.Feed(num(10)), move("arc_cw", X=1, Y=-1, radius=1))
     recs, diags = run(b.program())
     assert not diags
@@ -509,3 +509,24 @@ def test_three_point_tangent_and_aperture_arcs():
     assert ct.direction == "cw" and approx(ct.center, X=-20, Y=0)
     assert approx(ap.center, X=-10, Y=10) and ap.direction == "cw"
     assert approx(apc.end, X=-10, Y=0) and approx(apc.center, X=0, Y=0)   # ccw 90° from the top
+
+
+def test_frame_replacement_rules():
+    """Sinumerik-style TRANS (no centre, not local) replaces the whole programmable frame;
+    ISO G52 (local) and pivoted ops (G68) replace only their own component."""
+    b = B()
+    b(n.FrameOp("trans", {"X": num(10)}, local=True))
+    b(n.FrameOp("rot", center={"X": av(0), "Y": av(0)}, angle=num(90)), move("rapid", X=1, Y=0))
+    b(n.FrameOp("trans", {"X": num(5)}, local=True), move(X=1, Y=0))       # rotation kept
+    b(n.FrameOp("trans", {"Y": num(7)}), move(X=1, Y=0))                    # everything replaced
+    b(n.FrameOp("rot", angle=num(90), additive=True), move(X=1, Y=0))       # AROT about zero
+    b(n.FrameOp("mirror", {"X": num(1), "Y": num(1)}, center={"X": av(0), "Y": av(0)}))
+    b(n.FrameOp("mirror", {"X": num(1)}, clear=True), n.FrameOp("rot", clear=True), move(X=1, Y=1))
+    recs, diags = run(b.program())
+    assert not diags
+    e = [r.end for r in recs]
+    assert approx(e[0], X=10, Y=1) and approx(e[1], X=5, Y=1)
+    assert approx(e[2], X=1, Y=7) and approx(e[3], X=0, Y=8)
+    # G69 clears the G68 component only; the additive rotation stays: (1,1) -> (-1,1),
+    # mirrored in Y only -> (-1,-1), shifted -> (-1,6)
+    assert approx(e[4], X=-1, Y=6)

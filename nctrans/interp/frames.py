@@ -87,12 +87,13 @@ def compose(outer: Affine, inner: Affine) -> Affine:
 class ProgrammableFrame:
     """The frame between program and work coordinates."""
 
-    __slots__ = ("local", "mirror", "scale", "rot", "extra", "extra_trans", "affine", "inverse",
-                 "identity", "mirror_swap")
+    __slots__ = ("local", "mirror", "mirror_axes", "scale", "rot", "extra", "extra_trans",
+                 "affine", "inverse", "identity", "mirror_swap")
 
     def __init__(self) -> None:
         self.local: dict[str, float] = {}                   # G52 / TRANS, every axis
         self.mirror: Optional[Affine] = None
+        self.mirror_axes: dict[str, float] = {}           # mirrored axis -> pivot
         self.scale: Optional[Affine] = None
         self.rot: Optional[Affine] = None
         self.extra: Affine = ID_AFFINE                      # additive ops, applied first
@@ -114,6 +115,7 @@ class ProgrammableFrame:
 
     def set_mirror(self, axes: dict[str, float]) -> None:
         """Mirror about the given positions (axis -> pivot) on each axis named; {} cancels."""
+        self.mirror_axes = dict(axes)
         if not axes:
             self.mirror = None
         else:

@@ -1151,6 +1151,13 @@ class Interpreter:
                     out[a.upper()] = v
             return out
 
+        # A programmable op that is neither additive, local (ISO G52) nor pivoted (ISO G68/G51/
+        # G51.1 give a centre) replaces the whole programmable frame (Sinumerik TRANS/ROT/SCALE/
+        # MIRROR); the others replace only their own component.
+        replace_all = (not s.additive and not s.local and s.center is None and not s.clear
+                       and op in ("trans", "rot", "scale", "mirror"))
+        if replace_all:
+            fr.clear()
         if op == "all":
             if s.clear:
                 fr.clear()
@@ -1174,7 +1181,8 @@ class Interpreter:
                     axis = ROT_AXIS[plane]
                     piv = center()
                     a1, a2, _ = PLANE_AXES[plane]
-                    if not s.additive:   # ISO G68: a missing centre coordinate is the current point
+                    if s.center is not None and not s.additive:
+                        # ISO G68: a missing centre coordinate is the current point
                         for a in (a1, a2):
                             piv.setdefault(a, self.pos.get(a, 0.0))
                     fr.set_rotation(axis, ang, piv, additive=s.additive)
@@ -1194,7 +1202,9 @@ class Interpreter:
                 fr.set_scale({a: v for a, v in f.items() if v is not None}, center())
         elif op == "mirror":
             if s.clear:
-                fr.set_mirror({})
+                keep = {a: v for a, v in fr.mirror_axes.items()
+                        if s.values and a not in {k.upper() for k in s.values}}
+                fr.set_mirror(keep)
             else:
                 piv = center()
                 axes = {a.upper(): piv.get(a.upper(), 0.0) for a in s.values}
@@ -1228,6 +1238,7 @@ class Interpreter:
 
     def _h_modal_off(self, s):
         self.modal_call = None
+        self.modal_cycle = None
 
     def _call_args(self, s: n.SubCall) -> tuple[list, dict]:
         pos = [self.ev.compile(e)() for e in s.args]
