@@ -86,7 +86,7 @@ def program_key(name: str) -> str:
 
 class Unit:
     """A compiled program body: instructions, label positions, parameters."""
-    __slots__ = ("name", "code", "labels", "params", "file")
+    __slots__ = ("name", "code", "labels", "params", "file", "seen")
 
     def __init__(self, name: str, file: str, params: list):
         self.name = name
@@ -94,6 +94,7 @@ class Unit:
         self.code: list[tuple] = []
         self.labels: dict[Any, list[int]] = {}
         self.params = params
+        self.seen = bytearray()
 
 
 class Frame:
@@ -170,6 +171,7 @@ class Interpreter:
         if unit is None:
             unit = Unit(name, file, params)
             self._emit_nodes(body, unit)
+            unit.seen = bytearray(len(unit.code))
             self.units[key] = unit
         return unit
 
@@ -724,8 +726,7 @@ class Interpreter:
     # ---------------------------------------------------------------- motion
     def _c_motion(self, s: n.Motion):
         if (s.center is None and s.radius is None and s.turns is None and not s.polar
-                and not s.machine_coords and s.via is None
-                and getattr(s, "aperture", None) is None):
+                and not s.machine_coords and s.via is None and s.aperture is None):
             fast = []
             AV, Num = n.AxisValue, n.Num
             for axis, av in s.target.items():
@@ -1337,8 +1338,14 @@ class Interpreter:
                     self.span = ins[3]
                     stmts = ins[1]
                     if stmts is None:
+                        # a block runs compiled; the compiled form is kept only once it runs a
+                        # second time (loops, calls), so straight-line code adds no memory
                         stmts = self._compile_block(ins[2])
-                        code[pc] = (BLOCK, stmts, ins[2], ins[3])
+                        seen = unit.seen
+                        if seen[pc]:
+                            code[pc] = (BLOCK, stmts, ins[2], ins[3])
+                        else:
+                            seen[pc] = 1
                     ctl = None
                     if sidx == 0:
                         self.moved = False
