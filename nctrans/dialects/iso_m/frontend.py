@@ -1,0 +1,993 @@
+"""ISO milling front end: source text -> IR Program.
+
+Per line: pre-lexer (prelex.py: comments, cleaning) -> word list (fastpath.py for plain blocks,
+the lark grammar of record otherwise; words.py) -> lowering (this module) -> IR nodes, then the
+structure pass nests WHILE/DO..END bodies and files O-subprograms under Program.subprograms.
+
+The lowering looks every G/M code up in rules/iso-m.toml and dispatches on its (group, value)
+through small handler tables; the context-dependent addresses (R P Q K L I J K) get their meaning
+from the static modal state tracked in source order (canned-cycle mode, motion mode), as a Fanuc
+block classifier does (spec §2.5 step 3). Statements are ordered as rs274ngc executes them.
+"""
+from __future__ import annotations
+
+import gc
+import re
+from operator import itemgetter
+from typing import Any, Optional
+
+from nctrans.diagnostics import Diagnostic
+from nctrans.ir.nodes import (
+    Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
+    HomeReturn, If, Loop, ModalCallOff, ModeChange, Motion, Num, OffsetSelect, Passthrough,
+    Program, ProgramEnd, ResetSetPosition, Return, SetPosition, Span, SpindleSpeed, Stop,
+    SubCall, Subprogram, ToolChange, ToolSelect, Var, While,
+)
+from nctrans.rules import load_table, normalise_code
+
+from .fastpath import PLAIN, WORD
+from .prelex import clean, strip_comments
+
+DIALECT = "iso-m"
+AXES = "XYZABCUVW"
+AXIS_SET = frozenset(AXES)
+CENTER_LETTERS = frozenset("IJK")
+
+# rs274ngc order of execution (the interpreter runs Block.body as listed).
+(B_ASSIGN, B_FEEDMODE, B_FEED, B_SPMODE, B_SPEED, B_TOOL, B_M6, B_SPINDLE, B_COOLANT, B_DWELL,
+ B_PLANE, B_UNITS, B_COMP, B_TLC, B_WCS, B_PATH, B_DIST, B_RETRACT, B_NONMODAL, B_MOTION,
+ B_END) = range(21)
+
+# Bucket of every plain modal group (a ModeChange and nothing else).
+SIMPLE_GROUPS = {
+    "feed_mode": B_FEEDMODE, "spindle_mode": B_SPMODE, "spindle": B_SPINDLE, "coolant": B_COOLANT,
+    "plane": B_PLANE, "units": B_UNITS, "cutter_comp": B_COMP, "tool_length": B_TLC,
+    "path_mode": B_PATH, "exact_stop_once": B_PATH, "polar": B_PATH, "arc_distance": B_DIST,
+    "distance": B_DIST, "cycle_retract": B_RETRACT,
+}
+
+# G65 Type I argument letter -> Fanuc local variable (spec §1.8.1); I/J/K go by set (Type II).
+ARG_VARS = {"A": 1, "B": 2, "C": 3, "D": 7, "E": 8, "F": 9, "H": 11, "M": 13, "Q": 17, "R": 18,
+            "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24, "Y": 25, "Z": 26}
+IJK_BASE = {"I": 4, "J": 5, "K": 6}
+
+# Addresses scaled under standard decimal notation (spec §2.3, seed L413).
+LENGTH_LETTERS = frozenset("XYZUVWIJKRQ") | {",C", ",R"}
+ANGLE_LETTERS = frozenset("ABC")
+
+_G_IN_TEXT = re.compile(r"G(\d+(?:\.\d+)?)")
+_LEAD_N = re.compile(r"^\s*(?:/\d?\s*)?(?:[Nn]\s*\d+)?\s*")
+_O_WORDS = re.compile(r"O(\d+)(?=$|[A-Z][-+.\d#\[]|[,#\[/])")
+_O_NAME = re.compile(r"O([0-9A-Z_.]*)$")
+_SKIP = re.compile(r"/(\d?)")
+# "[your xy start position]": prose in brackets (a template to fill in), not a macro expression.
+_PLACEHOLDER = re.compile(r"\[[^\]]*[a-z]{2}[^\]]*\]")
+_ARCHIVE = re.compile(r"^\s*%?_N_\w+_(MPF|SPF)", re.I)
+
+
+def _ex(v: Any):
+    """Word value -> IR expression."""
+    return Num(float(v), v) if type(v) is str else v
+
+
+def _digits(v: Any) -> Optional[str]:
+    """The digits of a plain integer-like word (N, P, O, L numbers), or None for expressions."""
+    if type(v) is not str:
+        return None
+    t = v.lstrip("+")
+    if t.endswith(".0"):
+        t = t[:-2]
+    elif t.endswith("."):
+        t = t[:-1]
+    return t if t.isdigit() else None
+
+
+def _word_text(letter: str, v: Any) -> str:
+    if type(v) is str:
+        return letter + v
+    from .emitter import format_value
+    return letter + format_value(v)
+
+
+class _Blk:
+    """Per-block lowering context (one per non-trivial block)."""
+    __slots__ = ("vals", "out", "owner", "owner_rule", "machine", "motion_g", "cycle_g",
+                 "call", "args", "mcodes")
+
+    def __init__(self, vals):
+        self.vals = vals            # letter -> value, in source order (last wins)
+        self.out: list = []         # (bucket, statement)
+        self.owner = None           # non-modal function that consumes the axis words
+        self.owner_rule = None
+        self.machine = False        # G53
+        self.motion_g = None        # group-01 value written in this block
+        self.cycle_g = None         # cycle value written in this block
+        self.call = None            # "g65" / "g66" / "m98"
+        self.args = None            # G65/G66 arguments [(letter, value)]
+        self.mcodes: list = []
+
+
+class Lowering:
+    """Word lists -> IR nodes for one file, tracking the static modal state in source order."""
+
+    def __init__(self, file: str, diags: list[Diagnostic]):
+        self.table = load_table(DIALECT)
+        opts = self.table.options
+        self.file = file
+        self.diags = diags
+        self.standard = opts.get("decimal_mode", "pocket") == "standard"
+        self.factors = opts.get("standard_factors", {}).get(opts.get("increment_system", "IS-B"), {})
+        self.prog8 = bool(opts.get("prog_number_8digit", False))
+        self.dwell_unit = float(opts.get("dwell_p_unit", 0.001))
+        self.dwell_div = round(1 / self.dwell_unit) if self.dwell_unit else 1000
+        defaults = self.table.defaults()
+        self.motion = defaults.get("motion")
+        self.cycle = None               # active canned-cycle kind (None = off)
+        self.arc_abs = defaults.get("arc_distance") == "absolute"
+        self.units = defaults.get("units", "mm")
+        self.feed_mode = defaults.get("feed_mode", "per_min")
+        self.in_sub = False
+        self.main_ended = False         # M30/M2/M99 seen in the main program: a later O is a subprogram
+        self._codes: dict[str, Any] = {}    # "G" + text as written -> rule (or None)
+        self._warned: set[str] = set()
+        self.g_handlers = {
+            "motion": self._g_motion, "cycle": self._g_cycle, "work_offset": self._g_wcs,
+            "frame": self._g_frame, "call": self._g_call, "nonmodal": self._g_nonmodal,
+            "passthrough": self._g_passthrough,
+        }
+        self.nonmodal_handlers = {
+            "dwell": self._nm_owner, "home": self._nm_owner, "home2": self._nm_owner,
+            "set_position": self._nm_owner, "local_offset": self._nm_owner,
+            "data_setting": self._nm_owner, "reset_set_position": self._nm_reset,
+            "machine_coords": self._nm_machine, "macro_call": self._nm_macro,
+        }
+        self.m_handlers = {
+            "tool_change": lambda b, r, t: b.out.append((B_M6, ToolChange())),
+            "stop": lambda b, r, t: b.out.append((B_END, Stop(optional=r.value == "optional"))),
+            "program_end": self._m_end,
+            "call": self._m_call,
+            "passthrough": lambda b, r, t: b.out.append((B_NONMODAL, self._pass(t, r.meaning))),
+        }
+        self.owners = {
+            "dwell": self._own_dwell, "home": self._own_home, "home2": self._own_home,
+            "set_position": self._own_set_position, "local_offset": self._own_local,
+            "data_setting": self._own_g10, "rot": self._own_rot, "rot_off": self._own_clear,
+            "scale": self._own_scale, "scale_off": self._own_clear, "mirror": self._own_mirror,
+            "mirror_off": self._own_mirror,
+        }
+
+    # ------------------------------------------------------------------ helpers
+    def code(self, letter: str, text: str):
+        key = letter + text
+        try:
+            return self._codes[key]
+        except KeyError:
+            try:
+                rule = self.table.lookup(normalise_code(letter, text.lstrip("+")))
+            except ValueError:
+                rule = None
+            self._codes[key] = rule
+            return rule
+
+    def warn_once(self, key: str, rule: str, severity: str, message: str, line: int, col: int = 1):
+        if key in self._warned:
+            return
+        self._warned.add(key)
+        self.diags.append(Diagnostic(rule, severity, message, self.file, line, col))
+
+    def _pass(self, text: str, reason: str) -> Passthrough:
+        return Passthrough(text, reason, DIALECT)
+
+    def num(self, letter: str, v: Any):
+        """A word value as an expression; applies standard decimal notation when the profile asks."""
+        if type(v) is not str:
+            return v
+        if self.standard and "." not in v:
+            f = self._factor(letter)
+            if f != 1.0:
+                return Num(float(v) * f, v)
+        return Num(float(v), v)
+
+    def _factor(self, letter: str) -> float:
+        fs = self.factors
+        inch = self.units == "inch"
+        if letter in ANGLE_LETTERS:
+            return fs.get("angle", 1.0)
+        if letter in LENGTH_LETTERS:
+            return fs.get("length_inch" if inch else "length_mm", 1.0)
+        if letter == "F":
+            mode = "per_rev" if self.feed_mode == "per_rev" else "per_min"
+            return fs.get(f"feed_{mode}_{'inch' if inch else 'mm'}", 1.0)
+        return 1.0
+
+    def axis_values(self, vals: dict) -> dict:
+        return {k: AxisValue(self.num(k, v)) for k, v in vals.items() if k in AXIS_SET}
+
+    def _ms(self, v: Any):
+        """P in milliseconds -> seconds expression."""
+        if type(v) is str:
+            return Num(float(v) / self.dwell_div, None)
+        return Binary("/", v, Num(float(self.dwell_div), None))
+
+    # ------------------------------------------------------------------ G handlers
+    def _g_simple(self, b: _Blk, rule, text: str) -> None:
+        b.out.append((SIMPLE_GROUPS[rule.group], ModeChange(rule.group, rule.value, "G" + text)))
+        if rule.group == "units":
+            self.units = rule.value
+        elif rule.group == "feed_mode":
+            self.feed_mode = rule.value
+        elif rule.group == "arc_distance":
+            self.arc_abs = rule.value == "absolute"
+
+    def _g_motion(self, b: _Blk, rule, text: str) -> None:
+        b.out.append((B_MOTION, ModeChange("motion", rule.value, "G" + text)))
+        b.motion_g = rule.value
+
+    def _g_cycle(self, b: _Blk, rule, text: str) -> None:
+        b.out.append((B_MOTION, ModeChange("cycle", rule.value, "G" + text)))
+        b.cycle_g = rule.value
+
+    def _g_wcs(self, b: _Blk, rule, text: str) -> None:
+        value = rule.value
+        p = b.vals.get("P")
+        if b.args is not None:          # P belongs to G65/G66 in this block
+            p = None
+        if value in ("G54", "G54.1") and (p is not None or value == "G54.1"):
+            d = _digits(p) if p is not None else "1"
+            if d is None or int(d) == 0:
+                b.out.append((B_WCS, self._pass("G" + text + _word_text("P", p), "extended/external work offset by expression or P0")))
+                b.vals.pop("P", None)
+                return
+            value = f"G54.1P{int(d)}"
+            b.vals.pop("P", None)
+        b.out.append((B_WCS, ModeChange("work_offset", value, "G" + text)))
+
+    def _g_frame(self, b: _Blk, rule, text: str) -> None:
+        b.owner = rule.value
+        b.owner_rule = rule
+
+    def _g_call(self, b: _Blk, rule, text: str) -> None:
+        if rule.value == "g67":
+            b.out.append((B_END, ModalCallOff()))
+        else:                                   # g66: arguments follow, like G65
+            b.call = "g66"
+
+    def _g_nonmodal(self, b: _Blk, rule, text: str) -> None:
+        self.nonmodal_handlers[rule.value](b, rule, text)
+
+    def _g_passthrough(self, b: _Blk, rule, text: str) -> None:
+        b.out.append((B_NONMODAL, self._pass("G" + text, rule.meaning)))
+
+    def _nm_owner(self, b: _Blk, rule, text: str) -> None:
+        b.owner = rule.value
+        b.owner_rule = rule
+
+    def _nm_reset(self, b: _Blk, rule, text: str) -> None:
+        b.out.append((B_NONMODAL, ResetSetPosition()))
+        b.owner = "reset"           # G92.1 X0 Y0: the axis words name the axes, not a move
+
+    def _nm_machine(self, b: _Blk, rule, text: str) -> None:
+        b.machine = True
+
+    def _nm_macro(self, b: _Blk, rule, text: str) -> None:
+        b.call = "g65"
+
+    # ------------------------------------------------------------------ axis-word owners
+    def _own_dwell(self, b: _Blk) -> None:
+        vals = b.vals
+        if "P" in vals:
+            secs = self._ms(vals.pop("P"))
+        else:
+            v = vals.pop("X", None)
+            if v is None:
+                v = vals.pop("U", None)
+            if v is None:
+                secs = Num(0.0, None)
+            elif type(v) is str and self.standard and "." not in v:
+                secs = Num(float(v) * self.factors.get("dwell_s", 0.001), v)
+            else:
+                secs = _ex(v)
+        b.out.append((B_DWELL, Dwell(seconds=secs)))
+
+    def _own_home(self, b: _Blk) -> None:
+        ref = 1 if b.owner == "home" else 2
+        idx = None
+        if ref == 2 and "P" in b.vals:
+            idx = _ex(b.vals.pop("P"))
+        b.out.append((B_NONMODAL, HomeReturn(ref, self.axis_values(b.vals), idx)))
+        self._drop_axes(b)
+
+    def _own_set_position(self, b: _Blk) -> None:
+        b.out.append((B_NONMODAL, SetPosition(self.axis_values(b.vals))))
+        self._drop_axes(b)
+
+    def _own_local(self, b: _Blk) -> None:
+        values = {k: self.num(k, v) for k, v in b.vals.items() if k in AXIS_SET}
+        b.out.append((B_NONMODAL, FrameOp("trans", values, local=True)))
+        self._drop_axes(b)
+
+    def _own_g10(self, b: _Blk) -> None:
+        vals = b.vals
+        lclass = _digits(vals.get("L"))
+        p = vals.get("P")
+        kinds = {"2": ("work_offset", False), "20": ("work_offset", True),
+                 "10": ("tool_length", False), "1": ("tool_length_wear", False),
+                 "11": ("tool_length_wear", False), "12": ("tool_radius", False),
+                 "13": ("tool_radius_wear", False)}
+        kind = kinds.get(str(int(lclass))) if lclass else None
+        if kind is None or p is None:
+            text = "G10" + "".join(_word_text(k, v) for k, v in vals.items())
+            b.out.append((B_NONMODAL, self._pass(text, "G10 data class without an IR equivalent")))
+            vals.clear()
+            return
+        vals.pop("L")
+        vals.pop("P")
+        if kind[0] == "work_offset":
+            values = {k: self.num(k, v) for k, v in vals.items() if k in AXIS_SET}
+            self._drop_axes(b)
+        else:
+            r = vals.pop("R", None)
+            values = {"value": self.num("R", r)} if r is not None else {}
+        b.out.append((B_NONMODAL, DataSetting(kind[0], _ex(p), values, kind[1])))
+
+    def _own_rot(self, b: _Blk) -> None:
+        vals = b.vals
+        center = self.axis_values(vals)
+        self._drop_axes(b)
+        angle = self.num("A", vals.pop("R")) if "R" in vals else None
+        values = {k: self.num(k, vals.pop(k)) for k in "IJK" if k in vals}
+        b.out.append((B_NONMODAL, FrameOp("rot", values, center or None, angle)))
+
+    def _own_clear(self, b: _Blk) -> None:
+        op = {"rot_off": "rot", "scale_off": "scale"}[b.owner]
+        b.out.append((B_NONMODAL, FrameOp(op, clear=True)))
+
+    def _own_scale(self, b: _Blk) -> None:
+        vals = b.vals
+        center = self.axis_values(vals)
+        self._drop_axes(b)
+        values = {}
+        if "P" in vals:
+            f = self._scale_factor(vals.pop("P"))
+            values = {"X": f, "Y": f, "Z": f}
+        for letter, axis in (("I", "X"), ("J", "Y"), ("K", "Z")):
+            if letter in vals:
+                values[axis] = self._scale_factor(vals.pop(letter))
+        b.out.append((B_NONMODAL, FrameOp("scale", values, center or None)))
+
+    def _scale_factor(self, v: Any):
+        """G51 P/I/J/K: integers count 0.001 (seed L1622); a written decimal point is the factor."""
+        if type(v) is str:
+            return Num(float(v) if "." in v else float(v) / 1000, v)
+        return v
+
+    def _own_mirror(self, b: _Blk) -> None:
+        axes = self.axis_values(b.vals)
+        self._drop_axes(b)
+        values = {k: Num(1.0, None) for k in axes}
+        if b.owner == "mirror":
+            b.out.append((B_NONMODAL, FrameOp("mirror", values, axes or None)))
+        else:
+            b.out.append((B_NONMODAL, FrameOp("mirror", values, clear=True)))
+
+    @staticmethod
+    def _drop_axes(b: _Blk) -> None:
+        for k in [k for k in b.vals if k in AXIS_SET]:
+            del b.vals[k]
+
+    # ------------------------------------------------------------------ M handlers
+    def _m_end(self, b: _Blk, rule, text: str) -> None:
+        b.out.append((B_END, ProgramEnd(rule.value)))
+        if not self.in_sub:
+            self.main_ended = True
+
+    def _m_call(self, b: _Blk, rule, text: str) -> None:
+        if rule.value == "m98":
+            b.call = "m98"
+            return
+        p = b.vals.pop("P", None)
+        if self.in_sub:
+            b.out.append((B_END, Return(_digits(p) if p is not None else None)))
+        elif p is not None:
+            b.out.append((B_END, Goto(_digits(p) or _word_text("", p))))
+        else:
+            b.out.append((B_END, ProgramEnd("restart")))
+            self.main_ended = True
+
+    # ------------------------------------------------------------------ calls
+    def _subcall(self, b: _Blk, line: int) -> None:
+        vals = b.vals
+        p = vals.pop("P", None)
+        lval = vals.pop("L", None)
+        repeat = _ex(lval) if lval is not None else None
+        named: dict = {}
+        name = ""
+        d = _digits(p)
+        if d is not None:
+            if b.call == "m98" and not self.prog8 and len(d) > 4:
+                if repeat is None:
+                    repeat = Num(float(int(d[:-4])), None)
+                d = d[-4:]
+            name = f"O{int(d)}"
+        elif p is not None:
+            named["P"] = _ex(p)             # program number by expression: resolved at run time
+        else:
+            self.diags.append(Diagnostic("NC002", "error",
+                                         f"{b.call.upper()} without a program number P", self.file, line))
+        bindings: dict = {}
+        if b.call in ("g65", "g66"):
+            sets: list[set] = []
+            for letter, v in b.args or ():
+                if letter in IJK_BASE:
+                    order = "IJK".index(letter)
+                    cur = sets[-1] if sets else None
+                    if cur is None or letter in cur or any("IJK".index(x) > order for x in cur):
+                        cur = set()
+                        sets.append(cur)
+                    cur.add(letter)
+                    n = len(sets)
+                    key = f"{letter}{n}"
+                    if n > 10:
+                        self.diags.append(Diagnostic("NC002", "error",
+                                                     f"G65 argument {letter} repeated more than 10 times",
+                                                     self.file, line))
+                        continue
+                    var = IJK_BASE[letter] + 3 * (n - 1)
+                elif letter in ARG_VARS:
+                    key, var = letter, ARG_VARS[letter]
+                else:
+                    b.out.append((B_NONMODAL, self._pass(_word_text(letter, v),
+                                                         f"{letter} is not a macro argument")))
+                    continue
+                named.pop(key, None)
+                named[key] = self.num(letter, v)
+                bindings[key] = Var("num", var)
+        kind = b.call
+        modal = "after_move" if kind == "g66" else "none"
+        b.out.append((B_END, SubCall(name, [], named, repeat, modal, kind, bindings)))
+
+    # ------------------------------------------------------------------ block
+    def hot(self, words: list, _axes=AXIS_SET, _av=AxisValue, _num=Num,
+            _float=float) -> Optional[tuple]:
+        """Lowering of the commonest CAM blocks, [N] [G0|G1] axis words [F], exactly as lower()
+        would do it (tests/test_iso_fastpath.py compares them); None sends the block to lower()."""
+        if self.standard:
+            return None
+        number = None
+        target: dict = {}
+        mode = feed = None
+        for letter, text in words:
+            if letter in _axes:
+                if letter in target:
+                    return None
+                target[letter] = _av(_num(_float(text), text))
+            elif letter == "G" and mode is None:
+                rule = self.code("G", text)
+                if rule is None or rule.group != "motion" or rule.value not in ("rapid", "linear"):
+                    return None
+                mode = ModeChange("motion", rule.value, "G" + text)
+            elif letter == "F" and feed is None:
+                feed = Feed(Num(float(text), text))
+            elif letter == "N" and number is None and not target and mode is None and feed is None:
+                number = text
+            else:
+                return None
+        body = []
+        if feed is not None:
+            body.append(feed)
+        if mode is not None:
+            body.append(mode)
+            self.motion = mode.value
+            self.cycle = None
+        if target:
+            body.append(Motion(target))
+        return number, body
+
+    def lower(self, items: list, line: int) -> tuple[Optional[str], list, list, Optional[str]]:
+        """Lower one block's word list. Returns (number, body, structure items, unknown G)."""
+        number = None
+        gs: list = []
+        macro: list = []
+        vals: dict = {}
+        args = None
+        mcodes: list = []
+        first = True
+        for it in items:
+            letter = it[0]
+            if len(it) == 3:
+                macro.append(it)
+                first = False
+                continue
+            v = it[1]
+            if letter == "G":
+                if type(v) is str:
+                    rule = self.code("G", v)
+                    if rule is None:
+                        return None, [], [], "G" + v
+                    gs.append((rule, v))
+                    if rule.value in ("macro_call", "g66"):
+                        args = []
+                else:
+                    mcodes.append((None, v, "G"))
+            elif args is not None and letter not in "PL":
+                args.append((letter, v))
+            elif letter == "M":
+                mcodes.append((self.code("M", v) if type(v) is str else None, v, "M"))
+            elif letter == "N" and first and type(v) is str:
+                number = v
+            else:
+                if letter in vals and letter != "N":
+                    self._dup(line, f"address {letter} written twice in the block; the last one counts")
+                vals[letter] = v
+            first = False
+
+        # Hot path: a block of axis words only (most CAM blocks).
+        if not gs and not mcodes and not macro and args is None:
+            if not vals:
+                return number, [], [], None
+            if all(k in AXIS_SET for k in vals):
+                return number, [Motion(self.axis_values(vals))], [], None
+
+        b = _Blk(vals)
+        b.args = args
+        out = b.out
+        structure: list = []
+        for it in macro:
+            tag = it[0]
+            if tag == "=":
+                out.append((B_ASSIGN, Assign(it[1], it[2])))
+            elif tag == "GOTO":
+                out.append((B_END, Goto(self._target(it[1]))))
+            elif tag == "IFGOTO":
+                out.append((B_END, Goto(self._target(it[2]), cond=it[1])))
+            else:
+                structure.append(it)
+
+        # G codes: one per group, the last wins (NC201).
+        if len(gs) > 1:
+            seen: dict = {}
+            for i, (rule, v) in enumerate(gs):
+                key = rule.dialect_group if rule.modal and rule.group not in ("nonmodal", "passthrough") else (rule.group, rule.value)
+                if key in seen:
+                    self._dup(line, f"G{gs[seen[key]][1]} and G{v} are in the same modal group; G{v} counts")
+                    gs[seen[key]] = None
+                seen[key] = i
+            gs = [g for g in gs if g is not None]
+        handlers = self.g_handlers
+        for rule, v in gs:
+            h = handlers.get(rule.group)
+            if h is None:
+                self._g_simple(b, rule, v)
+            else:
+                h(b, rule, v)
+
+        for rule, v, letter in mcodes:
+            if rule is None:
+                text = _word_text(letter, v)
+                if type(v) is str:
+                    self.warn_once(text, "NC403", "warning",
+                                   f"{text} has no meaning in the IR; kept verbatim", line)
+                out.append((B_NONMODAL, self._pass(text, "machine-specific code")))
+            elif rule.group in SIMPLE_GROUPS:
+                out.append((SIMPLE_GROUPS[rule.group], ModeChange(rule.group, rule.value, "M" + v)))
+            else:
+                self.m_handlers[rule.group](b, rule, "M" + v)
+
+        # Static modal state after this block's G codes (group 01 cancels a canned cycle).
+        if b.motion_g is not None:
+            self.motion = b.motion_g
+            self.cycle = None
+        if b.cycle_g is not None:
+            self.cycle = None if (b.cycle_g == "off" or b.motion_g is not None) else b.cycle_g
+
+        if "F" in vals:
+            out.append((B_FEED, Feed(self.num("F", vals.pop("F")))))
+        if "S" in vals:
+            out.append((B_SPEED, SpindleSpeed(_ex(vals.pop("S")))))
+        if "T" in vals:
+            out.append((B_TOOL, ToolSelect(_ex(vals.pop("T")))))
+        if "D" in vals:
+            out.append((B_COMP, OffsetSelect("radius", _ex(vals.pop("D")))))
+        if "H" in vals:
+            out.append((B_TLC, OffsetSelect("length", _ex(vals.pop("H")))))
+
+        if b.owner is not None:
+            own = self.owners.get(b.owner)
+            if own is None:             # G92.1: axis words only name the axes
+                self._drop_axes(b)
+            else:
+                own(b)
+
+        if b.call is not None:
+            self._subcall(b, line)
+
+        if self.cycle is not None:
+            params = {}
+            if "R" in vals:
+                params["r_plane"] = self.num("R", vals.pop("R"))
+            if "Q" in vals:
+                key = "shift" if self.cycle in ("fine_bore", "back_bore") else "peck"
+                params[key] = self.num("Q", vals.pop("Q"))
+            if "P" in vals:
+                params["dwell"] = self._ms(vals.pop("P"))
+            for rep in ("K", "L"):
+                if rep in vals:
+                    params["repeat"] = _ex(vals.pop(rep))
+            if params:
+                out.append((B_MOTION, CycleParams(params)))
+
+        target = {}
+        for k in [k for k in vals if k in AXIS_SET]:
+            target[k] = AxisValue(self.num(k, vals.pop(k)))
+        arc = (b.motion_g or self.motion) in ("arc_cw", "arc_ccw") and self.cycle is None
+        center = radius = turns = None
+        if arc:
+            if vals.keys() & CENTER_LETTERS:
+                mode = "abs" if self.arc_abs else None
+                center = {k: AxisValue(self.num(k, vals.pop(k)), mode) for k in "IJK" if k in vals}
+            if "R" in vals:
+                radius = self.num("R", vals.pop("R"))
+            lv = vals.pop("L", None)
+            if lv is None:
+                lv = vals.pop("P", None)
+            if lv is not None:
+                turns = Num(float(lv) - 1, None) if type(lv) is str else Binary("-", lv, Num(1.0, None))
+        if target or center or radius is not None or b.machine:
+            out.append((B_MOTION, Motion(target, center, radius, turns, machine_coords=b.machine)))
+
+        for k, v in vals.items():       # words nothing above gave a meaning
+            text = _word_text(k, v)
+            self.warn_once("word:" + k, "NC403", "warning",
+                           f"{text}: address {k.lstrip(',')} has no meaning in this block; kept verbatim", line)
+            out.append((B_NONMODAL, self._pass(text, f"address {k} without an IR meaning here")))
+
+        if len(out) > 1:
+            out.sort(key=itemgetter(0))
+        return number, [s for _, s in out], structure, None
+
+    def _target(self, v: Any) -> str:
+        d = _digits(v)
+        return d if d is not None else _word_text("", v)
+
+    def _dup(self, line: int, message: str) -> None:
+        self.diags.append(Diagnostic("NC201", "warning", message, self.file, line))
+
+
+# ---------------------------------------------------------------------- parse
+
+class _Frame:
+    """An open WHILE/DO loop in the structure pass."""
+    __slots__ = ("node", "label", "parent", "line")
+
+    def __init__(self, node, label, parent, line):
+        self.node, self.label, self.parent, self.line = node, label, parent, line
+
+
+def _raw_col(blanked: str, index: int) -> int:
+    """1-based source column of the `index`-th (0-based) character of clean(blanked)."""
+    kept = 0
+    for i, ch in enumerate(blanked):
+        if clean(ch):
+            if kept == index:
+                return i + 1
+            kept += 1
+    return len(blanked) + 1
+
+
+def _syntax_diag(err, code: str, blanked: str, file: str, line: int, offset: int) -> Diagnostic:
+    from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedToken
+    if isinstance(err, UnexpectedToken):
+        idx = (err.token.start_pos if err.token.start_pos is not None else len(code))
+        expected = sorted(err.expected)
+        got = "end of block" if err.token.type == "$END" else repr(str(err.token))
+        msg = f"unexpected {got}; expected one of {', '.join(_pretty(expected))}"
+    elif isinstance(err, UnexpectedCharacters):
+        idx = err.pos_in_stream
+        msg = f"unexpected character {code[idx]!r}; expected one of {', '.join(_pretty(sorted(err.allowed or ())))}"
+    elif isinstance(err, UnexpectedEOF):
+        idx = len(code)
+        msg = f"block ends early; expected one of {', '.join(_pretty(sorted(err.expected)))}"
+    else:
+        idx = 0
+        msg = str(err).splitlines()[0]
+    return Diagnostic("NC002", "error", msg, file, line, _raw_col(blanked, offset + idx))
+
+
+_PRETTY = {"LETTER": "an address letter", "NUMBER": "a number", "RELOP": "EQ/NE/GT/GE/LT/LE",
+           "FUNC": "a function", "LSQB": "'['", "RSQB": "']'", "HASH": "'#'", "MINUS": "'-'",
+           "PLUS": "'+'", "EQUAL": "'='", "COMMA": "','", "SLASH": "'/'", "STAR": "'*'",
+           "$END": "end of block", "ATAN_SEP": "']/['"}
+
+
+def _pretty(names) -> list[str]:
+    return [_PRETTY.get(n, n.strip('"')) for n in names][:8]
+
+
+def _unbalanced(code: str) -> Optional[int]:
+    """Index of the first unbalanced square bracket, or None."""
+    depth = 0
+    opens: list[int] = []
+    for i, ch in enumerate(code):
+        if ch == "[":
+            opens.append(i)
+        elif ch == "]":
+            if not opens:
+                return i
+            opens.pop()
+    return opens[0] if opens else None
+
+
+def parse_program(text: str, file: str = "<stdin>"):
+    """Parse ISO text. The cyclic garbage collector is paused while the IR is built: the parse
+    allocates ~10 objects per block and none of them form cycles, so collections are pure cost."""
+    gc_was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _parse_program(text, file)
+    finally:
+        if gc_was_enabled:
+            gc.enable()
+
+
+def _parse_program(text: str, file: str):
+    from nctrans.dialects.base import ParseResult
+
+    diags: list[Diagnostic] = []
+    low = Lowering(file, diags)
+    opts = low.table.options
+    semicolon_comment = opts.get("eob_semicolon", "comment") != "eob"
+    meta: dict = {"program_number": None, "percent": False, "defaults": low.table.defaults(),
+                  "options": dict(opts)}
+    name = None
+    main: list = []
+    subprograms: dict[str, Subprogram] = {}
+    cur = main
+    stack: list[_Frame] = []
+    seen_block = False
+    lowercase_noted = False
+
+    if "\x00" in text:
+        diags.append(Diagnostic("NC001", "error", "NUL bytes: not NC program text (UTF-16 or binary?)",
+                                file, 1))
+        text = text.replace("\x00", "")
+    lines = text.split("\n") if "\n" in text else text.split("\r")
+    fast_plain = PLAIN.fullmatch
+    fast_words = WORD.findall
+    lower = low.lower
+    words_of = None
+
+    def close_loops(upto: int) -> None:
+        while stack:
+            fr = stack[-1]
+            if len(stack) <= upto:
+                break
+            stack.pop()
+            diags.append(Diagnostic("NC006", "error",
+                                    f"DO{fr.label} (line {fr.line}) has no END{fr.label}", file, fr.line))
+
+    hot = low.hot
+    _block = Block
+    _span = Span
+    for lineno, raw in enumerate(lines, 1):
+        # Hot path: a comment-free line of plain axis words (most of CAM output).
+        if not ("(" in raw or ";" in raw or ")" in raw):
+            code = raw.replace(" ", "")
+            if code[-1:] == "\r":
+                code = code[:-1]
+            if code and code[0] != "O" and fast_plain(code) is not None:
+                words = fast_words(code)
+                done = hot(words)
+                if done is not None:
+                    cur.append(_block(_span(file, lineno, 1, lineno, len(raw) + 1), done[1], done[0]))
+                    seen_block = True
+                    continue
+        if "(" in raw or ";" in raw or ")" in raw:
+            scan = strip_comments(raw, semicolon_comment)
+            blanked = scan.code
+            comments = scan.comments
+            if scan.open_col is not None:
+                diags.append(Diagnostic("NC003", "error", "comment '(' is not closed before the end of the line",
+                                        file, lineno, scan.open_col))
+            if scan.stray_col is not None:
+                diags.append(Diagnostic("NC003", "error", "')' without an opening '('",
+                                        file, lineno, scan.stray_col))
+        else:
+            blanked = raw
+            comments = None
+        code = blanked.translate(_DROP_TABLE)
+        if not code:
+            if comments is None:
+                continue
+            comment = " ".join(comments)
+            span = Span(file, lineno, 1, lineno, len(raw) + 1)
+            cur.append(Block(span, [], comment=comment))
+            continue
+        if not lowercase_noted and not code.isupper() and code.upper() != code:
+            lowercase_noted = True
+            diags.append(Diagnostic("NC501", "info", "lowercase address letters", file, lineno))
+        code = code.upper()
+        comment = " ".join(comments) if comments is not None else None
+        span = Span(file, lineno, 1, lineno, len(raw) + 1)
+
+        if fast_plain(code) is not None:
+            segments = ((None, code),)
+        else:
+            c0 = code[0]
+            if c0 == "%":
+                meta["percent"] = True
+                if seen_block:
+                    break                       # text after the closing % is not program text
+                continue
+            if c0 == "$" or (c0 == "#" and len(code) > 1 and code[1].isalpha()) or _ARCHIVE.match(raw):
+                if _ARCHIVE.match(raw):
+                    meta["archive_header"] = raw.strip()
+                    continue
+                low.warn_once("directive", "NC403", "warning",
+                              "controller/simulator directive kept verbatim", lineno)
+                cur.append(Block(span, [Passthrough(raw.strip(), "directive", DIALECT)]))
+                seen_block = True
+                continue
+            if c0 in "O:" and not code.startswith("OR"):
+                m = _O_WORDS.match("O" + code[1:])
+                if m is not None:
+                    prog = m.group(1)
+                    rest = code[m.end():]
+                else:
+                    m2 = _O_NAME.match("O" + code[1:])
+                    prog = m2.group(1) if m2 is not None else code[1:]
+                    rest = ""
+                key = f"O{int(prog)}" if prog.isdigit() else f"O{prog}"
+                if name is None and not low.main_ended and cur is main:
+                    name = key
+                    meta["program_number"] = int(prog) if prog.isdigit() else prog
+                    if comment is not None:
+                        meta["title"] = comment
+                else:
+                    close_loops(0)
+                    sub = Subprogram(key, span, [])
+                    subprograms[key] = sub
+                    cur = sub.body
+                    low.in_sub = True
+                if not rest:
+                    if comment is not None:
+                        cur.append(Block(span, [], comment=comment))
+                    continue
+                code = rest
+            segments = _split_skips(code)
+
+        seen_block = True
+        for skip, seg in segments:
+            items = None
+            if fast_plain(seg) is not None:
+                items = fast_words(seg)
+            else:
+                if words_of is None:
+                    from .words import lark_words as words_of
+                bad = _unbalanced(seg)
+                unknown = _unknown_g(low, seg)
+                if unknown is None and bad is not None:
+                    other = "]" if seg[bad] == "[" else "["
+                    diags.append(Diagnostic("NC003", "error", f"'{seg[bad]}' has no matching '{other}'",
+                                            file, lineno,
+                                            _raw_col(blanked, max(0, clean(blanked).find(seg)) + bad)))
+                elif unknown is None:
+                    try:
+                        items = words_of(seg)
+                    except Exception as err:    # lark's UnexpectedInput family
+                        from lark.exceptions import UnexpectedInput
+                        if not isinstance(err, UnexpectedInput):
+                            raise
+                        if _PLACEHOLDER.search(blanked):
+                            low.warn_once("placeholder", "NC403", "warning",
+                                          "template placeholder text in [ ] kept verbatim", lineno)
+                        else:
+                            diags.append(_syntax_diag(err, seg, blanked, file, lineno,
+                                                      max(0, clean(blanked).find(seg))))
+                if items is None:
+                    cur.append(_passthrough_block(raw, span, skip, unknown, low, lineno))
+                    comment = None
+                    continue
+            number, body, structure, unknown = lower(items, lineno)
+            if unknown is not None:
+                cur.append(_passthrough_block(raw, span, skip, unknown, low, lineno))
+                comment = None
+                continue
+            if body or number is not None or comment is not None or not structure:
+                cur.append(Block(span, body, number, None, skip, comment))
+            comment = None
+            for it in structure:
+                tag = it[0]
+                if tag == "IFTHEN":
+                    then = [Assign(a[1], a[2]) for a in it[2]]
+                    cur.append(If(span, it[1], [Block(span, then, skip=skip)]))
+                elif tag in ("WHILE", "DO"):
+                    node = While(span, it[1], [], it[2]) if tag == "WHILE" else Loop(span, [])
+                    if tag == "DO":
+                        node_label = it[1]
+                    else:
+                        node_label = it[2]
+                    cur.append(node)
+                    stack.append(_Frame(node, node_label, cur, lineno))
+                    cur = node.body
+                else:                           # END m
+                    label = it[1]
+                    if stack and stack[-1].label == label:
+                        fr = stack.pop()
+                        cur = fr.parent
+                    elif any(fr.label == label for fr in stack):
+                        while stack[-1].label != label:
+                            fr = stack.pop()
+                            diags.append(Diagnostic("NC002", "error",
+                                                    f"END{label} closes DO{label} across an open DO{fr.label}",
+                                                    file, lineno))
+                        cur = stack.pop().parent
+                    else:
+                        diags.append(Diagnostic("NC002", "error", f"END{label} without WHILE [...] DO{label}",
+                                                file, lineno))
+    while stack:
+        fr = stack.pop()
+        diags.append(Diagnostic("NC006", "error",
+                                f"DO{fr.label} (line {fr.line}) has no END{fr.label}: the program is truncated",
+                                file, fr.line))
+    if not main and not subprograms:
+        diags.append(Diagnostic("NC004", "error", "the file holds no NC blocks", file, 1))
+    program = Program(file, DIALECT, main, subprograms, meta, name)
+    return ParseResult(program, diags)
+
+
+_DROP_TABLE = {c: None for c in list(range(0x00, 0x21)) + [0x7F, 0x85, 0xA0, 0xFEFF]}
+
+
+def _unknown_g(low: Lowering, code: str) -> Optional[str]:
+    for m in _G_IN_TEXT.finditer(code):
+        start = m.start()
+        if start and code[start - 1] in "#[":      # inside an expression, not a G word
+            continue
+        if low.code("G", m.group(1)) is None:
+            return "G" + m.group(1)
+    return None
+
+
+def _passthrough_block(raw: str, span: Span, skip, unknown: Optional[str], low: Lowering,
+                       line: int) -> Block:
+    """A block kept verbatim: an unknown G code (with all its words, which belong to it) or a
+    block that does not parse."""
+    m = _LEAD_N.match(raw)
+    head = raw[:m.end()]
+    number = None
+    nm = re.search(r"[Nn]\s*(\d+)", head)
+    if nm:
+        number = nm.group(1)
+    text = raw[m.end():].strip()
+    if unknown is not None:
+        low.warn_once(unknown, "NC403", "warning",
+                      f"{unknown} is not an ISO milling code nctrans knows; the block is kept verbatim", line)
+        reason = f"unknown code {unknown}"
+    else:
+        reason = "syntax error"
+    return Block(span, [Passthrough(text, reason, DIALECT)] if text else [], number, None, skip)
+
+
+def _split_skips(code: str) -> list:
+    """Block-skip marks: a leading `/` or `/n` makes the block optional; in a block without macro
+    expressions a `/` later in the block starts an optional tail (spec §1.5), kept as a block of
+    its own with that skip level."""
+    skip = None
+    if code[0] == "/":
+        m = _SKIP.match(code)
+        skip = int(m.group(1) or 0)
+        code = code[m.end():]
+        if not code:
+            return [(skip, "")] if False else []
+    if "/" not in code or "#" in code or "[" in code:
+        return [(skip, code)]
+    parts = code.split("/")
+    out = [(skip, parts[0])] if parts[0] else []
+    for part in parts[1:]:
+        level = 0
+        if part[:1].isdigit():
+            level = int(part[0])
+            part = part[1:]
+        if part:
+            out.append((level, part))
+    return out
