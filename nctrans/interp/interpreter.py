@@ -664,6 +664,9 @@ class Interpreter:
         return ("return", s.to_label)
 
     def _h_end(self, s: n.ProgramEnd):
+        if s.kind == "restart" and self.stack:
+            # M99 at the end of a file's main body that was called as a subprogram: a return
+            return ("return", None)
         self._comp_flush()
         self._record("stop", stop_kind="end")
         if s.kind == "restart" and not self.stack:
