@@ -602,7 +602,7 @@ _KW = {"if_stmt": "IF", "else_stmt": "ELSE", "endif_stmt": "ENDIF", "while_stmt"
        "endwhile_stmt": "ENDWHILE", "for_stmt": "FOR", "endfor_stmt": "ENDFOR", "loop_stmt": "LOOP",
        "endloop_stmt": "ENDLOOP", "repeat_stmt": "REPEAT", "until_stmt": "UNTIL", "case_stmt": "CASE",
        "proc_stmt": "PROC"}
-_DIRECTION = {"GOTOF": "forward", "GOTOB": "backward", "GOTO": "any", "GOTOC": "any_quiet"}
+_DIRECTION = {"GOTOF": "forward", "GOTOB": "backward", "GOTO": "any", "GOTOC": "any"}
 
 
 def _target(t: Tree) -> str:

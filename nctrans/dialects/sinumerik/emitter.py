@@ -1,0 +1,713 @@
+"""IR -> idiomatic Sinumerik 840D text.
+
+What the output looks like (spec section 11.5): `DEF` blocks at the top of the program / PROC,
+`;` comments, `CR=` where the IR has a radius, structured control flow kept (IF/ELSE/ENDIF,
+WHILE, FOR, LOOP, REPEAT/UNTIL, CASE), frames as TRANS/ATRANS/ROT/AROT/SCALE/MIRROR instructions,
+comparisons always parenthesised inside other operators (they bind weakest, spec 4.1).
+
+Lowerings for IR from other dialects (each reported as NC401 info, or NC402 when impossible):
+- ISO macro variables Var("num", n) -> R parameters Rn (#1 -> R1 ... #999 -> R999; more than
+  R99 needs machine data 28050 MM_NUM_R_PARAM > n). #0 (vacant) and n > 999 are refused (NC402).
+  ISO G65/G66 arguments land in R parameters too: their `bindings` (A -> #1 ...) become
+  `R1=... R2=...` assignments in the calling block, then the call (global R parameters, so a
+  nested call can overwrite the caller's arguments: that is the NC401 note).
+- ISO numbered subprograms ("1000", "O1000") are called and defined as L1000.
+- ISO canned cycles (ModeChange("cycle") + CycleParams + positioning motions) become
+  `MCALL CYCLE8x(RTP, RFP, SDIS, DP)` before the first positioning block and `MCALL` at G80,
+  with RTP = R level under G99 and the initial level `$P_EP[<drill axis>]` (the programmed
+  position when the MCALL block is read = ISO initial level) under G98; incremental R/Z become
+  `$P_EP[..]+R` sums. Chosen for G81 drill, G82 drill_dwell, G85 bore_feed_out and G89
+  bore_dwell_feed_out, whose Siemens cycles do the same strokes. Peck, tapping, fine/back/manual
+  boring differ in stroke details from CYCLE83/84/86/87 and are refused with NC402 (convert with
+  --flatten so the interpreter expands them into motion).
+- ISO G92 -> ATRANS by ($P_EP - target); G92.1 -> TRANS; G68/G51/G51.1 pivots -> ATRANS/AROT
+  (ASCALE, AMIRROR)/ATRANS sequences; G28/G30 -> G0 via point + G74/G75.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Optional
+
+from nctrans.diagnostics import Diagnostic, at_span
+from nctrans.dialects.base import EmitResult
+from nctrans.dialects.sinumerik.lexer import number_value
+from nctrans.ir import nodes as ir
+from nctrans.rules import load_table
+
+DIALECT = "sinumerik"
+_NUM_OK = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?$|'[HB][0-9A-F]+'$|TRUE$|FALSE$",
+                     re.IGNORECASE)
+_PREC = {"==": 1, "!=": 1, "<": 1, ">": 1, "<=": 1, ">=": 1, "concat": 2, "or": 3, "xor": 4,
+         "and": 5, "bor": 6, "bxor": 7, "band": 8, "+": 9, "-": 9, "*": 10, "/": 10, "div": 10,
+         "mod": 10}
+_OPS = {"==": "==", "!=": "<>", "<": "<", ">": ">", "<=": "<=", ">=": ">=", "concat": "<<",
+        "or": " OR ", "xor": " XOR ", "and": " AND ", "bor": " B_OR ", "bxor": " B_XOR ",
+        "band": " B_AND ", "+": "+", "-": "-", "*": "*", "/": "/", "div": " DIV ", "mod": " MOD "}
+_DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
+_ISO_CYCLES = {"drill": "CYCLE81", "drill_dwell": "CYCLE82", "bore_feed_out": "CYCLE85",
+               "bore_dwell_feed_out": "CYCLE89"}
+_GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
+_SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
+
+
+def _fmt(v: float) -> str:
+    if v == int(v) and abs(v) < 1e15:
+        return str(int(v))
+    s = format(v, ".12g")
+    if "e" in s:
+        mant, ex = s.split("e")
+        return f"{mant}EX{int(ex)}"
+    return s
+
+
+@dataclass
+class _State:
+    """Modal facts the emitter needs while walking blocks in source order."""
+    motion: str = "linear"
+    plane: str = "XY"
+    distance: str = "absolute"
+    arc_abs: bool = False
+    cycle: str = "off"
+    cycle_retract: str = "initial"
+    cycle_params: dict = field(default_factory=dict)
+    cycle_pending: bool = False
+    cycle_active: bool = False
+
+
+class Emitter:
+    def __init__(self, program: ir.Program):
+        self.p = program
+        self.t = load_table(DIALECT)
+        self.diags: list[Diagnostic] = []
+        self.notes: set[str] = set()
+        self.lines: list[str] = []
+        self.st = _State()
+        self.fn = {v: k for k, v in self.t.options.get("functions", {}).items()}
+        self.axes = set(self.t.options.get("axes", []))
+        self.span: Optional[ir.Span] = None
+
+    # ---------------------------------------------------------------- diagnostics
+    def info(self, key: str, msg: str) -> None:
+        if key not in self.notes:
+            self.notes.add(key)
+            self.diags.append(at_span("NC401", "info", msg, self.span))
+
+    def refuse(self, msg: str) -> None:
+        self.diags.append(at_span("NC402", "error", msg, self.span))
+
+    # ---------------------------------------------------------------- expressions
+    def num(self, n: ir.Num) -> str:
+        if n.text and _NUM_OK.match(n.text):
+            try:
+                if math.isclose(number_value(n.text.lstrip("+")), n.value, rel_tol=1e-12, abs_tol=1e-12):
+                    return n.text.lstrip("+")
+            except ValueError:
+                pass
+        return _fmt(n.value)
+
+    def expr(self, e, prec: int = 0) -> str:
+        if e is None:
+            return ""
+        if isinstance(e, ir.Num):
+            s = self.num(e)
+            return f"({s})" if prec > 0 and s.startswith("-") else s
+        if isinstance(e, ir.Str):
+            if '"' in e.value:
+                self.refuse(f"string with a double quote cannot be written in Sinumerik: {e.value!r}")
+            return '"' + e.value.replace('"', "'") + '"'
+        if isinstance(e, ir.Var):
+            return self.var(e)
+        if isinstance(e, ir.Unary):
+            inner = self.expr(e.operand, 11)
+            op = {"-": "-", "+": "+", "not": "NOT ", "bnot": "B_NOT "}[e.op]
+            s = op + inner
+            return f"({s})" if prec > 0 else s
+        if isinstance(e, ir.Binary):
+            if e.op == "pow":
+                return self.func(ir.Func("pow", [e.left, e.right]))
+            p = _PREC.get(e.op)
+            if p is None:
+                self.refuse(f"operator {e.op!r} has no Sinumerik equivalent")
+                p = 9
+            if e.op == "concat" and isinstance(e.left, ir.Str) and e.left.value == "":
+                s = "<<" + self.expr(e.right, p + 1)
+            else:
+                left = self.expr(e.left, p if p > 1 else 99)
+                right = self.expr(e.right, (p + 1) if p > 1 else 99)
+                s = left + _OPS.get(e.op, e.op) + right
+            if p == 1 and prec > 0:
+                return f"({s})"
+            return f"({s})" if p < prec else s
+        if isinstance(e, ir.Func):
+            return self.func(e)
+        self.refuse(f"expression {type(e).__name__} cannot be written")
+        return "0"
+
+    def args(self, args) -> str:
+        return ", ".join(self.expr(a) for a in args).replace(", ,", ",,")
+
+    def func(self, f: ir.Func) -> str:
+        name, a = f.name, f.args
+        if name == "frame_chain":
+            return ":".join(self.expr(x) for x in a)
+        if name == "LIST":
+            return "(" + ",".join(self.expr(x) for x in a) + ")"
+        if name == "pow":
+            if len(a) == 2 and isinstance(a[1], ir.Num) and a[1].value == 2:
+                return f"POT({self.expr(a[0])})"
+            self.info("pow", "general power lowered to EXP(LN(a)*b) (valid for a > 0)")
+            return f"EXP(LN({self.expr(a[0])})*{self.expr(a[1], 10)})"
+        if name == "atan" and len(a) in (1, 2):
+            return f"ATAN2({self.expr(a[0])}, {self.expr(a[1]) if len(a) == 2 else '1'})"
+        if name == "fix":
+            self.info("fix", "FIX lowered to TRUNC (rounds toward zero)")
+            return f"TRUNC({self.expr(a[0])})"
+        if name == "fup":
+            x = self.expr(a[0], 11)
+            self.info("fup", "FUP lowered to TRUNC arithmetic")
+            return f"(TRUNC({x})+({x}>TRUNC({x}))-({x}<TRUNC({x})))"
+        if name in self.fn:
+            return f"{self.fn[name]}({self.args(a)})"
+        if name.islower():
+            self.refuse(f"function {name!r} has no Sinumerik equivalent")
+            return f"{name.upper()}({self.args(a)})"
+        return f"{name}({self.args(a)})"
+
+    def var(self, v: ir.Var) -> str:
+        idx = "[" + ", ".join(self.expr(i) for i in v.indices) + "]" if v.indices else ""
+        if v.space == "R":
+            return f"R{v.key}" if v.key is not None else f"R{idx}"
+        if v.space in ("name", "system"):
+            return f"{v.key}{idx}"
+        if v.space == "num":
+            self.info("num", "ISO macro variables #n written as R parameters Rn")
+            if v.key is None:
+                return f"R{idx}"
+            if not isinstance(v.key, int) or v.key < 1 or v.key > 999:
+                self.refuse(f"macro variable #{v.key} has no R parameter equivalent")
+                return "R0"
+            return f"R{v.key}"
+        self.refuse(f"variable {v.space}:{v.key} has no Sinumerik equivalent")
+        return f"_{v.key}"
+
+    # ---------------------------------------------------------------- words
+    def word(self, addr: str, e: ir.Expr) -> str:
+        if len(addr) == 1 and isinstance(e, ir.Num):
+            return addr + self.num(e)
+        return f"{addr}={self.expr(e)}"
+
+    def axis(self, name: str, av: ir.AxisValue, arc: bool = False) -> str:
+        mode = av.mode
+        if arc and mode is None and self.st.arc_abs:
+            mode = "abs"
+        if mode == "abs":
+            return f"{name}=AC({self.expr(av.value)})"
+        if mode == "inc":
+            return f"{name}=IC({self.expr(av.value)})"
+        return self.word(name, av.value)
+
+    def code_of(self, m: ir.ModeChange) -> Optional[str]:
+        r = self.t.lookup(m.code) if m.code else None
+        if r is not None and (r.group, r.value) == (m.group, m.value):
+            return r.code
+        r = self.t.code_for(m.group, m.value)
+        return r.code if r else None
+
+    # ---------------------------------------------------------------- statements
+    def statement(self, s, out: "_Line") -> None:
+        st = self.st
+        if isinstance(s, ir.ModeChange):
+            g = s.group
+            if g == "motion":
+                st.motion = s.value
+            elif g == "plane":
+                st.plane = s.value
+            elif g == "distance":
+                st.distance = s.value
+            if g == "cycle":
+                if s.value == "off":
+                    if st.cycle_active:
+                        out.alone("MCALL")
+                        out.alone(self.t.code_for("motion", st.motion).code
+                                  if self.t.code_for("motion", st.motion) else "")
+                    st.cycle, st.cycle_active, st.cycle_params = "off", False, {}
+                else:
+                    st.cycle, st.cycle_pending = s.value, True
+                    if s.value not in _ISO_CYCLES:
+                        self.refuse(f"canned cycle {s.code or s.value} cannot be expressed exactly as a "
+                                    "Sinumerik cycle: convert with --flatten to expand it into motion")
+                return
+            if g == "cycle_retract":
+                st.cycle_retract, st.cycle_pending = s.value, True
+                return
+            if g == "arc_distance":
+                st.arc_abs = s.value == "absolute"
+                self.info("arc_distance", "absolute arc centres written as I=AC(...)")
+                return
+            if g == "tool_length":
+                self.info("tool_length", "tool length compensation is part of the D cutting edge in "
+                                         "Sinumerik: G43/G44/G49 dropped")
+                return
+            code = self.code_of(s)
+            if code is None:
+                self.refuse(f"{s.code or s.group + '=' + s.value} has no Sinumerik equivalent")
+                return
+            out.words.append(code)
+        elif isinstance(s, ir.Motion):
+            self.motion(s, out)
+        elif isinstance(s, ir.Feed):
+            out.words.append(self.word("F", s.value))
+        elif isinstance(s, ir.SpindleSpeed):
+            out.words.append(self.word("S", s.value) if s.spindle == 1 else
+                             f"S{s.spindle}={self.expr(s.value)}")
+        elif isinstance(s, ir.ToolSelect):
+            out.words.append(self.word("T", s.tool))
+        elif isinstance(s, ir.ToolChange):
+            out.words.append("M6")
+        elif isinstance(s, ir.OffsetSelect):
+            if s.kind == "radius":
+                out.words.append(self.word("D", s.index))
+            else:
+                self.info("H", "length offset H dropped: Sinumerik takes the length from the D edge")
+        elif isinstance(s, ir.Dwell):
+            if s.revolutions is not None:
+                out.alone("G4 " + self.word("S", s.revolutions))
+            else:
+                out.alone("G4 " + self.word("F", s.seconds if s.seconds is not None else ir.Num(0.0)))
+        elif isinstance(s, ir.FrameOp):
+            self.frame(s, out)
+        elif isinstance(s, ir.SetPosition):
+            self.info("G92", "G92 written as ATRANS by the programmed position minus the new value")
+            ws = [f"{a}=$P_EP[{a}]-({self.expr(v.value)})" for a, v in s.target.items()]
+            out.alone("ATRANS " + " ".join(ws))
+        elif isinstance(s, ir.ResetSetPosition):
+            self.info("G92.1", "G92.1 written as TRANS (clears the whole programmable frame)")
+            out.alone("TRANS")
+        elif isinstance(s, ir.HomeReturn):
+            self.home(s, out)
+        elif isinstance(s, ir.CycleParams):
+            st.cycle_params.update(s.values)
+            st.cycle_pending = True
+        elif isinstance(s, ir.CycleCall):
+            self.cycle_call(s, out)
+        elif isinstance(s, ir.SubCall):
+            self.subcall(s, out)
+        elif isinstance(s, ir.ModalCallOff):
+            out.words.append("MCALL")
+        elif isinstance(s, ir.Return):
+            if s.to_label:
+                self.info("M99P", "M99 P written as RET(\"N..\") (SW 6.4 parameterised return)")
+                out.alone(f'RET("N{s.to_label}")')
+            else:
+                out.words.append("RET" if out.only else "M17")
+        elif isinstance(s, ir.ProgramEnd):
+            if s.kind == "restart":
+                self.refuse("program restart (M99 in a main program) has no Sinumerik equivalent")
+            out.words.append("M30" if s.kind == "end_rewind" else "M2")
+        elif isinstance(s, ir.Stop):
+            out.words.append("M1" if s.optional else "M0")
+        elif isinstance(s, ir.Assign):
+            out.words.append(f"{self.var(s.target)}={self.expr(s.value)}")
+        elif isinstance(s, ir.VarDecl):
+            out.alone(self.vardecl([s]))
+        elif isinstance(s, ir.Goto):
+            tgt = "N" + s.target if s.target.isdigit() else s.target
+            kw = _GOTO.get(s.direction, "GOTO")
+            if s.cond is not None:
+                out.alone(f"IF {self.expr(s.cond)} {kw} {tgt}")
+            else:
+                out.words.append(f"{kw} {tgt}")
+        elif isinstance(s, ir.Message):
+            out.words.append(f"MSG({self.expr(s.text)})")
+        elif isinstance(s, ir.Alarm):
+            extra = f", {self.expr(s.text)}" if s.text is not None else ""
+            out.words.append(f"SETAL({self.expr(s.number)}{extra})")
+        elif isinstance(s, ir.Passthrough):
+            if s.dialect in (DIALECT, ""):
+                out.words.append(s.text)
+            elif re.fullmatch(r"(?:[A-Z][-+]?\d+(?:\.\d*)?\s*)+", s.text.strip().upper()):
+                self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
+                                          f"{s.text} ({s.reason})", self.span))
+                out.words.append(s.text)
+            else:
+                self.refuse(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
+                out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
+        else:
+            self.refuse(f"{type(s).__name__} cannot be written in Sinumerik")
+
+    def motion(self, m: ir.Motion, out: "_Line") -> None:
+        st = self.st
+        if st.cycle != "off" and st.cycle in _ISO_CYCLES and m.target:
+            self.iso_cycle_position(m, out)
+            return
+        ws = []
+        if m.machine_coords:
+            ws.append("SUPA")
+        for a, v in m.target.items():
+            ws.append(self.axis(a, v))
+        for a, v in (m.center or {}).items():
+            ws.append(self.axis(a, v, arc=True))
+        via_names = {v: k for k, v in self.t.options.get("via_words", {}).items()}
+        for a, v in (m.via or {}).items():
+            ws.append(self.axis(via_names.get(a, a + "1"), v))
+        if m.radius is not None:
+            ws.append(f"CR={self.expr(m.radius)}")
+        if m.aperture is not None:
+            ws.append(f"AR={self.expr(m.aperture)}")
+        if m.polar:
+            if "angle" in m.polar:
+                ws.append(f"AP={self.expr(m.polar['angle'])}")
+            if "radius" in m.polar:
+                ws.append(f"RP={self.expr(m.polar['radius'])}")
+        if m.turns is not None:
+            ws.append(f"TURN={self.expr(m.turns)}")
+        out.words.extend(ws)
+
+    def frame(self, f: ir.FrameOp, out: "_Line") -> None:
+        a = "A" if f.additive else ""
+        if f.op == "all" or (f.clear and not f.values):
+            if f.op not in ("all",):
+                self.info("frame_clear", "cancelling one frame component clears the whole "
+                                         "programmable frame in Sinumerik (TRANS)")
+            out.alone("TRANS")
+            return
+        if f.local:
+            self.info("G52", "G52 local offset written as TRANS (replaces the programmable frame)")
+        pre, post = [], []
+        if f.center:
+            self.info("pivot", "frame pivot written as ATRANS to the pivot, the frame, ATRANS back")
+            c = {k: self.expr(v.value) for k, v in f.center.items()}
+            pre.append("ATRANS " + " ".join(f"{k}={v}" for k, v in c.items()))
+            post.append("ATRANS " + " ".join(f"{k}=-({v})" for k, v in c.items()))
+            a = "A"
+        op = {"trans": "TRANS", "rot": "ROT", "scale": "SCALE", "mirror": "MIRROR"}.get(f.op)
+        if op is None:
+            self.refuse(f"frame operation {f.op!r} cannot be written")
+            return
+        if f.op == "rot" and f.angle is not None:
+            body = f"{a}ROT RPL={self.expr(f.angle)}"
+        elif f.op == "mirror":
+            body = f"{a}MIRROR " + " ".join(f"{k}0" for k in f.values)
+        else:
+            body = f"{a}{op} " + " ".join(self.word(k, v) for k, v in f.values.items())
+        for line in pre + [body.strip()] + post:
+            out.alone(line)
+
+    def home(self, h: ir.HomeReturn, out: "_Line") -> None:
+        self.info("G28", "reference point return written as G0 to the intermediate point, then G74/G75")
+        if h.via:
+            out.alone("G0 " + " ".join(self.axis(a, v) for a, v in h.via.items()))
+        axes = " ".join(f"{a}1=0" for a in (h.via or {"X": 0, "Y": 0, "Z": 0}))
+        out.alone(f"G74 {axes}" if h.ref == 1 else f"G75 FP={h.ref} {axes}")
+        if h.via and self.st.motion != "rapid":
+            r = self.t.code_for("motion", self.st.motion)
+            if r:
+                out.alone(r.code)
+
+    def cycle_call(self, c: ir.CycleCall, out: "_Line") -> None:
+        from nctrans.interp.cycles import cycle_table
+        t = cycle_table()
+        entries = {x.name: x.params for x in t.cycle}
+        entries.update({x.name: x.params for x in t.pattern})
+        name = c.name if c.name in entries else next(
+            (x.name for x in t.cycle if x.kind == c.kind), None)
+        if name is None:
+            name = {"holes_line": "HOLES1", "holes_circle": "HOLES2"}.get(c.kind)
+        if name is None:
+            self.refuse(f"cycle kind {c.kind!r} has no Sinumerik standard cycle")
+            return
+        keys = [t.neutral(p) for p in entries[name]]
+        vals = [c.params.get(k) for k in keys]
+        while vals and vals[-1] is None:
+            vals.pop()
+        text = f"{name}({','.join(self.expr(v) for v in vals)})"
+        out.words.append(("MCALL " if c.modal else "") + text)
+
+    def iso_cycle_position(self, m: ir.Motion, out: "_Line") -> None:
+        st = self.st
+        ax = _DRILL_AXIS.get(st.plane, "Z")
+        pos = {a: v for a, v in m.target.items() if a != ax}
+        if ax in m.target:
+            st.cycle_params["bottom"] = m.target[ax].value
+            st.cycle_pending = True
+        if st.cycle_pending:
+            p = st.cycle_params
+            r = p.get("r_plane")
+            z = p.get("bottom")
+            if r is None or z is None:
+                self.refuse("canned cycle without R level or depth")
+                return
+            init = f"$P_EP[{ax}]"
+            absolute = st.distance == "absolute"
+            if "absolute" in p and isinstance(p["absolute"], ir.Num):
+                absolute = bool(p["absolute"].value)
+            if absolute:
+                rfp, dp = self.expr(r), self.expr(z)
+            else:
+                rfp = f"{init}+{self.expr(r, 9)}"
+                dp = f"{init}+{self.expr(r, 9)}+{self.expr(z, 9)}"
+            rtp = rfp if st.cycle_retract == "r_plane" else init
+            args = [rtp, rfp, "0", dp]
+            name = _ISO_CYCLES[st.cycle]
+            if name in ("CYCLE82", "CYCLE89"):
+                args += ["", self.expr(p.get("dwell", ir.Num(0.0)))]
+            self.info("cycle", "ISO canned cycle written as MCALL of the Siemens standard cycle")
+            out.alone(f"MCALL {name}({', '.join(args)})".replace(", ,", ",,"))
+            st.cycle_pending, st.cycle_active = False, True
+        words = ["G0"] + [self.axis(a, v) for a, v in pos.items()]
+        n = 1
+        rep = st.cycle_params.get("repeat")
+        if isinstance(rep, ir.Num):
+            n = int(rep.value)
+        for _ in range(n):
+            out.alone(" ".join(words))
+
+    def subcall(self, c: ir.SubCall, out: "_Line") -> None:
+        name = c.name
+        m = _SUB_NUM.match(name)
+        if m:
+            name = "L" + m.group(1)
+        pre = []
+        if c.bindings:
+            self.info("g65", "macro call arguments passed in R parameters (global: a nested call can "
+                             "overwrite them)")
+            for letter, var in c.bindings.items():
+                if letter in c.named_args:
+                    pre.append(f"{self.var(var)}={self.expr(c.named_args[letter])}")
+        elif c.named_args:
+            self.refuse(f"named call arguments of {c.name} have no binding to write")
+        if c.kind == "call" and not c.args:
+            text = f'CALL "{name}"'
+        elif c.kind in ("isocall", "extcall") and not c.args:
+            text = f'{c.kind.upper()} "{name}"'
+        elif c.kind == "pcall":
+            text = f"PCALL {name}" + (f"({self.args(c.args)})" if c.args else "")
+        else:
+            text = name + (f"({self.args(c.args)})" if c.args else "")
+        if c.modal != "none":
+            text = "MCALL " + text
+        if c.repeat is not None:
+            text += " " + self.word("P", c.repeat)
+        out.words.extend(pre)
+        out.words.append(text)
+
+    def vardecl(self, ds: list) -> str:
+        d0 = ds[0]
+        scope = "" if d0.scope in ("local", "", None) else d0.scope.upper() + " "
+        typ = d0.type + (f"[{d0.length}]" if d0.length is not None else "")
+        parts = []
+        for d in ds:
+            s = d.name
+            if d.dims:
+                s += "[" + ",".join(str(x) if x else "" for x in d.dims) + "]"
+            if d.init:
+                if d.type == "AXIS" and len(d.init) == 1:
+                    s += "=(" + self.expr(d.init[0]) + ")"
+                elif len(d.init) == 1 and not (d.dims and not isinstance(d.init[0], ir.Func)):
+                    s += "=" + self.expr(d.init[0])
+                else:
+                    s += "=SET(" + ",".join(self.expr(x) for x in d.init) + ")"
+            parts.append(s)
+        return f"DEF {scope}{typ} " + ", ".join(parts)
+
+    # ---------------------------------------------------------------- structure
+    def block(self, b: ir.Block, ind: str) -> None:
+        self.span = b.span
+        decls = [s for s in b.body if isinstance(s, ir.VarDecl)]
+        rest = [s for s in b.body if not isinstance(s, ir.VarDecl)]
+        line = _Line(only=len(rest) == 1)
+        groups: list[list] = []
+        for d in decls:
+            if groups and (groups[-1][0].type, groups[-1][0].length, groups[-1][0].scope) == (
+                    d.type, d.length, d.scope):
+                groups[-1].append(d)
+            else:
+                groups.append([d])
+        for g in groups:
+            line.alone(self.vardecl(g))
+        for s in rest:
+            self.statement(s, line)
+        texts = line.finish()
+        head = []
+        if b.skip is not None:
+            head.append("/" if b.skip == 0 else f"/{b.skip}")
+        if b.number is not None:
+            head.append(f"N{b.number}")
+        if b.label:
+            head.append(f"{b.label}:")
+        comment = b.comment
+        if line.comment_extra:
+            comment = (comment + " " if comment else "") + "; ".join(line.comment_extra)
+        if not texts:
+            texts = [""]
+        for i, t in enumerate(texts):
+            parts = (head if i == 0 else []) + ([t] if t else [])
+            if i == len(texts) - 1 and comment is not None:
+                parts.append(";" + comment)
+            text = " ".join(parts)
+            if text:
+                self.lines.append(ind + text)
+
+    def iso_section(self, ns: list) -> Optional[str]:
+        """A G291 ISO-mode section is written by the iso-m emitter (the front end parsed it so)."""
+        try:
+            from nctrans.dialects import base
+            iso = base.get("iso-m")
+        except Exception:       # iso-m not installed: fall back to Sinumerik words
+            return None
+        if iso is None:
+            return None
+        res = iso.emit(ir.Program(self.p.file, "iso-m", ns, {}, {}))
+        self.diags.extend(res.diagnostics)
+        lines = [l for l in res.text.splitlines() if l.strip() and not l.strip().startswith("%")]
+        return "\n".join(lines)
+
+    def nodes(self, ns: list, ind: str = "") -> None:
+        i = 0
+        while i < len(ns):
+            n = ns[i]
+            i += 1
+            self.span = getattr(n, "span", None)
+            if isinstance(n, ir.Block) and _mode_switch(n, "ISO dialect mode"):
+                j = i
+                while j < len(ns) and not (isinstance(ns[j], ir.Block) and _mode_switch(ns[j], "Siemens mode")):
+                    j += 1
+                text = self.iso_section(ns[i:j]) if j > i and not all(
+                    isinstance(x, ir.Block) and all(isinstance(s, ir.Passthrough) and s.dialect == "iso-m"
+                                                    for s in x.body) for x in ns[i:j]) else None
+                self.block(n, ind)
+                if text is not None:
+                    self.lines.extend(ind + l for l in text.split("\n"))
+                    i = j
+                continue
+            if isinstance(n, ir.Block):
+                self.block(n, ind)
+            elif isinstance(n, ir.If):
+                self.lines.append(f"{ind}IF {self.expr(n.cond)}")
+                self.nodes(n.then, ind + "  ")
+                if n.orelse:
+                    self.lines.append(f"{ind}ELSE")
+                    self.nodes(n.orelse, ind + "  ")
+                self.lines.append(f"{ind}ENDIF")
+            elif isinstance(n, ir.While):
+                self.lines.append(f"{ind}WHILE {self.expr(n.cond)}")
+                self.nodes(n.body, ind + "  ")
+                self.lines.append(f"{ind}ENDWHILE")
+            elif isinstance(n, ir.ForLoop):
+                self.for_loop(n, ind)
+            elif isinstance(n, ir.Loop):
+                self.lines.append(f"{ind}LOOP")
+                self.nodes(n.body, ind + "  ")
+                self.lines.append(f"{ind}ENDLOOP")
+            elif isinstance(n, ir.RepeatUntil):
+                self.lines.append(f"{ind}REPEAT")
+                self.nodes(n.body, ind + "  ")
+                self.lines.append(f"{ind}UNTIL {self.expr(n.cond)}")
+            elif isinstance(n, ir.Case):
+                parts = [f"{self.expr(v)} GOTOF {t}" for v, t in n.branches]
+                if n.default:
+                    parts.append(f"DEFAULT GOTOF {n.default}")
+                self.lines.append(f"{ind}CASE {self.expr(n.subject)} OF " + " ".join(parts))
+            else:
+                self.refuse(f"{type(n).__name__} cannot be written")
+
+    def for_loop(self, n: ir.ForLoop, ind: str) -> None:
+        var = self.var(n.var)
+        step_one = n.step is None or (isinstance(n.step, ir.Num) and n.step.value == 1)
+        if step_one and n.var.space == "name":
+            self.lines.append(f"{ind}FOR {var}={self.expr(n.start)} TO {self.expr(n.end)}")
+            self.nodes(n.body, ind + "  ")
+            self.lines.append(f"{ind}ENDFOR")
+            return
+        self.info("for", "counting loop with a step or a non-INT variable written as WHILE")
+        step = n.step if n.step is not None else ir.Num(1.0)
+        down = isinstance(step, ir.Num) and step.value < 0
+        self.lines.append(f"{ind}{var}={self.expr(n.start)}")
+        self.lines.append(f"{ind}WHILE {var}{'>=' if down else '<='}{self.expr(n.end, 2)}")
+        self.nodes(n.body, ind + "  ")
+        self.lines.append(f"{ind}  {var}={var}+{self.expr(step, 9)}")
+        self.lines.append(f"{ind}ENDWHILE")
+
+    def unit(self, nodes: list) -> None:
+        """Emit a unit's nodes with DEF blocks that follow code hoisted to the end of the preamble."""
+        pre = 0
+        for n in nodes:
+            if isinstance(n, ir.Block) and all(isinstance(s, ir.VarDecl) for s in n.body):
+                pre += 1
+            else:
+                break
+        late: list = []
+        body = nodes[pre:]
+        for n in body:
+            if isinstance(n, ir.Block) and any(isinstance(s, ir.VarDecl) for s in n.body):
+                late.extend(s for s in n.body if isinstance(s, ir.VarDecl))
+        if late and self.p.dialect != DIALECT:
+            self.info("def", "DEF statements moved to the top of the program")
+            body = [ir.Block(n.span, [s for s in n.body if not isinstance(s, ir.VarDecl)], n.number,
+                             n.label, n.skip, n.comment) if isinstance(n, ir.Block) else n for n in body]
+            hoisted = [ir.Block(ir.Span("", 0), [d]) for d in late]
+            nodes = nodes[:pre] + hoisted + body
+        self.nodes(nodes)
+
+    def program(self) -> str:
+        p = self.p
+        meta = p.meta or {}
+        if meta.get("header"):
+            self.lines.append(f"%{meta['header']}")
+        if meta.get("path"):
+            self.lines.append(f";$PATH={meta['path']}")
+        self.unit(p.body)
+        entry = meta.get("entry")
+        for name, sub in p.subprograms.items():
+            sname = name
+            m = _SUB_NUM.match(name)
+            if m:
+                sname = "L" + m.group(1)
+            if name != entry:
+                self.lines.append(f"%_N_{sname}_SPF")
+            params = []
+            for prm in sub.params:
+                dims = "[" + ",".join(str(x) if x else "" for x in prm.dims) + "]" if prm.dims else ""
+                params.append(("VAR " if prm.by_ref else "") + prm.type + " " + prm.name + dims)
+            head = f"PROC {sname}" + (f"({', '.join(params)})" if params else "")
+            if getattr(sub, "attrs", None):
+                head += " " + " ".join(sub.attrs)
+            self.lines.append(head)
+            self.st = _State()
+            self.unit(sub.body)
+        return "\n".join(self.lines) + "\n"
+
+
+def _mode_switch(b: ir.Block, reason: str) -> bool:
+    return any(isinstance(s, ir.Passthrough) and s.reason == reason for s in b.body)
+
+
+class _Line:
+    """Words of one output block; statements that must stand alone start their own lines."""
+
+    def __init__(self, only: bool = False):
+        self.words: list[str] = []
+        self.done: list[str] = []
+        self.only = only
+        self.comment_extra: list[str] = []
+
+    def alone(self, text: str) -> None:
+        if not text:
+            return
+        if self.words:
+            self.done.append(" ".join(self.words))
+            self.words = []
+        self.done.append(text)
+
+    def finish(self) -> list[str]:
+        if self.words:
+            self.done.append(" ".join(self.words))
+        return self.done
+
+
+def emit(program: ir.Program) -> EmitResult:
+    e = Emitter(program)
+    text = e.program()
+    return EmitResult(text, e.diags)
