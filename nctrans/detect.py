@@ -86,6 +86,15 @@ class Guess:
     evidence: dict[str, float] = field(default_factory=dict)
     first_marker: dict[str, tuple[int, int, str]] = field(default_factory=dict)
     ambiguous: bool = False
+    content: dict[str, float] = field(default_factory=dict)   # evidence from the text alone
+
+    def content_leader(self) -> tuple[Optional[str], float, float]:
+        """(dialect, share, evidence) that the text alone points to, ignoring the file name."""
+        total = sum(self.content.values())
+        if not total:
+            return None, 0.0, 0.0
+        name, ev = max(self.content.items(), key=lambda kv: kv[1])
+        return name, ev / total, ev
 
     def describe(self) -> str:
         ranked = sorted(self.scores.items(), key=lambda kv: -kv[1])
@@ -176,6 +185,7 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
         s = _sniff(n, head)
         if s is not None:
             evidence[n] += _SNIFF_WEIGHT * s
+    content = dict(evidence)
     if filename:
         suffix = Path(filename).suffix.lower()
         if suffix:
@@ -188,4 +198,4 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
     top, conf = ranked[0] if ranked else (None, 0.0)
     second = ranked[1][1] if len(ranked) > 1 else 0.0
     ambiguous = total < MIN_EVIDENCE or conf - second < MIN_MARGIN
-    return Guess(None if ambiguous else top, conf, scores, evidence, first, ambiguous)
+    return Guess(None if ambiguous else top, conf, scores, evidence, first, ambiguous, content)

@@ -21,8 +21,8 @@ from nctrans.machine import load as _load_machine
 from nctrans.toolpath import ToolpathRecord
 
 # how sure detection must be that a file is another dialect than --from says before NC005 fires
-WRONG_DIALECT_CONFIDENCE = 0.85
-WRONG_DIALECT_EVIDENCE = 6.0
+WRONG_DIALECT_CONFIDENCE = 0.75
+WRONG_DIALECT_EVIDENCE = 5.0
 
 
 class PipelineError(Exception):
@@ -59,11 +59,10 @@ def get_dialect(name: str) -> base.Dialect:
 
 
 def _wrong_dialect(src: _source.SourceText, dialect: str, guess: _detect.Guess) -> Optional[Diagnostic]:
-    """NC005 when the text is clearly another dialect than the one it is parsed as."""
-    other = guess.dialect
-    if other is None or other == dialect or guess.confidence < WRONG_DIALECT_CONFIDENCE:
-        return None
-    if guess.evidence.get(other, 0.0) < WRONG_DIALECT_EVIDENCE:
+    """NC005 when the text (whatever the file is called) is clearly another dialect than the one it
+    is parsed as: strong markers of the other dialect and next to none of this one."""
+    other, share, evidence = guess.content_leader()
+    if other is None or other == dialect or share < WRONG_DIALECT_CONFIDENCE or evidence < WRONG_DIALECT_EVIDENCE:
         return None
     line, col, text = guess.first_marker.get(other, (1, 1, ""))
     what = f" ({text!r} at line {line})" if text else ""
