@@ -530,3 +530,14 @@ def test_frame_replacement_rules():
     # G69 clears the G68 component only; the additive rotation stays: (1,1) -> (-1,1),
     # mirrored in Y only -> (-1,-1), shifted -> (-1,6)
     assert approx(e[4], X=-1, Y=6)
+
+
+def test_diagnostics_in_a_loop_are_reported_once():
+    b = B()
+    b(n.Assign(V(1), num(0)))
+    body = [n.Block(n.Span("t.nc", 3), [n.Assign(V(1), n.Binary("+", V(1), num(1))),
+                                        n.Assign(V(2), n.Binary("/", num(1), num(0))),
+                                        n.SubCall("O777")])]
+    b.node(n.While(b.span(), n.Binary("<", V(1), num(50)), body))
+    recs, diags = run(b.program())
+    assert sorted(d.rule for d in diags) == ["NC103", "NC106"]

@@ -284,8 +284,7 @@ class Evaluator:
         if fn is None:
             return self._bad(f"unknown operator {op!r}")
 
-        def binop():
-            a, b = fa(), fb()
+        def slow(a, b):
             if a is UNKNOWN or b is UNKNOWN:
                 return UNKNOWN
             if a is None:
@@ -302,6 +301,38 @@ class Evaluator:
                 return fn(a, b)
             except (OverflowError, ValueError) as ex:
                 raise EvalError("NC106", f"arithmetic error in {op!r}: {ex}") from None
+
+        # fast paths: two floats (the normal case) skip the vacant/unknown/string checks
+        if op == "+":
+            def add():
+                a, b = fa(), fb()
+                if type(a) is float and type(b) is float:
+                    return a + b
+                return slow(a, b)
+            return add
+        if op == "-":
+            def sub():
+                a, b = fa(), fb()
+                if type(a) is float and type(b) is float:
+                    return a - b
+                return slow(a, b)
+            return sub
+        if op == "*":
+            def mul():
+                a, b = fa(), fb()
+                if type(a) is float and type(b) is float:
+                    return a * b
+                return slow(a, b)
+            return mul
+
+        def binop():
+            a, b = fa(), fb()
+            if type(a) is float and type(b) is float:
+                try:
+                    return fn(a, b)
+                except (OverflowError, ValueError) as ex:
+                    raise EvalError("NC106", f"arithmetic error in {op!r}: {ex}") from None
+            return slow(a, b)
         return binop
 
     def _compile_func(self, e: n.Func) -> Callable[[], Any]:
@@ -310,6 +341,22 @@ class Evaluator:
         if fn is None:
             return self._bad(f"unknown function {e.name!r}")
         args = [self.compile(a) for a in e.args]
+
+        if len(args) == 1:
+            (f1,) = args
+
+            def call1():
+                v = f1()
+                if type(v) is float:
+                    try:
+                        return fn(v)
+                    except EvalError:
+                        raise
+                    except (TypeError, ValueError, OverflowError) as ex:
+                        raise EvalError("NC106", f"{name}: {ex}") from None
+                return call()
+        else:
+            call1 = None
 
         def call():
             vals = []
@@ -327,7 +374,7 @@ class Evaluator:
                 raise
             except (TypeError, ValueError, OverflowError) as ex:
                 raise EvalError("NC106", f"{name}: {ex}") from None
-        return call
+        return call1 or call
 
     # ---------------------------------------------------------------- variables
     def _index_fns(self, var: n.Var) -> list[Callable[[], Any]]:

@@ -119,6 +119,7 @@ class Interpreter:
         self.program = program
         self.machine = machine
         self.diags = diagnostics
+        self._reported: set = set()
         self.resolver = resolver
         self.max_steps = max_steps
         self.hook = flatten_hook
@@ -158,7 +159,13 @@ class Interpreter:
 
     # ================================================================ diagnostics
     def diag(self, rule: str, severity: str, message: str, span=None) -> None:
-        self.diags.append(at_span(rule, severity, message, span or self.span))
+        """Report once per place: a loop over a faulty block gives one diagnostic, not thousands."""
+        sp = span or self.span
+        key = (rule, message, sp.file if sp else None, sp.line if sp else 0, sp.col if sp else 0)
+        if key in self._reported:
+            return
+        self._reported.add(key)
+        self.diags.append(at_span(rule, severity, message, sp))
 
     # ================================================================ compile
     def _index_subprograms(self, program: n.Program) -> None:
@@ -652,7 +659,7 @@ class Interpreter:
 
     def _c_goto(self, s: n.Goto):
         cond = None if s.cond is None else self._cond(s.cond)
-        return (self._h_goto, (s.target, s.direction, cond))
+        return (self._h_goto, (label_key(s.target), s.direction, cond))
 
     def _h_goto(self, d):
         target, direction, cond = d
@@ -1491,7 +1498,7 @@ class Interpreter:
 
     @staticmethod
     def _find_label(unit: Unit, target, direction: str, pc: int) -> Optional[int]:
-        pcs = unit.labels.get(label_key(target))
+        pcs = unit.labels.get(target if type(target) is int else label_key(target))
         if not pcs:
             return None
         if direction in ("forward", "any"):
