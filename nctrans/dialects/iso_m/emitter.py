@@ -256,7 +256,7 @@ class _Emitter:
                     break
         if depth == 0:
             return f"({text})"
-        return "(" + text.replace("(", "[").replace(")", "]") + ")"
+        return "; " + text.strip()      # unbalanced parentheses: only a ';' comment keeps the text
 
     def s_Block(self, b: n.Block) -> None:
         prefix = ""
@@ -630,7 +630,7 @@ class _Emitter:
 
     def w_Assign(self, s):
         text = self.assign(s)
-        return [("#", text)] if text else []
+        return [("", text)] if text else []
 
     def w_Goto(self, s: n.Goto):
         target = self._goto_target(s.target)

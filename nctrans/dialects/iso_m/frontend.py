@@ -836,6 +836,10 @@ def _parse_program(text: str, file: str):
                     m2 = _O_NAME.match("O" + code[1:])
                     prog = m2.group(1) if m2 is not None else code[1:]
                     rest = ""
+                if not prog:                    # a bare ":" / "O": no program number
+                    if rest or comment is not None:
+                        cur.append(Block(span, [], comment=comment))
+                    continue
                 key = f"O{int(prog)}" if prog.isdigit() else f"O{prog}"
                 if name is None and not low.main_ended and cur is main:
                     name = key
@@ -849,7 +853,7 @@ def _parse_program(text: str, file: str):
                     cur = sub.body
                     low.in_sub = True
                 if not rest:
-                    if comment is not None:
+                    if comment is not None and cur is not main:
                         cur.append(Block(span, [], comment=comment))
                     continue
                 code = rest

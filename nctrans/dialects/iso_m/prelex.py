@@ -64,7 +64,8 @@ def _scan(line: str, nested: bool, semicolon_comment: bool) -> CommentScan:
             out.append(" ")
         elif ch == ";" and semicolon_comment:
             text = line[i + 1:].strip()
-            comments.append(text)
+            if text:                    # a bare ";" is the Fanuc EOB symbol, not a comment
+                comments.append(text)
             out.append(" " * (n - i))
             break
         else:
