@@ -541,3 +541,20 @@ def test_diagnostics_in_a_loop_are_reported_once():
     b.node(n.While(b.span(), n.Binary("<", V(1), num(50)), body))
     recs, diags = run(b.program())
     assert sorted(d.rule for d in diags) == ["NC103", "NC106"]
+
+
+def test_modal_cycle_call_and_hole_pattern():
+    pytest.importorskip("nctrans.interp.cycles")
+    b = B()
+    b(move("rapid", X=0, Y=0, Z=20), n.Feed(num(100)))
+    b(n.CycleCall("drill", {"retract_plane": num(10), "r_plane": num(0), "safety": num(2),
+                            "bottom": num(-5)}, modal=True, name="CYCLE81"))
+    b(n.CycleCall("holes_circle", {"cpa": num(50), "cpo": num(50), "rad": num(20), "sta1": num(0),
+                                   "inda": num(90), "num": num(4)}, name="HOLES2"))
+    b(n.ModalCallOff(), move("rapid", X=0))
+    recs, diags = run(b.program())
+    assert not diags
+    bottoms = [(round(r.end["X"], 6), round(r.end["Y"], 6)) for r in recs if r.kind == "linear"]
+    assert bottoms == [(70, 50), (50, 70), (30, 50), (50, 30)]
+    assert all(r.end["Z"] == -5 for r in recs if r.kind == "linear")
+    assert recs[-1].end["X"] == 0 and recs[-1].line == 4

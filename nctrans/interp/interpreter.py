@@ -44,9 +44,9 @@ try:  # the colleague's modules; without them the feature is skipped
 except ImportError:  # pragma: no cover
     expand_cycle = None
 try:
-    from nctrans.interp.cycles import sinumerik_cycle_levels
+    from nctrans.interp.cycles import cycle_table, hole_pattern, sinumerik_cycle_levels
 except ImportError:  # pragma: no cover
-    sinumerik_cycle_levels = None
+    cycle_table = hole_pattern = sinumerik_cycle_levels = None
 try:
     from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
 except ImportError:  # pragma: no cover
@@ -1102,12 +1102,38 @@ class Interpreter:
             self.mpos = self._to_machine(pos)
 
     def _h_cycle_call(self, s: n.CycleCall):
+        if s.kind in ("holes_line", "holes_circle"):
+            self._hole_pattern(s)
+            return
         if s.modal:
             self.modal_cycle = s
             return
         self._run_cycle_call(s)
 
-    def _run_cycle_call(self, s: n.CycleCall) -> None:
+    def _hole_pattern(self, s: n.CycleCall) -> None:
+        """Sinumerik HOLES1/HOLES2: the modally called cycle at each position of the pattern
+        (only positioning when no cycle is modal)."""
+        if hole_pattern is None or cycle_table is None:
+            return
+        pat = {p.name: p for p in cycle_table().pattern}.get((s.name or "").upper())
+        if pat is None:
+            self.diag("NC103", "warning", f"hole pattern {s.name or s.kind} is not known")
+            return
+        args = []
+        for p in pat.params:
+            e = s.params.get(p.lower())
+            args.append(None if e is None else self._value(self.ev.compile(e), p))
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        sc = self.st.scale
+        for p1, p2 in hole_pattern(pat.name, args):
+            hole = dict(self.pos)
+            hole[a1], hole[a2] = p1 * sc, p2 * sc
+            if self.modal_cycle is not None:
+                self._run_cycle_call(self.modal_cycle, hole)
+            else:
+                self._move("rapid", hole)
+
+    def _run_cycle_call(self, s: n.CycleCall, hole: Optional[dict] = None) -> None:
         if expand_cycle is None or sinumerik_cycle_levels is None:
             return
         st = self.st
@@ -1121,7 +1147,7 @@ class Interpreter:
             self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
             return
         approach, bottom, retract = sinumerik_cycle_levels(params, current=self.pos.get(ax, 0.0))
-        hole = dict(self.pos)
+        hole = dict(self.pos) if hole is None else hole
         self._expand(s.kind, hole, approach, bottom, retract, params)
 
     # ---------------------------------------------------------------- offsets and frames
