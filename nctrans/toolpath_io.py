@@ -8,6 +8,7 @@ with program length.
 from __future__ import annotations
 
 import csv
+import json
 import math
 from dataclasses import dataclass, field
 from typing import IO, Iterable, Optional
@@ -15,8 +16,6 @@ from typing import IO, Iterable, Optional
 from nctrans.machine import Machine
 from nctrans.toolpath import ToolpathRecord
 
-# order of keys in a jsonl line (contract order, then the event details the record also carries)
-_SCALARS = ("feed", "feed_mode", "spindle", "tool", "dwell_s", "spindle_dir", "coolant", "stop_kind")
 CSV_AXES = ("X", "Y", "Z", "A", "B", "C")
 CSV_COLUMNS = (
     ["seq", "file", "line", "kind"]
@@ -26,57 +25,84 @@ CSV_COLUMNS = (
 )
 
 
-def _num(v: float) -> str:
-    """JSON spelling of a coordinate rounded to 6 decimals; -0 prints as 0; NaN/inf as null."""
+def _num(v) -> str:
+    """JSON spelling of a number rounded to 6 decimals; -0 prints as 0; NaN/inf as null."""
     if v.__class__ is int:
         return str(v)
     if not math.isfinite(v):
         return "null"
-    r = round(v, 6)
-    if r == 0:
-        return "0.0"
-    return repr(r)
+    return repr(round(v, 6) + 0.0)
 
 
 def _axes(d: dict) -> str:
-    return "{" + ",".join(f'"{k}":{_num(v)}' for k, v in d.items()) + "}"
+    # round(v, 6) + 0.0 turns -0.0 into 0.0
+    return "{" + ",".join([f'"{k}":{round(v, 6) + 0.0!r}' for k, v in d.items()]) + "}"
+
+
+_FILE_JSON: dict[str, str] = {}
 
 
 def _str(s: str) -> str:
-    # file names and enum values: escape only what JSON requires
-    if '"' in s or "\\" in s or any(ord(c) < 0x20 for c in s):
-        import json
-        return json.dumps(s)
-    return '"' + s + '"'
+    """JSON string literal of s (file names are few: cached)."""
+    out = _FILE_JSON.get(s)
+    if out is None:
+        out = json.dumps(s)
+        if len(_FILE_JSON) < 1024:
+            _FILE_JSON[s] = out
+    return out
 
 
-def to_json_line(r: ToolpathRecord) -> str:
-    """One compact JSON object (no newline). Built by hand: ~3x faster than json.dumps on a dict."""
-    parts = [f'{{"seq":{r.seq},"file":{_str(r.file)},"line":{r.line},"kind":"{r.kind}"']
-    if r.start is not None:
-        parts.append(f',"start":{_axes(r.start)}')
-    if r.end is not None:
-        parts.append(f',"end":{_axes(r.end)}')
-    if r.center is not None:
-        parts.append(f',"center":{_axes(r.center)}')
-    if r.direction is not None:
-        parts.append(f',"direction":"{r.direction}"')
-    if r.plane is not None:
-        parts.append(f',"plane":"{r.plane}"')
-    if r.turns is not None:
-        parts.append(f',"turns":{int(r.turns)}')
-    for name in _SCALARS:
+def _safe_json_line(r: ToolpathRecord) -> str:
+    """The slow, always-valid path: non-finite numbers become null."""
+    d = {}
+    for name in ToolpathRecord.__slots__:
         v = getattr(r, name)
         if v is None:
             continue
-        if isinstance(v, str):
-            parts.append(f',"{name}":{_str(v)}')
-        elif name == "tool":
-            parts.append(f',"tool":{int(v)}')
-        else:
-            parts.append(f',"{name}":{_num(v)}')
-    parts.append("}")
-    return "".join(parts)
+        if isinstance(v, float):
+            v = round(v, 6) + 0.0 if math.isfinite(v) else None
+        elif isinstance(v, dict):
+            v = {k: (round(x, 6) + 0.0 if math.isfinite(x) else None) for k, x in v.items()}
+        d[name] = v
+    return json.dumps(d, separators=(",", ":"))
+
+
+def to_json_line(r: ToolpathRecord) -> str:
+    """One compact JSON object (no newline), keys in contract order, absent when they do not apply.
+    Built with f-strings: about 1.6x the speed of json.dumps on a dict with the same rounding."""
+    s = f'{{"seq":{r.seq},"file":{_str(r.file)},"line":{r.line},"kind":"{r.kind}"'
+    if r.start is not None:
+        s += ',"start":' + _axes(r.start)
+    if r.end is not None:
+        s += ',"end":' + _axes(r.end)
+    if r.center is not None:
+        s += ',"center":' + _axes(r.center)
+    if r.direction is not None:
+        s += f',"direction":"{r.direction}"'
+    if r.plane is not None:
+        s += f',"plane":"{r.plane}"'
+    if r.turns is not None:
+        s += f',"turns":{int(r.turns)}'
+    if r.feed is not None:
+        s += f',"feed":{round(r.feed, 6) + 0.0!r}'
+    if r.feed_mode is not None:
+        s += f',"feed_mode":"{r.feed_mode}"'
+    if r.spindle is not None:
+        s += f',"spindle":{round(r.spindle, 6) + 0.0!r}'
+    if r.tool is not None:
+        s += f',"tool":{int(r.tool)}'
+    if r.dwell_s is not None:
+        s += f',"dwell_s":{round(r.dwell_s, 6) + 0.0!r}'
+    if r.spindle_dir is not None:
+        s += f',"spindle_dir":"{r.spindle_dir}"'
+    if r.coolant is not None:
+        s += f',"coolant":"{r.coolant}"'
+    if r.stop_kind is not None:
+        s += f',"stop_kind":"{r.stop_kind}"'
+    s += "}"
+    if "nan" in s or "inf" in s:      # a non-finite number (or a file name containing the letters)
+        return _safe_json_line(r)
+    return s
 
 
 def write_jsonl(records: Iterable[ToolpathRecord], out: IO[str], on_record=None) -> int:

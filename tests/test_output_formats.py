@@ -141,3 +141,88 @@ def test_rule_documentation_has_every_part():
     text = catalogue.format_rule(catalogue.load().get("NC202"))
     for part in ("NC202", "missing-feed", "Why:", "Bad:", "G1 X10", "Good:", "F200", "Fix:"):
         assert part in text
+
+
+# --------------------------------------------------------------------------- toolpath writers
+
+import csv
+import io
+import math
+
+from nctrans.toolpath import ToolpathRecord
+from nctrans.toolpath_io import CSV_COLUMNS, Summary, to_json_line, write_csv, write_jsonl
+
+coords = st.dictionaries(st.sampled_from(["X", "Y", "Z", "A"]), st.floats(-1e4, 1e4), min_size=1, max_size=4)
+records = st.builds(
+    ToolpathRecord, st.integers(1, 10**6), st.sampled_from(["a.nc", "dir/b c.mpf", 'q"x.nc', "info.nc"]),
+    st.integers(1, 10**5), st.sampled_from(["rapid", "linear", "arc", "dwell", "spindle", "stop"]),
+    st.none() | coords, st.none() | coords, st.none() | coords, st.none() | st.sampled_from(["cw", "ccw"]),
+    st.none() | st.sampled_from(["XY", "ZX", "YZ"]), st.none() | st.integers(0, 3),
+    st.none() | st.floats(0, 1e5), st.none() | st.sampled_from(["per_min", "per_rev", "inverse_time"]),
+    st.none() | st.floats(0, 3e4), st.none() | st.integers(0, 99), st.none() | st.floats(0, 100))
+
+
+def _rounded(x):
+    if isinstance(x, dict):
+        return {k: _rounded(v) for k, v in x.items()}
+    if isinstance(x, float):
+        return round(x, 6) + 0.0
+    return x
+
+
+@settings(max_examples=200, deadline=None)
+@given(records)
+def test_jsonl_line_is_the_record_rounded_with_absent_keys(rec):
+    line = to_json_line(rec)
+    assert "\n" not in line and ", " not in line.replace('b c', '')
+    assert json.loads(line) == _rounded(rec.to_dict())
+
+
+def test_jsonl_non_finite_and_negative_zero():
+    rec = ToolpathRecord(1, "a.nc", 1, "linear", start={"X": -0.0, "Y": float("nan")}, end={"X": 1.23456789},
+                         feed=float("inf"))
+    assert json.loads(to_json_line(rec)) == {"seq": 1, "file": "a.nc", "line": 1, "kind": "linear",
+                                             "start": {"X": 0.0, "Y": None}, "end": {"X": 1.234568},
+                                             "feed": None}
+
+
+def test_writers_stream_one_record_at_a_time():
+    seen = []
+
+    def gen():
+        for i in range(1, 4):
+            seen.append(i)
+            yield ToolpathRecord(i, "a.nc", i, "rapid", start={"X": 0.0}, end={"X": float(i)})
+
+    class Sink(io.StringIO):
+        def write(self, s):
+            # by the time line i is written, the generator has produced exactly i records
+            if s.startswith('{"seq":'):
+                assert len(seen) == json.loads(s)["seq"]
+            return super().write(s)
+
+    out = Sink()
+    assert write_jsonl(gen(), out) == 3 and len(out.getvalue().splitlines()) == 3
+    out = io.StringIO()
+    assert write_csv((ToolpathRecord(i, "a.nc", i, "arc", start={"X": 1.0}, end={"Y": 2.0}, center={"Z": 0.5},
+                                     direction="cw", plane="XY", turns=0) for i in (1, 2)), out) == 2
+    rows = list(csv.reader(io.StringIO(out.getvalue())))
+    assert rows[0] == CSV_COLUMNS and len(rows) == 3
+    row = dict(zip(rows[0], rows[1]))
+    assert (row["start_X"], row["end_Y"], row["center_Z"], row["direction"], row["start_Y"]) == ("1.0", "2.0", "0.5", "cw", "")
+
+
+def test_summary_lengths_bbox_time_and_tools():
+    s = Summary()
+    s.add(ToolpathRecord(1, "a", 1, "tool_change", tool=3))
+    s.add(ToolpathRecord(2, "a", 2, "rapid", start={"X": 0.0, "Y": 0.0, "Z": 0.0}, end={"X": 10.0, "Y": 0.0, "Z": 0.0}))
+    # a half circle ccw from (10,0) to (-10,0) round (0,0): passes Y=+10
+    s.add(ToolpathRecord(3, "a", 3, "arc", start={"X": 10.0, "Y": 0.0, "Z": 0.0}, end={"X": -10.0, "Y": 0.0, "Z": 0.0},
+                         center={"X": 0.0, "Y": 0.0, "Z": 0.0}, direction="ccw", plane="XY", turns=0,
+                         feed=600.0, feed_mode="per_min"))
+    s.add(ToolpathRecord(4, "a", 4, "dwell", dwell_s=2.0))
+    assert math.isclose(s.rapid_mm, 10.0) and math.isclose(s.feed_mm, 10 * math.pi)
+    assert (s.lo["Y"], s.hi["Y"]) == (0.0, 10.0) and (s.lo["X"], s.hi["X"]) == (-10.0, 10.0)
+    assert math.isclose(s.time_s, 60 * 10 / 10000 + 60 * 10 * math.pi / 600 + 2.0)
+    text = s.format(diagnostics=4)
+    assert "tools: T3" in text and "diagnostics: 4" in text and "arc 1" in text
