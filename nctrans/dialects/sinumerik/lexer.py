@@ -69,9 +69,16 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
     """Tokens of `text`; columns are 1-based and offset by `col0 - 1` (the statement's place in the line)."""
     i, n = 0, len(text)
     last = [""]
+    state = {"def": False, "depth": 0}
 
     def tok(kind: str, value: str, start: int, end: int) -> Token:
         last[0] = kind
+        if kind == "DEF" and start == 0:
+            state["def"] = True
+        elif kind in ("LPAR", "LSQB"):
+            state["depth"] += 1
+        elif kind in ("RPAR", "RSQB"):
+            state["depth"] -= 1
         return Token(kind, value, start, 1, col0 + start, 1, col0 + end, end)
 
     while i < n:
@@ -127,8 +134,11 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
                 yield tok("IDENT", upper, i, end)
                 i = end
                 continue
-            if last[0] in ("LPAR", "COMMA", "LSQB") and not re.fullmatch(r"R\d+", upper) \
-                    and nxt in ",)]":
+            declared = last[0] == "TYPE" or (state["def"] and state["depth"] == 0 and last[0] in (
+                "COMMA", "IDENT", "RSQB") and not (upper in KEYWORDS))
+            if last[0] in ("PROC", "EXTERN") or declared or (
+                    last[0] in ("LPAR", "COMMA", "LSQB") and not re.fullmatch(r"R\d+", upper)
+                    and nxt in ",)]"):
                 # an axis name such as X1 as an argument or index: DEF AXIS A=(X1), A[I1]
                 yield tok("IDENT", upper, i, end)
                 i = end
