@@ -796,7 +796,7 @@ def _parse_program(text: str, file: str):
             comments = None
         code = blanked.translate(_DROP_TABLE)
         if not code:
-            if comments is None:
+            if not comments:
                 continue
             comment = " ".join(comments)
             span = Span(file, lineno, 1, lineno, len(raw) + 1)
@@ -806,10 +806,10 @@ def _parse_program(text: str, file: str):
             lowercase_noted = True
             diags.append(Diagnostic("NC501", "info", "lowercase address letters", file, lineno))
         code = code.upper()
-        comment = " ".join(comments) if comments is not None else None
+        comment = " ".join(comments) if comments else None
         span = Span(file, lineno, 1, lineno, len(raw) + 1)
 
-        if fast_plain(code) is not None:
+        if code[0] != "O" and fast_plain(code) is not None:
             segments = ((None, code),)
         else:
             c0 = code[0]
