@@ -253,7 +253,7 @@ def _compare_runs(ra: _Run, rb: _Run, tol: float, next_a: str = "", next_b: str 
 
 
 def _fmt(p, axes) -> str:
-    return " ".join(f"{a}{v:.4f}" for a, v in zip(axes, p))
+    return " ".join(f"{a}{v:.4f}" if len(a) == 1 else f"{a}={v:.4f}" for a, v in zip(axes, p))
 
 
 def _fmt_event(key: str, value) -> str:
