@@ -41,6 +41,8 @@ _MARKERS: list[tuple[str, float, int, re.Pattern]] = [
         r"\b(?:A?TRANS|A?ROT|A?SCALE|A?MIRROR|ENDIF|ENDWHILE|ENDFOR|ENDLOOP|STOPRE|TRAFOOF|TRAORI|SUPA|"
         r"CFC|DIAMON|BRISK|SOFT|G64[12]|CIP|CR[ \t]*=|AC[ \t]*\(|IC[ \t]*\(|M17|RET)\b", _I)),
     ("sinumerik", 3.0, 2, re.compile(r"\bT[ \t]*=[ \t]*\"", _I)),
+    # array element assignment by name (GUD/LUD arrays: INI[53]=0); ISO writes #[..] instead
+    ("sinumerik", 3.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?[A-Z_]{2,}\w*[ \t]*\[[^\]]*\][ \t]*=", _I)),
     ("iso-m", 3.0, 1, re.compile(r"^[ \t]*O\d{1,8}\b", _I)),
     # LinuxCNC rs274ngc (an ISO dialect): o-word control flow and named parameters
     ("iso-m", 4.0, 3, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?O(?:\d+|<\w+>)[ \t]*(?:SUB|ENDSUB|IF|ELSEIF|ELSE|ENDIF|"
@@ -66,11 +68,11 @@ _ISO_COMMENT_WEIGHT, _ISO_COMMENT_CAP = 1.0, 3
 _SEMICOLON_LINE_WEIGHT, _SEMICOLON_LINE_CAP = 1.0, 3
 # a "(" that opens an expression, not an ISO comment: after =, an operator, a bracket, a comma, a
 # name (function call CYCLE81(, MSG() or a condition keyword (IF (R1>0)).
-_EXPR_BEFORE_PAREN = re.compile(r"(?:[=+\-*/<>,(\[]|\b(?:IF|WHILE|UNTIL|ELSE|AND|OR|NOT|XOR|CASE|FOR))$",
+_EXPR_BEFORE_PAREN = re.compile(r"(?:[=+\-*/<>,(\[]|\b(?:IF|WHILE|UNTIL|ELSE|AND|OR|NOT|XOR|CASE|FOR|AS))$",
                                 re.IGNORECASE)
 _CALL_BEFORE_PAREN = re.compile(r"[A-Z_$][A-Z_$]+\w*$", re.IGNORECASE)   # CYCLE81( MSG( SIN( ...
 _SCAN_LINES = 4000
-_SNIFF_WEIGHT = 4.0
+_SNIFF_WEIGHT = 1.5   # front ends sniff coarsely; the marker table and file ending weigh more
 _EXT_WEIGHT = 2.0
 MIN_EVIDENCE = 1.0
 MIN_MARGIN = 0.2
@@ -190,8 +192,11 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
         suffix = Path(filename).suffix.lower()
         if suffix:
             owners = [n for n in names if suffix in _extensions(n)]
+            # an ending only one dialect uses (.mpf) says more than a shared one (.nc)
+            weight = _EXT_WEIGHT * 1.5 if len(owners) == 1 and all(
+                suffix not in exts for d, exts in EXTENSIONS.items() if d not in owners) else _EXT_WEIGHT
             for n in owners:
-                evidence[n] += _EXT_WEIGHT / len(owners)
+                evidence[n] += weight / len(owners)
     total = sum(evidence.values())
     scores = {n: (e / total if total else 0.0) for n, e in evidence.items()}
     ranked = sorted(scores.items(), key=lambda kv: -kv[1])

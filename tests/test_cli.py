@@ -459,3 +459,38 @@ def test_e2e_convert_iso_to_sinumerik_is_equivalent(tmp_path):
     if rc == 1:
         # a real finding of equiv, for the converter's owners (reported); not a CLI failure
         pytest.xfail("iso-m -> sinumerik conversion not toolpath-equivalent yet: " + text.strip()[:300])
+
+
+# --------------------------------------------------------------------------- detection (in process)
+
+def test_detect_every_corpus_program_with_and_without_its_name():
+    from nctrans.detect import detect
+    from nctrans.source import read_source
+    files = [p for p in CORPUS.rglob("*") if p.is_file() and p.suffix != ".tsv"]
+    assert len(files) > 50
+    for p in files:
+        want = "sinumerik" if "sinumerik" in p.parts else "iso-m"
+        text = read_source(p).text
+        assert detect(text, p.name).dialect == want, p
+        assert detect(text, None).dialect == want, p
+
+
+def test_detect_ignores_words_inside_iso_comments(monkeypatch):
+    from nctrans import detect as det
+    monkeypatch.setattr(det, "_sniff", lambda name, text: None)     # the marker table alone
+    detect = det.detect
+    iso = "%\nO1000\n(T1 D=0.5 CR=0. - ZMIN=0. - MIRROR ENDIF)\n(X=10 R1=5 GOTOF)\nG0 X0 Y0\nM30\n%\n"
+    g = detect(iso, None)
+    assert g.dialect == "iso-m" and g.content.get("sinumerik", 0.0) <= 1.0
+    sin = "DEF REAL LEN\nR1=(R2+3)*2\nIF (R1>2) GOTOF END\nCYCLE81(10, 0, 2, -5)\nEND:\nM30\n"
+    g = detect(sin, None)
+    assert g.dialect == "sinumerik" and g.first_marker["sinumerik"][0] == 1
+
+
+def test_detect_says_ambiguous_without_evidence():
+    from nctrans.detect import detect
+    for text in ("", "hello\n", "  \n"):
+        g = detect(text, None)
+        assert g.ambiguous and g.dialect is None
+    assert detect("G0 X1\n", "part.mpf").dialect == "sinumerik"
+    assert detect("G0 X1\n", "part.nc").dialect == "iso-m"
