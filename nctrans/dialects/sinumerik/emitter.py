@@ -195,7 +195,9 @@ class Emitter:
     # ---------------------------------------------------------------- words
     def word(self, addr: str, e: ir.Expr) -> str:
         if len(addr) == 1 and isinstance(e, ir.Num):
-            return addr + self.num(e)
+            text = self.num(e)
+            if text[:1].isdigit() or text[:1] in "-+.":
+                return addr + text
         return f"{addr}={self.expr(e)}"
 
     def axis(self, name: str, av: ir.AxisValue, arc: bool = False) -> str:
@@ -230,8 +232,9 @@ class Emitter:
                 if s.value == "off":
                     if st.cycle_active:
                         out.alone("MCALL")
-                        out.alone(self.t.code_for("motion", st.motion).code
-                                  if self.t.code_for("motion", st.motion) else "")
+                        back = self.t.code_for("motion", st.motion)
+                        if back is not None and st.motion != "rapid":
+                            out.alone(back.code)     # positioning blocks were written with G0
                     st.cycle, st.cycle_active, st.cycle_params = "off", False, {}
                 else:
                     st.cycle, st.cycle_pending = s.value, True

@@ -238,6 +238,11 @@ _ORDER = {"Assign": 0, "VarDecl": 0, "ModeChange": 1, "Feed": 2, "SpindleSpeed":
           "Return": 8, "Goto": 8}
 
 
+def _t(text) -> str:
+    """Statement text for a Passthrough: computed lazily (only kept constructs need it)."""
+    return text() if callable(text) else text
+
+
 def _priority(st) -> int:
     kind = type(st).__name__
     if kind == "ModeChange":
@@ -311,9 +316,9 @@ class Lowerer:
             reason = self.unsupported.get(code)
             if reason is None and code.startswith("M"):
                 reason = "auxiliary function"
-                w.out.append(ir.Passthrough(text, reason, ""))
+                w.out.append(ir.Passthrough(_t(text), reason, ""))
                 return
-            w.out.append(ir.Passthrough(text, reason or "unknown function", DIALECT))
+            w.out.append(ir.Passthrough(_t(text), reason or "unknown function", DIALECT))
             return
         g = rule.group
         if g in MODAL_GROUPS:
@@ -333,7 +338,7 @@ class Lowerer:
         elif g == "frame":
             w.frame = rule.value
         else:
-            w.out.append(ir.Passthrough(text, g, DIALECT))
+            w.out.append(ir.Passthrough(_t(text), g, DIALECT))
 
     def address(self, letter: str, num: ir.Num, w: _Words, text: str) -> None:
         """A word `letter number` (X10, G1, M3, F100, L47 ...)."""
@@ -365,7 +370,7 @@ class Lowerer:
             pass
         else:
             reason = self.pass_words.get(letter, f"address {letter}")
-            w.out.append(ir.Passthrough(text, reason, DIALECT if letter != "H" else ""))
+            w.out.append(ir.Passthrough(_t(text), reason, DIALECT if letter != "H" else ""))
 
     def named(self, name: str, value: ir.Expr, w: _Words, text: str) -> None:
         """A word `NAME=expr`: axis, arc parameter, extended address or an assignment."""
@@ -398,10 +403,10 @@ class Lowerer:
         elif _RPARAM.match(name):
             w.out.append(ir.Assign(ir.Var("R", int(name[1:])), value))
         elif name in self.pass_words:
-            w.out.append(ir.Passthrough(text, self.pass_words[name], DIALECT))
+            w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
         elif re.fullmatch(r"[A-Z]\d+", name):
             reason = self.pass_words.get(name[0], f"extended address {name[0]}")
-            w.out.append(ir.Passthrough(text, reason, DIALECT))
+            w.out.append(ir.Passthrough(_t(text), reason, DIALECT))
         else:
             w.out.append(ir.Assign(ir.Var("name", name), value))
 
@@ -412,7 +417,7 @@ class Lowerer:
                 self.code(name, w, text)
                 return
         if name in self.commands and not modal:
-            w.out.append(ir.Passthrough(text, self.commands[name], DIALECT))
+            w.out.append(ir.Passthrough(_t(text), self.commands[name], DIALECT))
             return
         if name == "MSG" and not modal:
             w.out.append(ir.Message(args[0] if args and args[0] is not None else ir.Str("")))
@@ -462,10 +467,10 @@ class Lowerer:
         for st in stmts:
             d = st.data
             ch = st.children
-            text = _slice(code, st)
+            text = (lambda c=code, t=st: _slice(c, t))
             if d == "word":
                 if ch[1] is None:
-                    w.out.append(ir.Passthrough(text, "address without value", DIALECT))
+                    w.out.append(ir.Passthrough(_t(text), "address without value", DIALECT))
                 else:
                     self.address(str(ch[0]), _num(ch[1]), w, text)
             elif d == "assign":
@@ -482,7 +487,7 @@ class Lowerer:
                 elif idx is not None:
                     name = str(lt)
                     if name in self.pass_words:
-                        w.out.append(ir.Passthrough(text, self.pass_words[name], DIALECT))
+                        w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
                     elif name == "R":
                         w.out.append(ir.Assign(ir.Var("R", None, _args(idx)), value))
                     else:
@@ -509,7 +514,7 @@ class Lowerer:
                 if isinstance(target, ir.Str) and ch[2] is None:
                     w.out.append(ir.SubCall(target.value.upper(), kind="call"))
                 else:
-                    w.out.append(ir.Passthrough(text, "indirect call", DIALECT))
+                    w.out.append(ir.Passthrough(_t(text), "indirect call", DIALECT))
             elif d == "pcall_stmt":
                 w.out.append(ir.SubCall(str(ch[1]), _args(ch[3]) if ch[3] is not None else [],
                                         kind="pcall"))
@@ -518,25 +523,25 @@ class Lowerer:
                 if isinstance(target, ir.Str):
                     w.out.append(ir.SubCall(target.value.upper(), kind=d.split("_")[0]))
                 else:
-                    w.out.append(ir.Passthrough(text, "indirect call", DIALECT))
+                    w.out.append(ir.Passthrough(_t(text), "indirect call", DIALECT))
             elif d == "ret_stmt":
                 if ch[1] is None:
                     w.out.append(ir.Return())
                 else:
-                    w.out.append(ir.Passthrough(text, "parameterized return", DIALECT))
+                    w.out.append(ir.Passthrough(_t(text), "parameterized return", DIALECT))
             elif d == "endproc_stmt":
                 w.out.append(ir.Return())
             elif d == "frame_stmt":
                 w.frame = table().lookup(str(ch[0])).value
             elif d == "procattr_stmt":
-                w.out.append(ir.Passthrough(text, self.commands.get(str(ch[0]), "program attribute"),
+                w.out.append(ir.Passthrough(_t(text), self.commands.get(str(ch[0]), "program attribute"),
                                             DIALECT))
             elif d == "goto_stmt":
                 w.out.append(_goto(ch[0], ch[1], None))
             elif d == "def_stmt":
                 w.out.extend(self.vardecls(st))
             elif d == "extern_stmt":
-                w.out.append(ir.Passthrough(text, "declaration", DIALECT))
+                w.out.append(ir.Passthrough(_t(text), "declaration", DIALECT))
                 self.meta.setdefault("externs", []).append(str(ch[1]))
             else:
                 self.error("NC002", f"{_KW.get(d, d)} must stand in its own block", line.lineno,
@@ -665,7 +670,7 @@ def _span(file: str, line: Line) -> ir.Span:
 
 
 def _passthrough_block(file: str, line: Line, text: str, reason: str, dialect: str = DIALECT) -> ir.Block:
-    return ir.Block(_span(file, line), [ir.Passthrough(text, reason, dialect)] if text else [],
+    return ir.Block(_span(file, line), [ir.Passthrough(_t(text), reason, dialect)] if text else [],
                     line.number, line.label, line.skip, line.comment)
 
 
@@ -788,9 +793,10 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
             unit.current.append(_passthrough_block(file, line, code, _SECTION_REASON[kw]))
             continue
         code = _PCALL_PATH.sub(lambda mm: mm.group(1) + mm.group(3), code)
-        # ---- parse the statement part
+        # ---- parse the statement part (plain address words skip the LALR parser)
         try:
-            tree = parser().parse(code)
+            fast = _plain_words(code)
+            tree = Tree("start", fast) if fast is not None else parser().parse(code)
         except LexError as e:
             low.error(e.rule, e.message, n, line.col + e.pos)
             unit.current.append(_passthrough_block(file, line, code, "syntax error"))
@@ -835,6 +841,23 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
     if not src.text.strip():
         pass
     return ParseResult(prog, diags)
+
+
+def _plain_words(code: str) -> Optional[list]:
+    """Blocks made only of `X10 G1 F100` words, as word trees without running the parser."""
+    try:
+        toks = list(tokenize(code))
+    except LexError:
+        return None
+    if not toks or len(toks) % 2:
+        return None
+    out = []
+    for i in range(0, len(toks), 2):
+        a, b = toks[i], toks[i + 1]
+        if a.type != "ADDR" or b.type != "NUMBER":
+            return None
+        out.append(Tree("word", [a, b]))
+    return out
 
 
 def _expand(code: str, macros: dict[str, str]) -> str:
