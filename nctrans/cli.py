@@ -168,26 +168,36 @@ def _strict(diags: list[Diagnostic]) -> list[Diagnostic]:
 
 
 def cmd_convert(args) -> int:
-    sources: list[str] = args.src
     _check_dialect(args.from_)
     target = pipeline.get_dialect(args.to)
     if args.output and args.out_dir:
         raise UsageError("give either -o or --out-dir, not both")
+    if args.src.count(_source.STDIN) > 1:
+        raise UsageError("'-' (stdin) can be given once")
+    # (source, path relative to the output directory) - directories are recursed, keeping structure
+    jobs: list[tuple[str, Path]] = []
+    ext = _target_extension(target.name)
+    for s in args.src:
+        if s != _source.STDIN and os.path.isdir(s):
+            if not args.out_dir:
+                raise UsageError(f"{s} is a directory: converting a directory needs --out-dir")
+            for f in pipeline.iter_inputs([s]):
+                jobs.append((f, Path(os.path.relpath(f, s)).with_suffix(ext)))
+        else:
+            jobs.append((s, Path("stdin" if s == _source.STDIN else Path(s).stem + ext)))
+    sources = [j[0] for j in jobs]
     if args.output and len(sources) > 1:
         raise UsageError("-o takes one source; use --out-dir for several")
     if len(sources) > 1 and not args.out_dir:
         raise UsageError("several sources need --out-dir")
-    if sources.count(_source.STDIN) > 1:
-        raise UsageError("'-' (stdin) can be given once")
     # decide every output path first, and refuse before doing any work
     outputs: dict[str, Optional[Path]] = {}
     inputs = [Path(s) for s in sources if s != _source.STDIN]
-    for s in sources:
+    for s, rel in jobs:
         if args.output:
             out = None if args.output == "-" else Path(args.output)
         elif args.out_dir:
-            stem = "stdin" if s == _source.STDIN else Path(s).stem
-            out = Path(args.out_dir) / (stem + _target_extension(target.name))
+            out = Path(args.out_dir) / rel
         else:
             out = None
         if out is not None:
@@ -202,7 +212,10 @@ def cmd_convert(args) -> int:
         outputs[s] = out
     machine = pipeline.load_machine(args.machine, args.from_) if args.flatten else None
     status = EXIT_OK
+    bar = _progress(len(sources), "convert")
     for s in sources:
+        if bar is not None:
+            bar.advance(bar.task_ids[0])
         try:
             ld = pipeline.load(s, args.from_)
         except pipeline.PipelineError as e:
@@ -215,8 +228,6 @@ def cmd_convert(args) -> int:
             program = ld.program
             if args.flatten:
                 program = _flatten(program, machine or pipeline.load_machine(None, ld.dialect), diags, ld)
-            if target.name == ld.dialect and not args.flatten:
-                program = program   # same dialect: a normalising round trip through the IR
             res = target.emit(program)
             diags.extend(res.diagnostics)
             text = res.text
@@ -237,6 +248,8 @@ def cmd_convert(args) -> int:
             except OSError as e:
                 _err(f"{out}: cannot write: {e.strerror or e}")
                 status = EXIT_USAGE
+    if bar is not None:
+        bar.stop()
     return status
 
 

@@ -41,6 +41,7 @@ _MARKERS: list[tuple[str, float, int, re.Pattern]] = [
         r"\b(?:A?TRANS|A?ROT|A?SCALE|A?MIRROR|ENDIF|ENDWHILE|ENDFOR|ENDLOOP|STOPRE|TRAFOOF|TRAORI|SUPA|"
         r"CFC|DIAMON|BRISK|SOFT|G64[12]|CIP|CR[ \t]*=|AC[ \t]*\(|IC[ \t]*\(|M17|RET)\b", _I)),
     ("sinumerik", 3.0, 2, re.compile(r"\bT[ \t]*=[ \t]*\"", _I)),
+    ("sinumerik", 1.5, 1, re.compile(r"\bG7[01]\b", _I)),          # inch/metric (ISO mills: G20/G21)
     # array element assignment by name (GUD/LUD arrays: INI[53]=0); ISO writes #[..] instead
     ("sinumerik", 3.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?[A-Z_]{2,}\w*[ \t]*\[[^\]]*\][ \t]*=", _I)),
     ("iso-m", 3.0, 1, re.compile(r"^[ \t]*O\d{1,8}\b", _I)),
@@ -61,11 +62,12 @@ _MARKERS: list[tuple[str, float, int, re.Pattern]] = [
     ("iso-m", 1.0, 2, re.compile(r"\bG28\b", _I)),
     # blocks of plain words only (N, G, M, axes, F, S, T...): both dialects allow them, ISO programs
     # are made of little else, so a small capped lean towards ISO.
-    ("iso-m", 0.25, 8, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?(?:[GMXYZIJKFSTHDPQRABC][ \t]*[-+]?\d*\.?\d+[ \t]*)+$", _I)),
+    ("iso-m", 0.25, 6, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?(?:[GMXYZIJKFSTHDPQRABC][ \t]*[-+]?\d*\.?\d+[ \t]*)+$", _I)),
 ]
 # comment-shaped markers, counted while the comments are removed
 _ISO_COMMENT_WEIGHT, _ISO_COMMENT_CAP = 1.0, 3
 _SEMICOLON_LINE_WEIGHT, _SEMICOLON_LINE_CAP = 1.0, 3
+_SEMICOLON_TAIL_WEIGHT, _SEMICOLON_TAIL_CAP = 0.5, 2     # "G1 X1 ; text": Sinumerik (and LinuxCNC) comments
 # a "(" that opens an expression, not an ISO comment: after =, an operator, a bracket, a comma, a
 # name (function call CYCLE81(, MSG() or a condition keyword (IF (R1>0)).
 _EXPR_BEFORE_PAREN = re.compile(r"(?:[=+\-*/<>,(\[]|\b(?:IF|WHILE|UNTIL|ELSE|AND|OR|NOT|XOR|CASE|FOR|AS))$",
@@ -104,12 +106,15 @@ class Guess:
 
 
 def _code_lines(text: str):
-    """(line number, code without comments, had an ISO comment, is a ';' comment line) per line."""
+    """(line number, code without comments, had an ISO comment, is a ';' comment line, has a ';'
+    comment after code) per line."""
     for n, raw in enumerate(text.split("\n", _SCAN_LINES)[:_SCAN_LINES], 1):
         line = raw
         semi_line = line.lstrip().startswith(";")
         cut = line.find(";")
+        semi_tail = False
         if cut >= 0:
+            semi_tail = not semi_line and bool(line[cut + 1:].strip())
             line = line[:cut]
         comment = False
         if "(" in line:
@@ -129,7 +134,7 @@ def _code_lines(text: str):
                 out.append(line[i:j] + " " * (k - j + 1))
                 i = k + 1
             line = "".join(out)
-        yield n, line, comment, semi_line
+        yield n, line, comment, semi_line, semi_tail
 
 
 def _extensions(name: str) -> tuple[str, ...]:
@@ -161,10 +166,11 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
     first: dict[str, tuple[int, int, str]] = {}
     markers = [m for m in _MARKERS if m[0] in evidence]
     hits = [0] * len(markers)
-    iso_comments = semi_lines = 0
-    for lineno, code, comment, semi in _code_lines(text):
+    iso_comments = semi_lines = semi_tails = 0
+    for lineno, code, comment, semi, tail in _code_lines(text):
         iso_comments += comment
         semi_lines += semi
+        semi_tails += tail
         if not code.strip():
             continue
         for i, (dialect, weight, cap, rx) in enumerate(markers):
@@ -182,6 +188,7 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
         evidence["iso-m"] += _ISO_COMMENT_WEIGHT * min(iso_comments, _ISO_COMMENT_CAP)
     if "sinumerik" in evidence:
         evidence["sinumerik"] += _SEMICOLON_LINE_WEIGHT * min(semi_lines, _SEMICOLON_LINE_CAP)
+        evidence["sinumerik"] += _SEMICOLON_TAIL_WEIGHT * min(semi_tails, _SEMICOLON_TAIL_CAP)
     head = text[:200_000]
     for n in names:
         s = _sniff(n, head)

@@ -287,8 +287,22 @@ def test_convert_usage_errors(fake, capsys):
     assert run(capsys, "convert", "a.fk", "b.fk", "--to", "fake", "-o", "x")[0] == 2
     rc, _, err = run(capsys, "convert", "a.fk", "--to", "klingon")
     assert rc == 2 and "unknown dialect 'klingon'" in err
-    rc, _, err = run(capsys, "convert", "a.fk", "--to", "fake", "--flatten")
-    assert rc == 2 and "not available" in err
+
+
+
+def test_convert_flatten_when_the_module_is_missing_or_there(fake, capsys, monkeypatch):
+    Path("a.fk").write_text("G0 X1\nG1 X2 F100\n")
+    with monkeypatch.context() as m:
+        m.setitem(sys.modules, "nctrans.lower.flatten", None)        # import fails
+        rc, _, err = run(capsys, "convert", "a.fk", "--to", "fake", "--flatten")
+        assert rc == 2 and "--flatten is not available" in err
+    try:
+        import nctrans.lower.flatten  # noqa: F401
+    except ImportError:
+        pytest.skip("nctrans.lower.flatten not there yet")
+    rc, out, err = run(capsys, "convert", "a.fk", "--to", "fake", "--flatten")
+    assert rc == 0, err
+    assert out.strip()
 
 
 def test_convert_lowering_strict_and_refusal(fake, capsys):
@@ -494,3 +508,45 @@ def test_detect_says_ambiguous_without_evidence():
         assert g.ambiguous and g.dialect is None
     assert detect("G0 X1\n", "part.mpf").dialect == "sinumerik"
     assert detect("G0 X1\n", "part.nc").dialect == "iso-m"
+
+
+def test_machine_file_is_used_and_a_broken_one_exits_2(fake, capsys):
+    Path("p.fk").write_text("G0 X10 Y0 Z5\n")
+    Path("m.toml").write_text('name = "vmc"\nkind = "mill"\n[offsets.G54]\nX = 100.0\nY = -50.0\nZ = 0.0\n'
+                              '[axes.X]\nmin = -300.0\nmax = 300.0\nrapid = 20000.0\n')
+    rc, out, _ = run(capsys, "toolpath", "p.fk", "--machine", "m.toml")
+    assert rc == 0
+    Path("bad.toml").write_text("name = [unclosed\n")
+    rc, _, err = run(capsys, "toolpath", "p.fk", "--machine", "bad.toml")
+    assert rc == 2 and "bad.toml" in err and "invalid TOML" in err
+    Path("wrong.toml").write_text('kind = "submarine"\n')
+    rc, _, err = run(capsys, "lint", "p.fk", "--machine", "wrong.toml")
+    assert rc == 2 and "invalid machine description" in err
+    rc, _, err = run(capsys, "lint", "p.fk", "--machine", "missing.toml")
+    assert rc == 2 and "cannot read machine file" in err
+
+
+def test_convert_a_directory_keeps_its_structure(fake, capsys):
+    (Path("src") / "sub").mkdir(parents=True)
+    Path("src/a.fk").write_text("G0 X1\n")
+    Path("src/sub/b.fk").write_text("G0 X2\n")
+    Path("src/notes.md").write_text("(\n")
+    assert run(capsys, "convert", "src", "--to", "fake")[0] == 2          # a directory needs --out-dir
+    rc, _, err = run(capsys, "convert", "src", "--to", "fake", "--out-dir", "dst")
+    assert rc == 0, err
+    assert sorted(str(p.relative_to("dst")) for p in Path("dst").rglob("*") if p.is_file()) == ["a.nc", "sub/b.nc"]
+
+
+@needs_iso
+def test_e2e_flatten_is_equivalent_to_its_source(tmp_path):
+    sample = ROOT / "corpus" / "iso-m" / "sample-pocket.nc"
+    for target, name in (("iso-m", "flat.nc"), ("sinumerik", "flat.mpf")):
+        if not available(target):
+            continue
+        out = tmp_path / name
+        rc, _, err = sh("convert", str(sample), "--flatten", "--to", target, "-o", str(out))
+        if rc == 2 and "not available" in err:
+            pytest.skip("--flatten not there yet")
+        assert rc == 0, err
+        rc, text, err = sh("equiv", str(sample), str(out), "--from-a", "iso-m", "--from-b", target)
+        assert rc == 0, text + err
