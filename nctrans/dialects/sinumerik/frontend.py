@@ -404,8 +404,13 @@ class Lowerer:
             w.out.append(ir.Assign(ir.Var("R", int(name[1:])), value))
         elif name in self.pass_words:
             w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
+        elif re.fullmatch(r"M\d+", name) and name == "M1" and isinstance(value, ir.Num) and \
+                f"M{value.value:g}" in ("M3", "M4", "M5", "M19"):
+            self.code(f"M{value.value:g}", w, text)          # M1=3: master spindle 1 clockwise
         elif re.fullmatch(r"[A-Z]\d+", name):
             reason = self.pass_words.get(name[0], f"extended address {name[0]}")
+            if name[0] == "M":
+                reason = "spindle-addressed M function"
             w.out.append(ir.Passthrough(_t(text), reason, DIALECT))
         else:
             w.out.append(ir.Assign(ir.Var("name", name), value))
