@@ -102,6 +102,8 @@ def _expr(e: Any, ctx) -> tuple[str, int]:
         if name not in _FUNCS:
             raise NotExpressible(f"function {e.name.upper()}")
         args = ",".join(format_expr(a, ctx) for a in e.args)
+        if name == "atan":              # bracketed, so a following "/[" is not read as ATAN[a]/[b]
+            return f"[ATAN[{args}]]", 5
         return f"{_FUNCS[name]}[{args}]", 5
     if t is n.Str:
         raise NotExpressible("a string value")

@@ -861,6 +861,11 @@ def _parse_program(text: str, file: str):
 
         seen_block = True
         for skip, seg in segments:
+            if not seg:                             # "/" alone (perhaps with a comment)
+                if comment is not None or skip is not None:
+                    cur.append(Block(span, [], None, None, skip, comment))
+                comment = None
+                continue
             items = None
             if fast_plain(seg) is not None:
                 items = fast_words(seg)
@@ -982,7 +987,7 @@ def _split_skips(code: str) -> list:
         skip = int(m.group(1) or 0)
         code = code[m.end():]
         if not code:
-            return [(skip, "")] if False else []
+            return [(skip, "")]
     if "/" not in code or "#" in code or "[" in code:
         return [(skip, code)]
     parts = code.split("/")
