@@ -218,7 +218,7 @@ def test_unbalanced_structures_are_diagnosed():
 
 def test_call_forms():
     c = first("BORDER(15.3, ,5) P3", ir.SubCall)
-    assert c.name == "BORDER" and c.args[1] is None and c.repeat.value == 3
+    assert c.name == "BORDER" and c.args[1] == ir.Num(0.0, "") and c.repeat.value == 3   # omitted
     c = first("L0123", ir.SubCall)
     assert (c.name, c.kind) == ("L0123", "l")                    # leading zeros kept
     c = first("MCALL L70", ir.SubCall)
@@ -380,6 +380,13 @@ def test_bad_blocks_give_diagnostics_with_position(text, rule, col):
     blocks = res.program.body
     assert len(blocks) == 3 and isinstance(blocks[2].body[-1], ir.Motion)
     assert isinstance(blocks[1].body[0], ir.Passthrough)
+
+
+def test_integer_addresses_reject_fractions():
+    res = parse("G0 X0\nG1 X1 T1.5\n", "t.mpf")
+    d = res.diagnostics[0]
+    assert (d.rule, d.line, d.column) == ("NC007", 2, 7)
+    assert not parse("G1 X1.5 F0.5 S100.5\n", "t.mpf").diagnostics
 
 
 def test_syntax_error_lists_expected_tokens():

@@ -20,12 +20,14 @@ _CLASSES: dict[str, type] = {
 
 
 def to_data(obj: Any) -> Any:
-    """IR object -> JSON-ready data. Fields equal to None are left out to keep documents small."""
+    """IR object -> JSON-ready data. Optional fields equal to None are left out to keep documents
+    small; a required field that is None (Var.key of R[expr] / #[expr]) is written as null."""
     if dataclasses.is_dataclass(obj):
         out: dict[str, Any] = {"node": type(obj).__name__}
         for f in dataclasses.fields(obj):
             v = getattr(obj, f.name)
-            if v is None:
+            if v is None and (f.default is not dataclasses.MISSING
+                              or f.default_factory is not dataclasses.MISSING):
                 continue
             out[f.name] = to_data(v)
         return out

@@ -99,6 +99,8 @@ class Emitter:
 
     # ---------------------------------------------------------------- expressions
     def num(self, n: ir.Num) -> str:
+        if n.text == "":               # an omitted call argument f(1,,3) (frontend.OMITTED)
+            return ""
         if n.text and _NUM_OK.match(n.text):
             try:
                 if math.isclose(number_value(n.text.lstrip("+")), n.value, rel_tol=1e-12, abs_tol=1e-12):
@@ -503,7 +505,10 @@ class Emitter:
         parts = []
         for d in ds:
             s = d.name
-            if d.dims:
+            sym = (self.p.meta or {}).get("symbolic_dims", {}).get(d.name)
+            if sym and len(sym) == len(d.dims):
+                s += "[" + ",".join(t if t else str(x) for t, x in zip(sym, d.dims)) + "]"
+            elif d.dims:
                 s += "[" + ",".join(str(x) if x else "" for x in d.dims) + "]"
             if d.init:
                 if d.type == "AXIS" and len(d.init) == 1:

@@ -154,6 +154,7 @@ _BINOPS = {"+": "+", "-": "-", "*": "*", "/": "/", "DIV": "div", "MOD": "mod", "
            "=>": ">=", "<<": "concat"}
 _PREFIX = {"-": "-", "+": "+", "NOT": "not", "B_NOT": "bnot"}
 _RPARAM = re.compile(r"R(\d+)$")
+_INTEGER_ADDRESSES = frozenset("NGMLTDP")     # spec 2.2 / table: integer values only
 
 
 def _num(tok: Token) -> ir.Num:
@@ -195,7 +196,7 @@ def expr(t) -> Optional[ir.Expr]:
         return func(str(ch[0]), _args(ch[2]))
     if d == "paren":
         args = _args(ch[1])
-        if len(args) == 1 and args[0] is not None:
+        if len(args) == 1:
             return args[0]
         return ir.Func("LIST", args)
     if d == "prefix":
@@ -212,12 +213,25 @@ def expr(t) -> Optional[ir.Expr]:
     raise ValueError(f"unexpected tree {d}")
 
 
-def _args(t) -> list[Optional[ir.Expr]]:
-    """arglist -> expressions; an omitted argument (`f(1,,3)`) is None."""
+OMITTED = ""      # Num.text of an omitted argument `f(1,,3)`: value 0, as the control passes it
+
+
+def omitted() -> ir.Num:
+    return ir.Num(0.0, OMITTED)
+
+
+def is_omitted(e) -> bool:
+    return e is None or (isinstance(e, ir.Num) and e.text == OMITTED)
+
+
+def _args(t) -> list[ir.Expr]:
+    """arglist -> expressions; an omitted argument (`f(1,,3)`) is Num(0, text="") (spec 6.1:
+    omitted parameters are 0 / ""), so argument positions and the JSON schema both hold."""
     if t is None:
         return []
-    return [expr(a.children[0]) if a.children and a.children[0] is not None else None
+    args = [expr(a.children[0]) if a.children and a.children[0] is not None else omitted()
             for a in t.children if isinstance(a, Tree)]
+    return [] if len(args) == 1 and is_omitted(args[0]) else args
 
 
 def func(name: str, args: list) -> ir.Expr:
@@ -342,6 +356,12 @@ class Lowerer:
 
     def address(self, letter: str, num: ir.Num, w: _Words, text: str) -> None:
         """A word `letter number` (X10, G1, M3, F100, L47 ...)."""
+        if letter in _INTEGER_ADDRESSES and (num.value != int(num.value) or "." in (num.text or "")
+                                             or "EX" in (num.text or "").upper()):
+            self.invalid_number = (f"address {letter} takes an integer, not {num.text}",
+                                   getattr(self, "word_col", 1))
+            w.out.append(ir.Passthrough(_t(text), "invalid number", DIALECT))
+            return
         if letter == "G":
             self.code(normalise_code("G", num.text or num.value), w, text)
         elif letter == "M":
@@ -425,7 +445,7 @@ class Lowerer:
             w.out.append(ir.Passthrough(_t(text), self.commands[name], DIALECT))
             return
         if name == "MSG" and not modal:
-            w.out.append(ir.Message(args[0] if args and args[0] is not None else ir.Str("")))
+            w.out.append(ir.Message(args[0] if args and not is_omitted(args[0]) else ir.Str("")))
             return
         if name == "SETAL" and not modal and args:
             w.out.append(ir.Alarm(args[0], args[1] if len(args) > 1 else None))
@@ -433,7 +453,7 @@ class Lowerer:
         cyc = _cycles().get(name)
         if cyc is not None and args is not None:
             kind, keys, kind_by = cyc
-            params = {k: a for k, a in zip(keys, args) if a is not None}
+            params = {k: a for k, a in zip(keys, args) if not is_omitted(a)}
             if kind_by:
                 sel = params.get(kind_by[0])
                 if isinstance(sel, ir.Num):
@@ -468,6 +488,15 @@ class Lowerer:
     def statements(self, stmts: list, line: Line) -> list:
         """The statements of one (non-control) block in execution order."""
         w = _Words()
+        self.invalid_number = None
+        try:
+            return self._statements(stmts, line, w)
+        finally:
+            if self.invalid_number:
+                msg, col = self.invalid_number
+                self.error("NC007", msg, line.lineno, col, col + 1)
+
+    def _statements(self, stmts: list, line: Line, w: _Words) -> list:
         code = line.code
         for st in stmts:
             d = st.data
@@ -477,6 +506,7 @@ class Lowerer:
                 if ch[1] is None:
                     w.out.append(ir.Passthrough(_t(text), "address without value", DIALECT))
                 else:
+                    self.word_col = line.col + ch[0].start_pos
                     self.address(str(ch[0]), _num(ch[1]), w, text)
             elif d == "assign":
                 lv = ch[0]
@@ -595,13 +625,18 @@ class Lowerer:
             name = str(dcl.children[0])
             dims = []
             if dcl.children[2] is not None:
-                for a in _args(dcl.children[2]):
-                    dims.append(int(a.value) if isinstance(a, ir.Num) else 0)
+                dim_exprs = _args(dcl.children[2]) or [omitted()]
+                for a in dim_exprs:
+                    dims.append(int(a.value) if isinstance(a, ir.Num) and not is_omitted(a) else 0)
+                if any(not isinstance(a, ir.Num) for a in dim_exprs):
+                    # DEF REAL A[MAXFAZA]: a dimension named by a macro/GUD constant (spec 3.4)
+                    self.meta.setdefault("symbolic_dims", {})[name] = [
+                        None if isinstance(a, ir.Num) else _expr_text(a) for a in dim_exprs]
             init = None
             if dcl.children[5] is not None:
                 v = expr(dcl.children[5])
                 if isinstance(v, ir.Func) and v.name in ("LIST", "SET"):
-                    init = [a if a is not None else ir.Num(0.0, "0") for a in v.args]
+                    init = [ir.Num(0.0, "0") if is_omitted(a) else a for a in v.args]
                 else:
                     init = [v]
             out.append(ir.VarDecl(name, typ, dims, init, length, scope))
@@ -865,6 +900,12 @@ def _plain_words(code: str) -> Optional[list]:
     return out
 
 
+def _expr_text(e) -> str:
+    """Sinumerik spelling of an expression (for metadata that must round-trip)."""
+    from nctrans.dialects.sinumerik.emitter import Emitter
+    return Emitter(ir.Program("", DIALECT, [])).expr(e)
+
+
 def _expand(code: str, macros: dict[str, str]) -> str:
     out, pos = [], 0
     inq = False
@@ -935,7 +976,8 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
                 ts = next(x for x in c.children if isinstance(x, Tree) and x.data == "type_spec")
                 name = next(str(x) for x in c.children if isinstance(x, Token) and x.type == "IDENT")
                 arr = [x for x in c.children if isinstance(x, Tree) and x.data == "arglist"]
-                dims = [int(a.value) if isinstance(a, ir.Num) else 0 for a in _args(arr[0])] if arr else []
+                dims = [0 if is_omitted(a) else int(a.value) if isinstance(a, ir.Num) else 0
+                        for a in _args(arr[0])] or [0] if arr and arr[0] is not None else []
                 typ, _len = _type(ts)
                 params.append(ir.Param(name, typ, by_ref, dims))
         attrs = [str(c) for c in ch if isinstance(c, Token) and c.type == "PROCATTR"]
