@@ -296,3 +296,9 @@ def test_bad_input_gives_located_diagnostics(text, rule, col):
 def test_garbage_never_raises(text):
     result = parse(text, "fuzz.nc")
     assert all(d.line >= 1 and d.column >= 1 for d in result.diagnostics)
+
+
+def test_sniff_separates_iso_from_sinumerik():
+    from nctrans.dialects.iso_m import sniff
+    assert min(sniff(read(p)) for p in ISO_FILES) >= 0.9
+    assert max(sniff(read(p)) for p in sorted((CORPUS / "sinumerik").glob("*"))) < 0.5

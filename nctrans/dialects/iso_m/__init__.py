@@ -23,9 +23,10 @@ def emit(program) -> EmitResult:
 
 _ISO_HINTS = re.compile(r"(?im)^\s*(?:%\s*$|[O:]\d+|N\d+\s*G|G0?[0-3]\s*[XYZ]|G\d+G\d+|#\d+\s*=|"
                         r"IF\s*\[|WHILE\s*\[|G(?:28|43|54|80|81|83|90|91)\b|M(?:0?6|30|98|99)\b)")
-_OTHER_HINTS = re.compile(r"(?im)^\s*(?:N\d+\s+)?(?:DEF\s|PROC\s|MCALL|CYCLE\d|ENDIF|ENDWHILE|"
-                          r"ENDLOOP|GOTO[FB]\s|R\d+\s*=|\$[A-Z]{2}_|TRANS\s|ROT\s|O\d+\s+(?:sub|call|if|while|endsub)\b|"
-                          r"#<|%_N_|G(?:500|64[0-9]|7[01]\b)|M17\b)")
+_OTHER_HINTS = re.compile(r"(?im)(?:^\s*(?:N\d+\s+)?(?:DEF\s|DEFINE\s|PROC\s|MCALL|CYCLE\d|ENDIF|ENDWHILE|"
+                          r"ENDLOOP|ENDFOR|STOPRE|O\d+\s+(?:sub|call|if|while|endsub)\b|#<|%_N_)|^\s*;|"
+                          r"\bR\d+\s*=|GOTO[FB]\b|\$[A-Z]{2}_|\b(?:SIN|COS|TAN|SQRT|ABS|TRUNC|ROUND)\(|"
+                          r"\bMSG\s*\(|\b[XYZ]\s*=\s*[A-Z(]|\bG(?:500|64[0-9])\b|\bM17\b)")
 
 
 def sniff(text: str) -> float:
