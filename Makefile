@@ -26,7 +26,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/bench.py
 
 fuzz: $(STAMP)
-	$(BIN)/python -m pytest -q -p no:cacheprovider tests/fuzz --hypothesis-profile=fuzz
+	NCTRANS_FUZZ_PROFILE_SET=1 $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 tests/fuzz --hypothesis-profile=fuzz
 
 clean:
 	rm -rf $(VENV) build *.egg-info
