@@ -50,6 +50,7 @@ _ISO_CYCLES = {"drill": "CYCLE81", "drill_dwell": "CYCLE82", "bore_feed_out": "C
                "bore_dwell_feed_out": "CYCLE89"}
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
+_AMBIGUOUS = re.compile(r"^[A-Za-z](?:\d\w*)?$")
 
 
 def _fmt(v: float) -> str:
@@ -147,15 +148,21 @@ class Emitter:
         self.refuse(f"expression {type(e).__name__} cannot be written")
         return "0"
 
+    def arg(self, e) -> str:
+        """An element of an argument or index list: a name such as X or C1 stands bare there."""
+        if isinstance(e, ir.Var) and e.space == "name" and not e.indices:
+            return str(e.key)
+        return self.expr(e)
+
     def args(self, args) -> str:
-        return ", ".join(self.expr(a) for a in args).replace(", ,", ",,")
+        return ", ".join(self.arg(a) for a in args).replace(", ,", ",,")
 
     def func(self, f: ir.Func) -> str:
         name, a = f.name, f.args
         if name == "frame_chain":
             return ":".join(self.expr(x) for x in a)
         if name == "LIST":
-            return "(" + ",".join(self.expr(x) for x in a) + ")"
+            return "(" + ",".join(self.arg(x) for x in a) + ")"
         if name == "pow":
             if len(a) == 2 and isinstance(a[1], ir.Num) and a[1].value == 2:
                 return f"POT({self.expr(a[0])})"
@@ -177,10 +184,12 @@ class Emitter:
             return f"{name.upper()}({self.args(a)})"
         return f"{name}({self.args(a)})"
 
-    def var(self, v: ir.Var) -> str:
-        idx = "[" + ", ".join(self.expr(i) for i in v.indices) + "]" if v.indices else ""
+    def var(self, v: ir.Var, target: bool = False) -> str:
+        idx = "[" + ", ".join(self.arg(i) for i in v.indices) + "]" if v.indices else ""
         if v.space == "R":
             return f"R{v.key}" if v.key is not None else f"R{idx}"
+        if v.space == "name" and not idx and not target and _AMBIGUOUS.match(str(v.key)):
+            return f"({v.key})"        # C or R1R2 alone would read back as address words
         if v.space in ("name", "system"):
             return f"{v.key}{idx}"
         if v.space == "num":
@@ -277,7 +286,9 @@ class Emitter:
             else:
                 self.info("H", "length offset H dropped: Sinumerik takes the length from the D edge")
         elif isinstance(s, ir.Dwell):
-            if s.revolutions is not None:
+            if s.revolutions is None and s.seconds is None:
+                out.alone("G4")
+            elif s.revolutions is not None:
                 out.alone("G4 " + self.word("S", s.revolutions))
             else:
                 out.alone("G4 " + self.word("F", s.seconds if s.seconds is not None else ir.Num(0.0)))
@@ -314,11 +325,11 @@ class Emitter:
         elif isinstance(s, ir.Stop):
             out.words.append("M1" if s.optional else "M0")
         elif isinstance(s, ir.Assign):
-            out.words.append(f"{self.var(s.target)}={self.expr(s.value)}")
+            out.words.append(f"{self.var(s.target, target=True)}={self.expr(s.value)}")
         elif isinstance(s, ir.VarDecl):
             out.alone(self.vardecl([s]))
         elif isinstance(s, ir.Goto):
-            tgt = "N" + s.target if s.target.isdigit() else s.target
+            tgt = "N" + s.target if s.target.isascii() and s.target.isdigit() else s.target
             kw = _GOTO.get(s.direction, "GOTO")
             if s.cond is not None:
                 out.alone(f"IF {self.expr(s.cond)} {kw} {tgt}")
@@ -330,8 +341,8 @@ class Emitter:
             extra = f", {self.expr(s.text)}" if s.text is not None else ""
             out.words.append(f"SETAL({self.expr(s.number)}{extra})")
         elif isinstance(s, ir.Passthrough):
-            if s.dialect in (DIALECT, ""):
-                out.words.append(s.text)
+            if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
+                out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
             elif re.fullmatch(r"(?:[A-Z][-+]?\d+(?:\.\d*)?\s*)+", s.text.strip().upper()):
                 self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
                                           f"{s.text} ({s.reason})", self.span))
@@ -472,7 +483,7 @@ class Emitter:
     def subcall(self, c: ir.SubCall, out: "_Line") -> None:
         name = c.name
         m = _SUB_NUM.match(name)
-        if m:
+        if m and self.p.dialect != DIALECT:
             name = "L" + m.group(1)
         pre = []
         if c.bindings:
@@ -512,7 +523,7 @@ class Emitter:
                 s += "[" + ",".join(str(x) if x else "" for x in d.dims) + "]"
             if d.init:
                 if d.type == "AXIS" and len(d.init) == 1:
-                    s += "=(" + self.expr(d.init[0]) + ")"
+                    s += "=(" + self.arg(d.init[0]) + ")"
                 elif len(d.init) == 1 and not (d.dims and not isinstance(d.init[0], ir.Func)):
                     s += "=" + self.expr(d.init[0])
                 else:
@@ -525,7 +536,7 @@ class Emitter:
         self.span = b.span
         decls = [s for s in b.body if isinstance(s, ir.VarDecl)]
         rest = [s for s in b.body if not isinstance(s, ir.VarDecl)]
-        line = _Line(only=len(rest) == 1)
+        line = _Line(only=len(rest) == 1, join=self.p.dialect == DIALECT)
         groups: list[list] = []
         for d in decls:
             if groups and (groups[-1][0].type, groups[-1][0].length, groups[-1][0].scope) == (
@@ -622,7 +633,7 @@ class Emitter:
                 self.refuse(f"{type(n).__name__} cannot be written")
 
     def for_loop(self, n: ir.ForLoop, ind: str) -> None:
-        var = self.var(n.var)
+        var = self.var(n.var, target=True)
         step_one = n.step is None or (isinstance(n.step, ir.Num) and n.step.value == 1)
         if step_one and n.var.space == "name":
             self.lines.append(f"{ind}FOR {var}={self.expr(n.start)} TO {self.expr(n.end)}")
@@ -668,12 +679,15 @@ class Emitter:
             self.lines.append(f";$PATH={meta['path']}")
         self.unit(p.body)
         entry = meta.get("entry")
+        headers = meta.get("unit_headers", {})
         for name, sub in p.subprograms.items():
             sname = name
             m = _SUB_NUM.match(name)
-            if m:
+            if m and p.dialect != DIALECT:
                 sname = "L" + m.group(1)
-            if name != entry:
+            if name in headers and not re.match(r"_N_\w+_(?:MPF|SPF)$", headers[name], re.I):
+                self.lines.append(f"%{headers[name]}")          # a member header kept as written
+            elif name != entry:
                 self.lines.append(f"%_N_{sname}_SPF")
             params = []
             for prm in sub.params:
@@ -682,7 +696,8 @@ class Emitter:
             head = f"PROC {sname}" + (f"({', '.join(params)})" if params else "")
             if getattr(sub, "attrs", None):
                 head += " " + " ".join(sub.attrs)
-            self.lines.append(head)
+            if name not in meta.get("members_without_proc", []):
+                self.lines.append(head)
             self.st = _State()
             self.unit(sub.body)
         return "\n".join(self.lines) + "\n"
@@ -695,7 +710,8 @@ def _mode_switch(b: ir.Block, reason: str) -> bool:
 class _Line:
     """Words of one output block; statements that must stand alone start their own lines."""
 
-    def __init__(self, only: bool = False):
+    def __init__(self, only: bool = False, join: bool = False):
+        self.join = join               # Sinumerik-origin blocks stay one block (round trip)
         self.words: list[str] = []
         self.done: list[str] = []
         self.only = only
@@ -703,6 +719,9 @@ class _Line:
 
     def alone(self, text: str) -> None:
         if not text:
+            return
+        if self.join and not text.startswith(("IF ", "DEF ")):
+            self.words.append(text)
             return
         if self.words:
             self.done.append(" ".join(self.words))

@@ -185,12 +185,12 @@ def expr(t) -> Optional[ir.Expr]:
         return ir.Var("R", int(str(ch[0])[1:]))
     if d == "name":
         name = str(ch[0])
-        idx = _args(ch[2]) if len(ch) > 1 and ch[2] is not None else None
+        idx = _index(ch[2]) if len(ch) > 1 and ch[2] is not None else None
         if name == "R" and idx:
             return ir.Var("R", None, idx)
         return ir.Var("name", name, idx)
     if d == "sysvar":
-        idx = _args(ch[2]) if len(ch) > 1 and ch[2] is not None else None
+        idx = _index(ch[2]) if len(ch) > 1 and ch[2] is not None else None
         return ir.Var("system", str(ch[0]), idx)
     if d == "func":
         return func(str(ch[0]), _args(ch[2]))
@@ -232,6 +232,11 @@ def _args(t) -> list[ir.Expr]:
     args = [expr(a.children[0]) if a.children and a.children[0] is not None else omitted()
             for a in t.children if isinstance(a, Tree)]
     return [] if len(args) == 1 and is_omitted(args[0]) else args
+
+
+def _index(t) -> list[ir.Expr]:
+    """Subscripts of A[...]; an empty `A[]` keeps one omitted subscript so it is written back."""
+    return _args(t) or [omitted()]
 
 
 def func(name: str, args: list) -> ir.Expr:
@@ -502,7 +507,9 @@ class Lowerer:
             d = st.data
             ch = st.children
             text = (lambda c=code, t=st: _slice(c, t))
-            if d == "word":
+            if d == "rword":           # R5 standing alone: an address word, not an assignment
+                self.address("R", ir.Num(float(str(ch[0])[1:]), str(ch[0])[1:]), w, text)
+            elif d == "word":
                 if ch[1] is None:
                     w.out.append(ir.Passthrough(_t(text), "address without value", DIALECT))
                 else:
@@ -518,15 +525,15 @@ class Lowerer:
                 if lt.type == "RPARAM":
                     w.out.append(ir.Assign(ir.Var("R", int(str(lt)[1:])), value))
                 elif lt.type == "SYSVAR":
-                    w.out.append(ir.Assign(ir.Var("system", str(lt), _args(idx) if idx else None), value))
+                    w.out.append(ir.Assign(ir.Var("system", str(lt), _index(idx) if idx else None), value))
                 elif idx is not None:
                     name = str(lt)
                     if name in self.pass_words:
                         w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
                     elif name == "R":
-                        w.out.append(ir.Assign(ir.Var("R", None, _args(idx)), value))
+                        w.out.append(ir.Assign(ir.Var("R", None, _index(idx)), value))
                     else:
-                        w.out.append(ir.Assign(ir.Var("name", name, _args(idx)), value))
+                        w.out.append(ir.Assign(ir.Var("name", name, _index(idx)), value))
                 else:
                     self.named(str(lt), value, w, text)
             elif d == "call_name":
@@ -761,7 +768,7 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
             um = _UNIT_NAME.match(name)
             if seen_code or units[-1].pre or units[-1].proc:
                 units.append(_Unit(um.group(1).upper() if um else name.upper()))
-                units[-1].header = name
+                meta.setdefault("unit_headers", {})[units[-1].name] = name
             else:
                 meta["header"] = name
                 if um:
@@ -877,6 +884,7 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
                 sub.body = unit.pre + sub.body
             elif unit.proc is None:
                 sub.body = unit.pre
+                meta.setdefault("members_without_proc", []).append(sub.name)
             prog.subprograms[sub.name] = sub
     if not src.text.strip():
         pass
@@ -916,7 +924,7 @@ def _expand(code: str, macros: dict[str, str]) -> str:
             inq = not inq
             i += 1
             continue
-        if not inq and (ch.isalpha() or ch == "_"):
+        if not inq and ch.isascii() and (ch.isalpha() or ch == "_"):
             m = _WORD_RE.match(code, i)
             w = m.group().upper()
             if w in macros:
@@ -987,6 +995,11 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
             unit.root.append(ir.Block(span, [], None, line.label, None, line.comment))
         return
     ctrl = d in _KW or (d == "if_stmt")
+    decls = [st for st in stmts if st.data == "def_stmt"]
+    if decls and len(decls) != len(stmts):
+        low.error("NC002", "DEF must stand in its own block", line.lineno, line.col)
+        unit.current.append(_passthrough_block(file, line, line.code, "syntax error"))
+        return
     if not ctrl:
         for st in stmts[1:]:
             if st.data in _KW:

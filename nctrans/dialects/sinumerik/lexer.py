@@ -31,6 +31,8 @@ for _k in ("SAVE", "DISPLOF", "SBLOF"):
 for _k in ("TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR"):
     KEYWORDS[_k] = "FRAMEOP"
 
+_DIGITS = frozenset("0123456789")
+_LETTERS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz_")
 _NUMBER = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?", re.IGNORECASE)
 _SIGNED = re.compile(r"\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?", re.IGNORECASE)
 _WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -112,12 +114,12 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
             yield tok("STR", text[i + 1:j], i, j + 1)
             i = j + 1
             continue
-        if ch.isdigit() or (ch == "." and i + 1 < n and text[i + 1].isdigit()):
+        if ch in _DIGITS or (ch == "." and i + 1 < n and text[i + 1] in _DIGITS):
             m = _NUMBER.match(text, i)
             yield tok("NUMBER", m.group(), i, m.end())
             i = m.end()
             continue
-        if ch.isalpha() or ch == "_":
+        if ch in _LETTERS:
             m = _WORD.match(text, i)
             word, end = m.group(), m.end()
             upper = word.upper()
@@ -143,7 +145,7 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
                 yield tok("IDENT", upper, i, end)
                 i = end
                 continue
-            if len(word) > 1 and word[1].isdigit() and word[0].isalpha():
+            if len(word) > 1 and word[1] in _DIGITS and word[0] in _LETTERS and word[0] != "_":
                 # glued address words: G0X.. / R1 / X100 / g18g500
                 letter = upper[0]
                 m2 = _NUMBER.match(text, i + 1)
