@@ -174,7 +174,7 @@ def test_for_loop_with_step_becomes_while():
     loop = ir.ForLoop(ir.Span("x", 1), ir.Var("name", "I"), ir.Num(0.0), ir.Num(10.0),
                       [block(ir.Motion({"X": ir.AxisValue(ir.Var("name", "I"))}))], step=ir.Num(2.0))
     text = emit(ir.Program("x", "pnc", [loop])).text
-    assert text.splitlines() == ["I=0", "WHILE I<=10", "  X=I", "  I=I+2", "ENDWHILE"]
+    assert text.splitlines() == ["I=0", "WHILE I<=10", "  X=(I)", "  I=I+2", "ENDWHILE"]
 
 
 # --------------------------------------------------------------------------- generated programs
