@@ -1,0 +1,404 @@
+"""`convert --flatten`: an IR Program of plain motion only, for controllers and tools without macros.
+
+The interpreter already knows what a program does, so flattening is running it and writing its
+toolpath records back as IR blocks (the interpreter's `flatten_hook` sees every record just before
+it is yielded). Loops are unrolled, calls and cycles expanded, expressions evaluated, programmable
+frames and local offsets folded into coordinates, because the records hold their results.
+
+What the output keeps, so the target machine's own data still applies:
+- the work offset selection (G54..G59, G54.1Pn) as a modal code. Coordinates are written as
+  `machine point - (offset of that selection in the given machine model) - (tool length)`; so the
+  flattened program reproduces the source's machine positions exactly on the same machine model,
+  and on the real target its own offset registers apply as they would to the source.
+  The hook's work points are not used for this because they exclude G92/G52 and reflect G10 writes
+  the target's registers do not have; taking the difference from the machine point folds G92, G52,
+  G10 and G53/G28 moves into coordinates with one rule. A source with no work offset active
+  (Sinumerik G500/G53) is written under G54 relative to the model's G54 values (NC401 says so).
+- tool length compensation (G43 H.. as ModeChange tool_length + OffsetSelect length) when the source
+  had it active, so the target's tool-length registers apply. Negative compensation (G44, which
+  LinuxCNC lacks) is folded into coordinates instead (NC401).
+- tool changes, spindle speed and direction, coolant, dwells, stops, feeds and feed mode.
+Cutter radius compensation is folded: the tool-centre path is written with compensation off.
+
+Arcs are written with incremental centre words I/J/K computed from the point the target actually
+starts from (the previous written, rounded end), so the arc the target computes has the source's
+centre within the rounding of DECIMALS. Every block's span is the source line that caused the
+motion, so diagnostics and `equiv` point back to the source.
+
+Reporting: each kind of lowering present in the program (static walk of the program, its
+subprograms and every file the resolver loads) is one NC401 info at its first source line.
+Constructs the interpreter does not model (IR Passthrough) cannot be placed in the flattened
+stream: M functions are dropped with NC403 (warning), constructs known to have no effect on motion
+with NC401, anything else with NC402 (error), each at its line. An unresolved call (NC103) or a
+truncated run (step budget) makes the flattened program incomplete: NC402.
+"""
+from __future__ import annotations
+
+import dataclasses
+import re
+from typing import Any, Callable, Optional
+
+from nctrans.diagnostics import Diagnostic, at_span
+from nctrans.interp.interpreter import Interpreter
+from nctrans.interp.frames import PLANE_AXES
+from nctrans.ir import nodes as n
+from nctrans.toolpath import ToolpathRecord
+
+DECIMALS = 6                        # mm / degrees written: 1 nm, far under any controller's resolution
+_EPS = 0.5 * 10 ** -DECIMALS
+ISO_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
+CENTRE_WORD = {"X": "I", "Y": "J", "Z": "K"}
+STRUCTURE = (n.If, n.While, n.ForLoop, n.Loop, n.RepeatUntil, n.Case)
+
+# Passthrough reasons (front ends' words) for constructs with no effect on the programmed path
+NO_MOTION_EFFECT = frozenset((
+    "ISO dialect mode", "Siemens mode", "directive", "preprocessing stop", "data attribute",
+    "macro definition", "declaration", "feedforward", "program attribute",
+))
+_M_FUNCTION = re.compile(r"^\s*(?:M\d+(?:\.\d+)?(?:\s*=\s*\d+)?\s*)+$", re.IGNORECASE)
+
+# kinds of lowering: key -> message (one NC401 each, at the first source line where it applies)
+LOWERINGS = {
+    "loop": "loops unrolled",
+    "branch": "conditions and jumps resolved",
+    "call": "subprogram calls expanded",
+    "cycle": "canned cycles expanded into motion",
+    "frame": "programmable frames and local offsets folded into coordinates",
+    "expr": "expressions and variables evaluated",
+    "arcform": "radius, 3-point, tangential, polar and opening-angle arcs written as centre arcs",
+    "units": "inch input written in mm",
+    "comp": "cutter radius compensation folded: the tool-centre path is written with "
+            "compensation off",
+    "message": "messages left out",
+}
+
+
+def _r(v: float) -> float:
+    v = round(v, DECIMALS)
+    return 0.0 if v == 0 else v
+
+
+def _num(v: float) -> n.Num:
+    return n.Num(_r(v))
+
+
+def _is_expr(e: Any) -> bool:
+    """True for any expression that is not a literal number (so evaluating it is a lowering)."""
+    return isinstance(e, (n.Var, n.Unary, n.Binary, n.Func, n.Str))
+
+
+def _has_expr(obj: Any) -> bool:
+    if _is_expr(obj):
+        return True
+    if isinstance(obj, n.AxisValue):
+        return _is_expr(obj.value)
+    if isinstance(obj, dict):
+        return any(_has_expr(v) for v in obj.values())
+    if isinstance(obj, (list, tuple)):
+        return any(_has_expr(v) for v in obj)
+    return False
+
+
+class _Walker:
+    """Static scan of the source for the lowerings flattening applies and for dropped constructs."""
+
+    def __init__(self, diags: list[Diagnostic]):
+        self.diags = diags
+        self.first: dict[str, n.Span] = {}
+        self.dropped: set = set()
+        self.seen_programs: set[int] = set()
+
+    def note(self, kind: str, span: Optional[n.Span]) -> None:
+        if kind not in self.first and span is not None:
+            self.first[kind] = span
+
+    def program(self, p: n.Program) -> None:
+        if id(p) in self.seen_programs:
+            return
+        self.seen_programs.add(id(p))
+        self.nodes(p.body)
+        for sub in (p.subprograms or {}).values():
+            self.nodes(sub.body)
+
+    def nodes(self, nodes_: list) -> None:
+        for node in nodes_:
+            t = type(node)
+            if t is n.Block:
+                for s in node.body:
+                    self.statement(s, node.span)
+                continue
+            if t in (n.While, n.ForLoop, n.Loop, n.RepeatUntil):
+                self.note("loop", node.span)
+                if t is not n.Loop:
+                    self.note("expr", node.span)
+            else:
+                self.note("branch", node.span)
+                self.note("expr", node.span)
+            for attr in ("then", "orelse", "body"):
+                sub = getattr(node, attr, None)
+                if sub:
+                    self.nodes(sub)
+
+    def statement(self, s, span: n.Span) -> None:
+        t = type(s)
+        if t is n.Goto:
+            self.note("loop" if s.direction == "backward" else "branch", span)
+        elif t is n.SubCall:
+            self.note("call", span)
+        elif t is n.CycleCall or t is n.CycleParams or (t is n.ModeChange and s.group == "cycle"
+                                                         and s.value != "off"):
+            self.note("cycle", span)
+        elif t in (n.FrameOp, n.SetPosition, n.ResetSetPosition, n.DataSetting, n.HomeReturn):
+            self.note("frame", span)
+        elif t is n.Assign or t is n.VarDecl:
+            self.note("expr", span)
+        elif t is n.Message:
+            self.note("message", span)
+        elif t is n.Motion:
+            if s.machine_coords:
+                self.note("frame", span)
+            if s.radius is not None or s.via or s.polar or s.aperture is not None:
+                self.note("arcform", span)
+        elif t is n.ModeChange:
+            if s.group == "units" and s.value == "inch":
+                self.note("units", span)
+            elif s.group == "cutter_comp" and s.value != "off":
+                self.note("comp", span)
+            elif s.group == "motion" and s.value in ("arc_3point", "arc_tangent"):
+                self.note("arcform", span)
+        elif t is n.Passthrough:
+            self.passthrough(s, span)
+            return
+        if "expr" not in self.first and t is not n.Passthrough and dataclasses.is_dataclass(s):
+            if any(_has_expr(getattr(s, f.name)) for f in dataclasses.fields(s)):
+                self.note("expr", span)
+
+    def passthrough(self, s: n.Passthrough, span: n.Span) -> None:
+        key = (span.file, span.line, s.text)
+        if key in self.dropped:
+            return
+        self.dropped.add(key)
+        what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
+        if s.reason in NO_MOTION_EFFECT:
+            self.diags.append(at_span("NC401", "info", f"--flatten leaves out {what}: no effect on "
+                                      "the motion", span))
+        elif _M_FUNCTION.match(s.text):
+            self.diags.append(at_span("NC403", "warning", f"--flatten drops the machine function "
+                                      f"{what}: nctrans does not model it, so it has no place in the "
+                                      "flattened motion; add it by hand if the target needs it", span))
+        else:
+            self.diags.append(at_span("NC402", "error", f"--flatten cannot expand {what}: nctrans "
+                                      "does not model what it does, so the flattened motion would "
+                                      "silently lose it", span))
+
+    def report(self) -> None:
+        for kind, msg in LOWERINGS.items():
+            sp = self.first.get(kind)
+            if sp is not None:
+                self.diags.append(at_span("NC401", "info", f"--flatten: {msg} (first at line "
+                                          f"{sp.line})", sp))
+
+
+class _Flattener:
+    """Turns the interpreter's records into blocks, tracking what the target's modal state is."""
+
+    def __init__(self, program: n.Program, machine, diags: list[Diagnostic]):
+        self.program = program
+        self.machine = machine
+        self.diags = diags
+        self.interp: Optional[Interpreter] = None
+        self.blocks: list[n.Block] = []
+        self.ended = False
+        # the target's modal state as written so far
+        self.sel: Optional[str] = None
+        self.length: tuple[str, Optional[int]] = ("off", None)
+        self.motion: Optional[str] = None
+        self.plane = "XY"
+        self.feed: Optional[float] = None
+        self.feed_mode = "per_min"
+        self.speed: Optional[float] = None
+        self.spindle_dir: Optional[str] = None
+        self.mpos: dict[str, float] = {"X": 0.0, "Y": 0.0, "Z": 0.0}   # target's machine point
+        self.off: dict[str, float] = {}            # target's offsets (work + tool length), mm
+        self.noted: set[str] = set()
+        self._raw: Optional[tuple] = None          # interpreter state the offsets were synced for
+
+    def info_once(self, key: str, message: str, span: n.Span) -> None:
+        if key not in self.noted:
+            self.noted.add(key)
+            self.diags.append(at_span("NC401", "info", message, span))
+
+    def header(self) -> None:
+        span = n.Span(self.program.file, 1)
+        self.blocks.append(n.Block(span, [
+            n.ModeChange("units", "mm"), n.ModeChange("distance", "absolute"),
+            n.ModeChange("plane", "XY"), n.ModeChange("cutter_comp", "off"),
+            n.ModeChange("feed_mode", "per_min"),
+        ], comment="flattened by nctrans: plain motion, mm, absolute"))
+
+    # ------------------------------------------------------------------ offsets
+    def _wanted_offsets(self, span: n.Span) -> tuple[str, tuple[str, Optional[int]]]:
+        st = self.interp.st
+        sel = (st.work_offset or "").upper()
+        if sel not in ISO_OFFSETS and not sel.startswith("G54.1P"):
+            self.info_once("no_offset", f"--flatten: no settable work offset active (here "
+                           f"{st.work_offset or 'none'}): coordinates written under G54, relative "
+                           "to the machine model's G54 values", span)
+            sel = "G54"
+        length: tuple[str, Optional[int]] = ("off", None)
+        if st.length_mode == "plus":
+            idx = st.length_index if st.length_index is not None else st.tool
+            if idx:
+                length = ("plus", int(idx))
+        elif st.length_mode == "minus":
+            self.info_once("g44", "--flatten: negative tool length compensation folded into "
+                           "coordinates (written with length compensation off)", span)
+        return sel, length
+
+    def _sync_offsets(self, body: list, span: n.Span) -> None:
+        st = self.interp.st
+        raw = (st.work_offset, st.length_mode, st.length_index, st.tool)
+        if raw == self._raw:
+            return
+        self._raw = raw
+        sel, length = self._wanted_offsets(span)
+        if sel != self.sel:
+            body.append(n.ModeChange("work_offset", sel))
+            self.sel = sel
+        if length != self.length:
+            if length[0] == "off":
+                body.append(n.ModeChange("tool_length", "off"))
+            else:
+                body.append(n.ModeChange("tool_length", "plus"))
+                body.append(n.OffsetSelect("length", n.Num(float(length[1]))))
+            self.length = length
+        off = {a.upper(): float(v) for a, v in self.machine.work_offset(sel).items()}
+        if length[0] == "plus":
+            off["Z"] = off.get("Z", 0.0) + self.machine.length_offset(length[1])
+        self.off = off
+
+    # ------------------------------------------------------------------ records
+    def hook(self, rec: ToolpathRecord, work_end, work_center) -> None:
+        if self.ended:
+            return
+        span = n.Span(rec.file, rec.line)
+        kind = rec.kind
+        if kind in ("rapid", "linear", "arc"):
+            self.move(rec, span)
+        elif kind == "tool_change":
+            # no tool known (the source's T word failed): the change alone, as the source did
+            body = [] if rec.tool is None else [n.ToolSelect(n.Num(float(rec.tool)))]
+            self.blocks.append(n.Block(span, body + [n.ToolChange()]))
+        elif kind == "spindle":
+            body = []
+            if rec.spindle is not None and rec.spindle != self.speed:
+                body.append(n.SpindleSpeed(_num(rec.spindle)))
+                self.speed = rec.spindle
+            if rec.spindle_dir and rec.spindle_dir != self.spindle_dir:
+                body.append(n.ModeChange("spindle", rec.spindle_dir))
+                self.spindle_dir = rec.spindle_dir
+            if body:
+                self.blocks.append(n.Block(span, body))
+        elif kind == "coolant":
+            self.blocks.append(n.Block(span, [n.ModeChange("coolant", rec.coolant or "off")]))
+        elif kind == "dwell":
+            self.blocks.append(n.Block(span, [n.Dwell(seconds=_num(rec.dwell_s or 0.0))]))
+        elif kind == "stop":
+            if rec.stop_kind == "end":
+                self.blocks.append(n.Block(span, [n.ProgramEnd("end_rewind")]))
+                self.ended = True
+            else:
+                self.blocks.append(n.Block(span, [n.Stop(optional=rec.stop_kind == "optional")]))
+
+    def move(self, rec: ToolpathRecord, span: n.Span) -> None:
+        body: list = []
+        self._sync_offsets(body, span)
+        off = self.off
+        end = rec.end or {}
+        prog_now = {a: v - off.get(a, 0.0) for a, v in self.mpos.items()}
+        target_vals = {a: _r(v - off.get(a, 0.0)) for a, v in end.items()}
+        if rec.kind == "arc":
+            plane = rec.plane or "XY"
+            a1, a2, _ = PLANE_AXES[plane]
+            if plane != self.plane:
+                body.append(n.ModeChange("plane", plane))
+                self.plane = plane
+            motion = "arc_cw" if rec.direction == "cw" else "arc_ccw"
+        else:
+            a1 = a2 = None
+            motion = rec.kind
+        if motion != self.motion:
+            body.append(n.ModeChange("motion", motion))
+            self.motion = motion
+        if rec.kind != "rapid":
+            fm = rec.feed_mode or "per_min"
+            if fm != self.feed_mode:
+                body.append(n.ModeChange("feed_mode", fm))
+                self.feed_mode = fm
+                self.feed = None
+            if rec.feed is not None and (rec.feed != self.feed or fm == "inverse_time"):
+                body.append(n.Feed(_num(rec.feed)))
+                self.feed = rec.feed
+        axes = [a for a, v in target_vals.items()
+                if a in (a1, a2) or a not in prog_now or abs(v - prog_now[a]) > _EPS]
+        if not axes:
+            axes = list(target_vals)
+        motion_stmt = n.Motion({a: n.AxisValue(n.Num(target_vals[a])) for a in axes})
+        if rec.kind == "arc":
+            c = rec.center or {}
+            motion_stmt.center = {CENTRE_WORD[a]: n.AxisValue(_num(c.get(a, 0.0) - self.mpos.get(a, 0.0)))
+                                  for a in (a1, a2)}
+            if rec.turns:
+                motion_stmt.turns = n.Num(float(rec.turns))
+        body.append(motion_stmt)
+        self.blocks.append(n.Block(span, body))
+        # where the target now is: the written (rounded) program point plus its offsets
+        mpos = dict(self.mpos)
+        for a, v in target_vals.items():
+            mpos[a] = v + off.get(a, 0.0)
+        self.mpos = mpos
+
+
+def flatten(program: n.Program, machine=None, *, diagnostics: list,
+            resolver: Optional[Callable] = None, max_steps: Optional[int] = None) -> n.Program:
+    """Plain-motion Program equivalent to `program` on `machine` (default mill); NC4xx diagnostics
+    (and the interpreter's own) are appended to `diagnostics`."""
+    if machine is None:
+        from nctrans.machine import default_mill
+        machine = default_mill()
+    walker = _Walker(diagnostics)
+    walker.program(program)
+
+    wrapped = None
+    if resolver is not None:
+        def wrapped(name, from_file):
+            prog = resolver(name, from_file)
+            if prog is not None:
+                walker.program(prog)
+            return prog
+
+    interp_diags: list[Diagnostic] = []
+    fl = _Flattener(program, machine, diagnostics)
+    fl.header()
+    kwargs = {"diagnostics": interp_diags, "resolver": wrapped, "flatten_hook": fl.hook}
+    if max_steps is not None:
+        kwargs["max_steps"] = max_steps
+    interp = Interpreter(program, machine, **kwargs)
+    fl.interp = interp
+    for _ in interp.run():
+        pass
+    if not fl.ended:
+        last = fl.blocks[-1].span if fl.blocks else n.Span(program.file, 1)
+        fl.blocks.append(n.Block(last, [n.ProgramEnd("end_rewind")]))
+    diagnostics.extend(interp_diags)
+    for d in interp_diags:
+        if d.rule == "NC103" or (d.rule == "NC205" and "budget" in d.message):
+            diagnostics.append(Diagnostic("NC402", "error", f"--flatten output would be incomplete: "
+                                          f"{d.message}", d.file, d.line, d.column, d.end_line,
+                                          d.end_column))
+    walker.report()
+    meta: dict[str, object] = {"flattened_from": program.dialect, "percent": True}
+    defaults = program.meta.get("defaults") if isinstance(program.meta, dict) else None
+    if isinstance(defaults, dict):
+        meta["defaults"] = dict(defaults)
+    return n.Program(program.file, program.dialect, fl.blocks, {}, meta, None)
