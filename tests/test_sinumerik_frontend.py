@@ -294,6 +294,13 @@ def test_execution_order_inside_a_block():
     assert s.index(spindle) < kinds.index("Motion")
 
 
+def test_reference_and_fixed_point_approach():
+    h = first("G74 X1=0 Z1=0", ir.HomeReturn)
+    assert h.ref == 1 and set(h.via) == {"X", "Z"}
+    assert all(v.mode == "inc" and v.value.value == 0 for v in h.via.values())   # no intermediate move
+    assert first("G75 FP=2 Z1=0", ir.HomeReturn).ref == 3
+
+
 def test_dwell_tool_feed_message():
     assert first("G4 F2.5", ir.Dwell).seconds.value == 2.5
     d = first("G4 S10", ir.Dwell)

@@ -343,7 +343,7 @@ class Emitter:
         elif isinstance(s, ir.Passthrough):
             if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
                 out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
-            elif re.fullmatch(r"(?:[A-Z][-+]?\d+(?:\.\d*)?\s*)+", s.text.strip().upper()):
+            elif _reads_as_sinumerik(s.text):
                 self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
                                           f"{s.text} ({s.reason})", self.span))
                 out.words.append(s.text)
@@ -412,12 +412,17 @@ class Emitter:
             out.alone(line)
 
     def home(self, h: ir.HomeReturn, out: "_Line") -> None:
-        self.info("G28", "reference point return written as G0 to the intermediate point, then G74/G75")
-        if h.via:
+        """G74 (ref 1) / G75 FP=ref-1 on the machine axes X1.. ; an ISO intermediate point that
+        moves (not incremental zero) is a G0 block before it."""
+        inc = lambda v: v.mode == "inc" or (v.mode is None and self.st.distance == "incremental")
+        direct = all(inc(v) and isinstance(v.value, ir.Num) and v.value.value == 0
+                     for v in h.via.values())
+        if h.via and not direct:
+            self.info("G28", "reference point return written as G0 to the intermediate point, then G74/G75")
             out.alone("G0 " + " ".join(self.axis(a, v) for a, v in h.via.items()))
         axes = " ".join(f"{a}1=0" for a in (h.via or {"X": 0, "Y": 0, "Z": 0}))
-        out.alone(f"G74 {axes}" if h.ref == 1 else f"G75 FP={h.ref} {axes}")
-        if h.via and self.st.motion != "rapid":
+        out.alone(f"G74 {axes}" if h.ref == 1 else f"G75 FP={h.ref - 1} {axes}")
+        if h.via and not direct and self.st.motion != "rapid":
             r = self.t.code_for("motion", self.st.motion)
             if r:
                 out.alone(r.code)
@@ -480,11 +485,19 @@ class Emitter:
         for _ in range(n):
             out.alone(" ".join(words))
 
-    def subcall(self, c: ir.SubCall, out: "_Line") -> None:
-        name = c.name
+    def subname(self, name: str) -> str:
+        """Sinumerik spelling of a program name: ISO O1000 -> L1000; invalid names are refused."""
         m = _SUB_NUM.match(name)
         if m and self.p.dialect != DIALECT:
-            name = "L" + m.group(1)
+            return "L" + m.group(1)
+        if self.p.dialect != DIALECT and not _NAME_OK.match(name):
+            self.refuse(f"program name {name!r} is not a Sinumerik name")
+            fixed = re.sub(r"\W", "_", name)[:31]
+            return fixed if re.match(r"[A-Za-z_]", fixed) else "_" + fixed[:30]
+        return name
+
+    def subcall(self, c: ir.SubCall, out: "_Line") -> None:
+        name = self.subname(c.name)
         pre = []
         if c.bindings:
             self.info("g65", "macro call arguments passed in R parameters (global: a nested call can "
@@ -670,6 +683,25 @@ class Emitter:
             nodes = nodes[:pre] + hoisted + body
         self.nodes(nodes)
 
+    def prologue(self, source_defaults: dict) -> None:
+        """A program from another dialect relies on that controller's power-on modes (ISO: G0,
+        G80...): where they differ from Sinumerik's (G1, G500...) the first block selects them."""
+        if self.p.dialect == DIALECT:
+            return
+        mine = self.t.defaults()
+        codes = []
+        for group, value in source_defaults.items():
+            if group in ("cycle", "cycle_retract", "tool_length") or mine.get(group) == value:
+                continue
+            rule = self.t.code_for(group, value)
+            if rule is not None:
+                codes.append(rule.code)
+                if group == "motion":
+                    self.st.motion = value
+        if codes:
+            self.info("defaults", f"power-on modes of {self.p.dialect} written out: {' '.join(codes)}")
+            self.lines.append(" ".join(codes))
+
     def program(self) -> str:
         p = self.p
         meta = p.meta or {}
@@ -677,14 +709,13 @@ class Emitter:
             self.lines.append(f"%{meta['header']}")
         if meta.get("path"):
             self.lines.append(f";$PATH={meta['path']}")
+        self.prologue(meta.get("defaults") or {})
         self.unit(p.body)
         entry = meta.get("entry")
         headers = meta.get("unit_headers", {})
         for name, sub in p.subprograms.items():
-            sname = name
-            m = _SUB_NUM.match(name)
-            if m and p.dialect != DIALECT:
-                sname = "L" + m.group(1)
+            self.span = sub.span
+            sname = self.subname(name)
             if name in headers and not re.match(r"_N_\w+_(?:MPF|SPF)$", headers[name], re.I):
                 self.lines.append(f"%{headers[name]}")          # a member header kept as written
             elif name != entry:
@@ -701,6 +732,20 @@ class Emitter:
             self.st = _State()
             self.unit(sub.body)
         return "\n".join(self.lines) + "\n"
+
+
+def _reads_as_sinumerik(text: str) -> bool:
+    """Foreign text is kept verbatim (NC403) only when it is also a valid Sinumerik block."""
+    from nctrans.dialects.sinumerik.frontend import parse
+    if not text.strip() or "\n" in text or ";" in text:
+        return False
+    res = parse(text, "<passthrough>")
+    return not res.diagnostics and all(
+        not isinstance(s, ir.Passthrough) or s.reason != "syntax error"
+        for b in res.program.body if isinstance(b, ir.Block) for s in b.body)
+
+
+_NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z_0-9]{0,30}$")
 
 
 def _mode_switch(b: ir.Block, reason: str) -> bool:

@@ -304,6 +304,8 @@ class _Words:
     repeat: Optional[ir.Expr] = None
     dwell: bool = False
     machine: bool = False
+    home: Optional[str] = None          # G74 / G75
+    fixed_point: Optional[ir.Expr] = None
     frame: Optional[str] = None
 
 
@@ -356,6 +358,8 @@ class Lowerer:
             w.machine = True
         elif g == "frame":
             w.frame = rule.value
+        elif g == "home":
+            w.home = rule.code
         else:
             w.out.append(ir.Passthrough(_t(text), g, DIALECT))
 
@@ -417,6 +421,8 @@ class Lowerer:
             w.turns = value
         elif name == "RPL":
             w.rpl = value
+        elif name == "FP":
+            w.fixed_point = value
         elif name == "F":
             w.feed = value
         elif name == "S" or re.fullmatch(r"S\d+", name):
@@ -472,6 +478,20 @@ class Lowerer:
             kind = "mcall"
         w.out.append(ir.SubCall(name, list(args or []), modal="after_move" if modal else "none",
                                 kind=kind))
+
+    def home(self, w: _Words) -> None:
+        """G74 X1=0 Z1=0 / G75 FP=n ...: the named axes go straight to the reference (fixed)
+        point, i.e. ISO G28 with an incremental-zero intermediate point (HomeReturn)."""
+        via = {}
+        for name in w.target:
+            axis = name[:-1] if name.endswith("1") and name[:-1] in self.axes else name
+            via[axis] = ir.AxisValue(ir.Num(0.0, "0"), "inc")
+        w.target.clear()
+        ref = 1
+        if w.home == "G75":
+            fp = w.fixed_point
+            ref = 1 + (int(fp.value) if isinstance(fp, ir.Num) else 1)
+        w.out.append(ir.HomeReturn(ref, via))
 
     def frame_op(self, w: _Words) -> None:
         op = w.frame
@@ -591,6 +611,8 @@ class Lowerer:
         # frame instructions take the block's axis words as their values
         if w.frame:
             self.frame_op(w)
+        if w.home:
+            self.home(w)
         if w.dwell:
             secs = w.feed
             revs = w.speed[0][1] if w.speed else None
