@@ -913,20 +913,22 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
     return ParseResult(prog, diags)
 
 
+_NUM_RE = r"(?:\d+\.?\d*|\.\d+)(?:[Ee][Xx][+-]?\d+)?"
+_PLAIN = re.compile(rf"(?:\s*[A-Za-z]\s*[+-]?{_NUM_RE}(?![A-Za-z_]))+\s*")
+_PAIR = re.compile(rf"([A-Za-z])\s*([+-]?{_NUM_RE})")
+
+
 def _plain_words(code: str) -> Optional[list]:
-    """Blocks made only of `X10 G1 F100` words, as word trees without running the parser."""
-    try:
-        toks = list(tokenize(code))
-    except LexError:
-        return None
-    if not toks or len(toks) % 2:
+    """Blocks made only of `X10 G1 F100` words (the bulk of real programs), as word trees built
+    without the lexer and parser; anything else returns None and takes the full path."""
+    if not _PLAIN.fullmatch(code):
         return None
     out = []
-    for i in range(0, len(toks), 2):
-        a, b = toks[i], toks[i + 1]
-        if a.type != "ADDR" or b.type != "NUMBER":
-            return None
-        out.append(Tree("word", [a, b]))
+    for m in _PAIR.finditer(code):
+        letter = m.group(1).upper()
+        a0, n0, n1 = m.start(1), m.start(2), m.end(2)
+        out.append(Tree("word", [Token("ADDR", letter, a0, 1, a0 + 1, 1, a0 + 2, a0 + 1),
+                                 Token("NUMBER", m.group(2), n0, 1, n0 + 1, 1, n1 + 1, n1)]))
     return out
 
 
