@@ -88,6 +88,7 @@ class Emitter:
         self.fn = {v: k for k, v in self.t.options.get("functions", {}).items()}
         self.axes = set(self.t.options.get("axes", []))
         self.span: Optional[ir.Span] = None
+        self.pending = None
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -614,45 +615,61 @@ class Emitter:
                     self.lines.extend(ind + l for l in text.split("\n"))
                     i = j
                 continue
+            if isinstance(n, ir.Block) and _deco(n) and i < len(ns) and isinstance(ns[i], _STRUCT):
+                self.pending = _deco(n)          # "N30 FOR ..." / "IF ... ; comment" on one line
+                continue
             if isinstance(n, ir.Block):
                 self.block(n, ind)
-            elif isinstance(n, ir.If):
-                self.lines.append(f"{ind}IF {self.expr(n.cond)}")
-                self.nodes(n.then, ind + "  ")
+                continue
+            deco, self.pending = self.pending, None
+            if isinstance(n, ir.If):
+                self.ctl(ind, f"IF {self.expr(n.cond)}", deco)
+                close = self.body(n.then, ind)
                 if n.orelse:
-                    self.lines.append(f"{ind}ELSE")
-                    self.nodes(n.orelse, ind + "  ")
-                self.lines.append(f"{ind}ENDIF")
+                    self.ctl(ind, "ELSE", close)
+                    close = self.body(n.orelse, ind)
+                self.ctl(ind, "ENDIF", close)
             elif isinstance(n, ir.While):
-                self.lines.append(f"{ind}WHILE {self.expr(n.cond)}")
-                self.nodes(n.body, ind + "  ")
-                self.lines.append(f"{ind}ENDWHILE")
+                self.ctl(ind, f"WHILE {self.expr(n.cond)}", deco)
+                self.ctl(ind, "ENDWHILE", self.body(n.body, ind))
             elif isinstance(n, ir.ForLoop):
-                self.for_loop(n, ind)
+                self.for_loop(n, ind, deco)
             elif isinstance(n, ir.Loop):
-                self.lines.append(f"{ind}LOOP")
-                self.nodes(n.body, ind + "  ")
-                self.lines.append(f"{ind}ENDLOOP")
+                self.ctl(ind, "LOOP", deco)
+                self.ctl(ind, "ENDLOOP", self.body(n.body, ind))
             elif isinstance(n, ir.RepeatUntil):
-                self.lines.append(f"{ind}REPEAT")
-                self.nodes(n.body, ind + "  ")
-                self.lines.append(f"{ind}UNTIL {self.expr(n.cond)}")
+                self.ctl(ind, "REPEAT", deco)
+                self.ctl(ind, f"UNTIL {self.expr(n.cond)}", self.body(n.body, ind))
             elif isinstance(n, ir.Case):
                 parts = [f"{self.expr(v)} GOTOF {t}" for v, t in n.branches]
                 if n.default:
                     parts.append(f"DEFAULT GOTOF {n.default}")
-                self.lines.append(f"{ind}CASE {self.expr(n.subject)} OF " + " ".join(parts))
+                self.ctl(ind, f"CASE {self.expr(n.subject)} OF " + " ".join(parts), deco)
             else:
                 self.refuse(f"{type(n).__name__} cannot be written")
 
-    def for_loop(self, n: ir.ForLoop, ind: str) -> None:
+    def ctl(self, ind: str, text: str, deco) -> None:
+        """A control-structure line, with the block number / comment of its source line."""
+        pre, post = deco or ("", "")
+        self.lines.append(f"{ind}{pre}{text}{post}")
+
+    def body(self, ns: list, ind: str):
+        """Emit a structure body; a trailing number/comment-only block goes on the closing line."""
+        if ns and isinstance(ns[-1], ir.Block) and _deco(ns[-1]):
+            self.nodes(ns[:-1], ind + "  ")
+            return _deco(ns[-1])
+        self.nodes(ns, ind + "  ")
+        return None
+
+    def for_loop(self, n: ir.ForLoop, ind: str, deco=None) -> None:
         var = self.var(n.var, target=True)
         step_one = n.step is None or (isinstance(n.step, ir.Num) and n.step.value == 1)
         if step_one and n.var.space == "name":
-            self.lines.append(f"{ind}FOR {var}={self.expr(n.start)} TO {self.expr(n.end)}")
-            self.nodes(n.body, ind + "  ")
-            self.lines.append(f"{ind}ENDFOR")
+            self.ctl(ind, f"FOR {var}={self.expr(n.start)} TO {self.expr(n.end)}", deco)
+            self.ctl(ind, "ENDFOR", self.body(n.body, ind))
             return
+        if deco:
+            self.ctl(ind, "", deco)
         self.info("for", "counting loop with a step or a non-INT variable written as WHILE")
         step = n.step if n.step is not None else ir.Num(1.0)
         down = isinstance(step, ir.Num) and step.value < 0
@@ -746,6 +763,17 @@ def _reads_as_sinumerik(text: str) -> bool:
 
 
 _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z_0-9]{0,30}$")
+
+
+_STRUCT = (ir.If, ir.While, ir.ForLoop, ir.Loop, ir.RepeatUntil, ir.Case)
+
+
+def _deco(b: ir.Block):
+    """(prefix, suffix) when a block holds only a block number and/or a comment."""
+    if b.body or b.label or b.skip is not None or (b.number is None and b.comment is None):
+        return None
+    return (f"N{b.number} " if b.number is not None else "",
+            f" ;{b.comment}" if b.comment is not None else "")
 
 
 def _mode_switch(b: ir.Block, reason: str) -> bool:

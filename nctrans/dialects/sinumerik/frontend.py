@@ -1033,18 +1033,20 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
         body = low.statements(stmts, line)
         unit.current.append(ir.Block(span, body, line.number, line.label, line.skip, line.comment))
         return
+    ch = head.children
+    rest = stmts[1:]
+    if d == "if_stmt" and ch[2] is not None:       # IF cond GOTOF label: a plain block
+        cond = expr(ch[1])
+        unit.current.append(ir.Block(span, [_goto(ch[2], ch[3], cond)], line.number, line.label,
+                                     line.skip, line.comment))
+        if rest:
+            low.error("NC002", "statement after the jump target", line.lineno, line.col)
+        return
     # control structures: a label/number/comment on the line is kept in an empty block before it
     if line.label or line.number or line.comment:
         unit.current.append(ir.Block(span, [], line.number, line.label, line.skip, line.comment))
-    ch = head.children
-    rest = stmts[1:]
     if d == "if_stmt":
         cond = expr(ch[1])
-        if ch[2] is not None:
-            unit.current.append(ir.Block(span, [_goto(ch[2], ch[3], cond)], None, None, line.skip))
-            if rest:
-                low.error("NC002", "statement after the jump target", line.lineno, line.col)
-            return
         node = ir.If(span, cond, [])
         if rest:          # IF cond stmt... in one block: a one-block conditional
             node.then.append(ir.Block(span, low.statements(rest, line)))
