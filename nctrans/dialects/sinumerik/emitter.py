@@ -404,7 +404,8 @@ class Emitter:
             self.refuse(f"frame operation {f.op!r} cannot be written")
             return
         if f.op == "rot" and f.angle is not None:
-            body = f"{a}ROT RPL={self.expr(f.angle)}"
+            words = " ".join(self.word(k, v) for k, v in f.values.items())
+            body = f"{a}ROT {words} RPL={self.expr(f.angle)}".replace("  ", " ")
         elif f.op == "mirror":
             body = f"{a}MIRROR " + " ".join(f"{k}0" for k in f.values)
         else:
@@ -514,6 +515,8 @@ class Emitter:
             text = f'{c.kind.upper()} "{name}"'
         elif c.kind == "pcall":
             text = f"PCALL {name}" + (f"({self.args(c.args)})" if c.args else "")
+        elif re.fullmatch(r"[A-Za-z]\d+", name) and not name.upper().startswith("L"):
+            text = f"{name}({self.args(c.args)})"      # B200() would read back as an axis word
         else:
             text = name + (f"({self.args(c.args)})" if c.args else "")
         if c.modal != "none":

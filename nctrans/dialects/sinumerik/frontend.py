@@ -395,8 +395,6 @@ class Lowerer:
             w.out.append(ir.SubCall("L" + (num.text or str(int(num.value))), kind="l"))
         elif letter == "P":
             w.repeat = num
-        elif letter == "N":
-            pass
         else:
             reason = self.pass_words.get(letter, f"address {letter}")
             w.out.append(ir.Passthrough(_t(text), reason, DIALECT if letter != "H" else ""))
@@ -627,7 +625,7 @@ class Lowerer:
             w.out.append(ir.Motion(dict(w.target), dict(w.center) or None, w.radius, w.turns,
                                    dict(w.via) or None, w.machine, dict(w.polar) or None, w.aperture))
         elif w.rpl is not None:
-            w.out.append(ir.Passthrough("RPL", "plane rotation outside ROT", DIALECT))
+            w.out.append(ir.Passthrough("RPL=" + _expr_text(w.rpl), "plane rotation outside ROT", DIALECT))
         if w.repeat is not None:
             calls = [s for s in w.out if isinstance(s, ir.SubCall)]
             if calls:
