@@ -208,6 +208,23 @@ def constant(expr: Any) -> Optional[float]:
     return None
 
 
+_AXES = "XYZABC"
+# system variable -> first ISO position number it mirrors (work / machine coordinates)
+_AXIS_POSITION_VARS = {"$P_EP": 5001, "$AA_IW": 5001, "$P_AXN1": None, "$AA_IM": 5021, "$AA_MW": 5021}
+
+
+def _axis_index(var: n.Var) -> Optional[str]:
+    """The axis named as the only subscript of a system variable ($P_EP[Z]), else None."""
+    if not var.indices or len(var.indices) != 1:
+        return None
+    ix = var.indices[0]
+    if type(ix) is n.Var and ix.space == "name" and not ix.indices:
+        key = str(ix.key).upper()
+        if key in _AXES:
+            return key
+    return None
+
+
 class Evaluator:
     """Variable stores plus the expression compiler. One per interpreter run.
 
@@ -420,6 +437,9 @@ class Evaluator:
             return lambda: self.read_name(name, self._indices(fns) if fns else None)
         if space == "system":
             name = str(var.key).upper()
+            axis = _axis_index(var)
+            if axis is not None:
+                return lambda: self.read_axis_system(name, axis)
             return lambda: self.read_system(name, self._indices(fns) if fns else None)
         if space == "arg":
             key = str(var.key).upper()
@@ -470,6 +490,17 @@ class Evaluator:
                 raise EvalError("NC104", f"array {name} used without an index")
             return v.get(idx)
         return v
+
+    def read_axis_system(self, name: str, axis: str) -> Any:
+        """Axis-indexed position variables (Sinumerik $P_EP[Z], $AA_IW[X], $AA_IM[Y]) read the
+        interpreter's current position, which it publishes as the ISO position numbers (#5001..
+        work coordinates, #5021.. machine coordinates) in program units."""
+        base = _AXIS_POSITION_VARS.get(name)
+        f = self.system.get(base + _AXES.index(axis)) if base is not None and axis in _AXES else None
+        if f is not None:
+            return f()
+        self.unknown_used = True
+        return UNKNOWN
 
     def read_system(self, name: str, idx: Optional[tuple]) -> Any:
         f = self.system.get(name)

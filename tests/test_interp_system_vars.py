@@ -1,0 +1,29 @@
+"""Axis-indexed position variables read the interpreter's position (Sinumerik $P_EP[Z] ...)."""
+from nctrans.dialects.base import get
+from nctrans.interp import interpret
+from nctrans.machine import Machine
+
+
+def _run(text: str, machine=None):
+    program = get("sinumerik").parse(text, "t.mpf").program
+    diags: list = []
+    moves = [r for r in interpret(program, machine, diagnostics=diags) if r.kind in ("rapid", "linear")]
+    return moves, diags
+
+
+def test_programmed_end_point_reads_current_work_position():
+    moves, diags = _run("G0 X1 Y2 Z30\nR1=$P_EP[Z]\nR2=$P_EP[X]\nG1 X=R1+R2 F100\nM30\n")
+    assert not [d for d in diags if d.severity == "error"]
+    assert moves[-1].end["X"] == 31.0
+
+
+def test_machine_position_includes_the_work_offset():
+    machine = Machine(offsets={"G54": {"X": 100.0}})
+    moves, _ = _run("G54 G0 X5\nR1=$AA_IM[X]\nG1 X=R1 F100\nM30\n", machine)
+    # $AA_IM[X] = 105 (machine), programmed as a work coordinate -> machine X 205
+    assert moves[-1].end["X"] == 205.0
+
+
+def test_unknown_axis_system_variable_is_flagged_not_fatal():
+    moves, diags = _run("G0 X1\nR1=$AA_XYZ[X]\nG1 X=R1 F100\nM30\n")
+    assert any(d.rule == "NC107" for d in diags)
