@@ -150,6 +150,10 @@ class _Emitter:
         self.next_label = 90000
         self.used_numbers = set()
         self.depth = 0
+        # distance mode in source order, so a one-block G91 (incremental reference-point
+        # approach from other dialects) can be followed by the G90 that restores it
+        self.distance = "absolute"
+        self.restore_absolute = False
 
     # -------------------------------------------------------------- reporting
     def lowered(self, what: str) -> None:
@@ -286,6 +290,9 @@ class _Emitter:
             if i == len(lines) - 1:
                 text += tail
             self.out.append(text)
+        if self.restore_absolute:
+            self.restore_absolute = False
+            self.out.append("G90")
 
     def s_If(self, node: n.If) -> None:
         then = node.then
@@ -417,6 +424,8 @@ class _Emitter:
         return key, code
 
     def w_ModeChange(self, s: n.ModeChange):
+        if s.group == "distance":
+            self.distance = s.value
         if s.group == "work_offset" and s.value.startswith("G54.1P"):
             return [("G:14", "G54.1"), ("P", "P" + s.value[6:])]
         if s.group == "work_offset" and s.value not in ("G54", "G55", "G56", "G57", "G58", "G59"):
@@ -499,11 +508,24 @@ class _Emitter:
 
     def w_HomeReturn(self, s):
         words = [("G:18", "G28" if s.ref == 1 else "G30")]
+        modes = {av.mode for av in s.via.values()}
+        if modes == {"inc"}:
+            # Sinumerik G74 (approach the reference point directly) arrives as a zero
+            # incremental via point: ISO writes that as G91 G28 and restores G90 after the block.
+            via = {k: n.AxisValue(av.value) for k, av in s.via.items()}
+            if self.distance == "absolute":
+                self.lowered("incremental reference-point approach written as G91 G28 ... then G90")
+                self.restore_absolute = True
+            return [("G:3", "G91")] + words + self._ref_index(s) + self._axes(via)
+        return words + self._ref_index(s) + self._axes(s.via)
+
+    def _ref_index(self, s) -> list:
+        words = []
         if s.ref not in (1, 2) and s.ref_index is None:
             words.append(("P", f"P{s.ref}"))
         if s.ref_index is not None:
             words.append(("P", self.addr("P", s.ref_index)))
-        return words + self._axes(s.via)
+        return words
 
     def w_FrameOp(self, s: n.FrameOp):
         if s.additive:
