@@ -34,6 +34,8 @@ truncated run (step budget) makes the flattened program incomplete: NC402.
 """
 from __future__ import annotations
 
+import math
+
 import dataclasses
 import re
 from typing import Any, Callable, Optional
@@ -311,6 +313,12 @@ class _Flattener:
                 self.blocks.append(n.Block(span, [n.Stop(optional=rec.stop_kind == "optional")]))
 
     def move(self, rec: ToolpathRecord, span: n.Span) -> None:
+        if rec.kind == "arc" and rec.turns:
+            # Extra full turns are spelled differently by every controller (ISO L, LinuxCNC P,
+            # Sinumerik TURN=); plain motion writes them as one full circle per turn instead.
+            for piece in _split_turns(rec):
+                self.move(piece, span)
+            return
         body: list = []
         self._sync_offsets(body, span)
         off = self.off
@@ -357,6 +365,33 @@ class _Flattener:
         for a, v in target_vals.items():
             mpos[a] = v + off.get(a, 0.0)
         self.mpos = mpos
+
+
+def _split_turns(rec: ToolpathRecord) -> list[ToolpathRecord]:
+    """An arc (or helix) with extra full turns as `turns` full circles plus the final part,
+    the axes outside the plane advancing in proportion to the angle swept."""
+    a1, a2, _ = PLANE_AXES[rec.plane or "XY"]
+    start, end, c = rec.start or {}, rec.end or {}, rec.center or {}
+
+    def angle(p):
+        return math.atan2(p.get(a2, 0.0) - c.get(a2, 0.0), p.get(a1, 0.0) - c.get(a1, 0.0))
+
+    sweep = angle(end) - angle(start)
+    if rec.direction == "cw":
+        sweep = -sweep
+    sweep %= 2 * math.pi
+    if sweep < 1e-9:
+        sweep = 2 * math.pi
+    total = sweep + 2 * math.pi * rec.turns
+    pieces, prev = [], dict(start)
+    for k in range(1, rec.turns + 1):
+        f = 2 * math.pi * k / total
+        point = {a: start.get(a, 0.0) + (v - start.get(a, 0.0)) * f for a, v in end.items()}
+        point[a1], point[a2] = start.get(a1, 0.0), start.get(a2, 0.0)
+        pieces.append(dataclasses.replace(rec, start=prev, end=point, turns=0))
+        prev = point
+    pieces.append(dataclasses.replace(rec, start=prev, end=dict(end), turns=0))
+    return pieces
 
 
 def flatten(program: n.Program, machine=None, *, diagnostics: list,
