@@ -367,6 +367,11 @@ class _Flattener:
         self.mpos = mpos
 
 
+def _centre_at(centre: dict, point: dict, a1: str, a2: str) -> dict:
+    """The arc centre as records carry it: plane coordinates, other axes at the end point."""
+    return {a: (centre.get(a, 0.0) if a in (a1, a2) else point[a]) for a in centre}
+
+
 def _split_turns(rec: ToolpathRecord) -> list[ToolpathRecord]:
     """An arc (or helix) with extra full turns as `turns` full circles plus the final part,
     the axes outside the plane advancing in proportion to the angle swept."""
@@ -388,7 +393,8 @@ def _split_turns(rec: ToolpathRecord) -> list[ToolpathRecord]:
         f = 2 * math.pi * k / total
         point = {a: start.get(a, 0.0) + (v - start.get(a, 0.0)) * f for a, v in end.items()}
         point[a1], point[a2] = start.get(a1, 0.0), start.get(a2, 0.0)
-        pieces.append(dataclasses.replace(rec, start=prev, end=point, turns=0))
+        pieces.append(dataclasses.replace(rec, start=prev, end=point, turns=0,
+                                          center=_centre_at(c, point, a1, a2)))
         prev = point
     pieces.append(dataclasses.replace(rec, start=prev, end=dict(end), turns=0))
     return pieces
