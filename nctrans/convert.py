@@ -1,0 +1,77 @@
+"""Conversion between dialects: front end of A -> IR -> (lowering B needs) -> emitter of B.
+
+The policy, in one place (sqlglot's "unsupported level"):
+- the target emitter first writes the program structurally (loops, variables, calls and cycles kept
+  where the target has them), recording NC401 for each construct it lowered on the way;
+- when the emitter cannot express something (NC402), the whole program is lowered to plain motion
+  (`nctrans.lower.flatten`: loops unrolled, calls and cycles expanded, expressions evaluated, frames
+  folded) and emitted again; each refusal becomes an NC401 info naming the construct and its line,
+  so nothing is dropped silently and the output still drives the same toolpath;
+- what even plain motion cannot carry (an unresolved call, a synchronized action ...) stays an NC402
+  error and the conversion is refused;
+- `strict` turns every lowering into an error.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+from nctrans.diagnostics import Diagnostic
+from nctrans.dialects.base import Dialect
+from nctrans.ir.nodes import Program
+
+
+@dataclass
+class Conversion:
+    text: Optional[str]                 # None when the conversion was refused
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    flattened: bool = False
+
+
+def _is_refusal(d: Diagnostic) -> bool:
+    return d.rule == "NC402" and d.severity == "error"
+
+
+def _as_lowering(d: Diagnostic, target: str) -> Diagnostic:
+    return Diagnostic("NC401", "info",
+                      f"{d.message} — {target} cannot express it, so the program was lowered to plain "
+                      f"motion (as with --flatten)", d.file, d.line, d.column, d.end_line, d.end_column)
+
+
+def strict(diags: list[Diagnostic]) -> list[Diagnostic]:
+    """--strict: every lowering (NC401) becomes an error."""
+    out = []
+    for d in diags:
+        if d.rule == "NC401" and d.severity != "error":
+            d = Diagnostic(d.rule, "error", f"{d.message} (refused by --strict)", d.file, d.line,
+                           d.column, d.end_line, d.end_column, d.fix)
+        out.append(d)
+    return out
+
+
+def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callable[[list], Program]],
+            flatten: bool = False, strict_mode: bool = False) -> Conversion:
+    """Emit `program` in `target`. `flatten_with(diagnostics) -> Program` lowers it to plain motion
+    (it closes over the machine and the subprogram resolver); None when lowering is unavailable."""
+    diags: list[Diagnostic] = []
+    flattened = False
+    if flatten and flatten_with is not None:
+        program = flatten_with(diags)
+        flattened = True
+    result = target.emit(program)
+    refusals = [d for d in result.diagnostics if _is_refusal(d)]
+    if refusals and not flattened and flatten_with is not None and not strict_mode:
+        lowered = [_as_lowering(d, target.name) for d in refusals]
+        flat_diags: list[Diagnostic] = []
+        flat = flatten_with(flat_diags)
+        again = target.emit(flat)
+        diags.extend(lowered)
+        diags.extend(flat_diags)
+        diags.extend(again.diagnostics)
+        result, flattened = again, True
+    else:
+        diags.extend(result.diagnostics)
+    if strict_mode:
+        diags = strict(diags)
+    refused = any(d.severity == "error" for d in diags)
+    return Conversion(None if refused else result.text, diags, flattened)

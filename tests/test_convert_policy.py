@@ -1,0 +1,58 @@
+"""The conversion policy: structural first, plain motion when the target cannot express a construct,
+refusal only when even plain motion cannot carry it; --strict refuses every lowering."""
+from pathlib import Path
+
+from nctrans import equiv
+from nctrans.convert import convert
+from nctrans.dialects.base import get
+from nctrans.interp import interpret
+from nctrans.lower.flatten import flatten
+
+SIN = """DEF REAL DEPTH=2
+N10 G17 G90 G71
+N20 T1 M6
+N30 G0 X0 Y0 Z5
+LOOP_START:
+N40 G1 Z=-DEPTH F200
+N50 X=AC(20) Y=IC(5)
+N60 DEPTH=DEPTH+2
+N70 IF DEPTH<=6 GOTOB LOOP_START
+N80 G0 Z5
+M30
+"""
+
+
+def _records(program):
+    return list(interpret(program, None, diagnostics=[]))
+
+
+def _convert(text, src, dst, **kw):
+    program = get(src).parse(text, "p." + src).program
+    res = convert(program, get(dst),
+                  flatten_with=lambda diags: flatten(program, None, diagnostics=diags), **kw)
+    return program, res
+
+
+def test_construct_the_target_lacks_lowers_the_program_with_a_located_info():
+    program, res = _convert(SIN, "sinumerik", "iso-m")
+    assert res.text is not None and res.flattened
+    infos = [d for d in res.diagnostics if d.rule == "NC401"]
+    assert infos and all(d.severity == "info" for d in infos)
+    assert any(d.line > 1 for d in infos)          # points at the construct, not the file
+    out = get("iso-m").parse(res.text, "p.nc").program
+    assert equiv.compare(_records(program), _records(out)) is None
+
+
+def test_strict_refuses_the_lowering():
+    _, res = _convert(SIN, "sinumerik", "iso-m", strict_mode=True)
+    assert res.text is None
+    assert any(d.severity == "error" and d.rule in ("NC401", "NC402") for d in res.diagnostics)
+
+
+def test_expressible_program_stays_structured():
+    iso = "G21 G90\n#1=0\nWHILE [#1 LT 3] DO1\nG1 X[#1*10] F100\n#1=#1+1\nEND1\nM30\n"
+    program, res = _convert(iso, "iso-m", "sinumerik")
+    assert res.text is not None and not res.flattened
+    assert "WHILE" in res.text.upper()
+    out = get("sinumerik").parse(res.text, "p.mpf").program
+    assert equiv.compare(_records(program), _records(out)) is None
