@@ -265,9 +265,9 @@ def _t(text) -> str:
 def _priority(st) -> int:
     kind = type(st).__name__
     if kind == "ModeChange":
-        if st.group in ("spindle", "coolant"):
-            return 7 if st.value == "off" else 4
-        return 1
+        # spindle and coolant switch before the block's motion, on and off alike (as RS274/NGC
+        # orders them; the Siemens output timing "with the motion" is a PLC matter)
+        return 4 if st.group in ("spindle", "coolant") else 1
     if kind == "SubCall" and st.modal != "none":
         return 7
     return _ORDER.get(kind, 5)
