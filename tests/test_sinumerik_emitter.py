@@ -144,6 +144,18 @@ def test_iso_initial_level_and_incremental_cycle_use_programmed_position():
     assert line == "MCALL CYCLE82($P_EP[Z], $P_EP[Z]+(-8), 0, $P_EP[Z]+(-8)+(-3),, 0.5)"
 
 
+def test_iso_initial_level_known_from_the_program_gives_plain_numbers():
+    rapid_z = block(ir.ModeChange("motion", "rapid"), ir.Motion({"Z": ir.AxisValue(ir.Num(10.0))}))
+    g98 = [rapid_z, block(ir.ModeChange("cycle", "drill"), ir.CycleParams({"r_plane": ir.Num(2.0)}),
+                          ir.Motion({"X": ir.AxisValue(ir.Num(1.0)), "Z": ir.AxisValue(ir.Num(-5.0))}))]
+    assert emit(ir.Program("iso.nc", "iso-m", g98)).text.splitlines()[1] == "MCALL CYCLE81(10, 2, 0, -5)"
+    # G91: R is from the initial level (10-8=2), Z from R (2-3=-1); G98 returns to 10
+    inc = [rapid_z, block(ir.ModeChange("distance", "incremental"), ir.ModeChange("cycle", "drill"),
+                          ir.CycleParams({"r_plane": ir.Num(-8.0)}),
+                          ir.Motion({"X": ir.AxisValue(ir.Num(1.0)), "Z": ir.AxisValue(ir.Num(-3.0))}))]
+    assert emit(ir.Program("iso.nc", "iso-m", inc)).text.splitlines()[2] == "MCALL CYCLE81(10, 2, 0, -1)"
+
+
 def test_iso_cycles_without_exact_siemens_equivalent_are_refused():
     body = [block(ir.ModeChange("cycle", "peck"), ir.CycleParams({"r_plane": ir.Num(2.0)}))]
     out = emit(ir.Program("iso.nc", "iso-m", body))

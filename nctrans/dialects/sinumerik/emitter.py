@@ -75,6 +75,8 @@ class _State:
     cycle_params: dict = field(default_factory=dict)
     cycle_pending: bool = False
     cycle_active: bool = False
+    cycle_init: Optional[float] = None      # ISO initial level when known statically
+    known: dict = field(default_factory=dict)   # axis -> last programmed value when constant
 
 
 class Emitter:
@@ -89,6 +91,7 @@ class Emitter:
         self.axes = set(self.t.options.get("axes", []))
         self.span: Optional[ir.Span] = None
         self.pending = None
+        self.targets = _jump_targets(program)
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -232,6 +235,10 @@ class Emitter:
     # ---------------------------------------------------------------- statements
     def statement(self, s, out: "_Line") -> None:
         st = self.st
+        if isinstance(s, (ir.SubCall, ir.HomeReturn, ir.SetPosition, ir.ResetSetPosition, ir.FrameOp,
+                          ir.CycleCall)) or (isinstance(s, ir.ModeChange) and s.group in (
+                              "units", "work_offset")):
+            st.known = {}
         if isinstance(s, ir.ModeChange):
             g = s.group
             if g == "motion":
@@ -248,6 +255,7 @@ class Emitter:
                         if back is not None and st.motion != "rapid":
                             out.alone(back.code)     # positioning blocks were written with G0
                     st.cycle, st.cycle_active, st.cycle_params = "off", False, {}
+                    st.cycle_init = None
                 else:
                     st.cycle, st.cycle_pending = s.value, True
                     if s.value not in _ISO_CYCLES:
@@ -359,6 +367,7 @@ class Emitter:
         if st.cycle != "off" and st.cycle in _ISO_CYCLES and m.target:
             self.iso_cycle_position(m, out)
             return
+        self.track(m)
         ws = []
         if m.machine_coords:
             ws.append("SUPA")
@@ -381,6 +390,19 @@ class Emitter:
         if m.turns is not None:
             ws.append(f"TURN={self.expr(m.turns)}")
         out.words.extend(ws)
+
+    def track(self, m: ir.Motion) -> None:
+        """Last programmed constant position per axis (for the ISO cycle initial level)."""
+        known = self.st.known
+        for a, av in m.target.items():
+            v = av.value
+            inc = av.mode == "inc" or (av.mode is None and self.st.distance == "incremental")
+            if m.machine_coords or not isinstance(v, ir.Num):
+                known[a] = None
+            elif inc:
+                known[a] = known[a] + v.value if known.get(a) is not None else None
+            else:
+                known[a] = v.value
 
     def frame(self, f: ir.FrameOp, out: "_Line") -> None:
         a = "A" if f.additive else ""
@@ -462,16 +484,29 @@ class Emitter:
             if r is None or z is None:
                 self.refuse("canned cycle without R level or depth")
                 return
-            init = f"$P_EP[{ax}]"
+            if not st.cycle_active:
+                st.cycle_init = st.known.get(ax)
             absolute = st.distance == "absolute"
             if "absolute" in p and isinstance(p["absolute"], ir.Num):
                 absolute = bool(p["absolute"].value)
-            if absolute:
-                rfp, dp = self.expr(r), self.expr(z)
+            zi = st.cycle_init
+            if zi is not None and isinstance(r, ir.Num) and isinstance(z, ir.Num):
+                # the initial level is known from the program text: plain numbers
+                rv = r.value if absolute else zi + r.value
+                dv = z.value if absolute else rv + z.value
+                rtv = rv if st.cycle_retract == "r_plane" else zi
+                rfp, dp, rtp = _fmt(rv), _fmt(dv), _fmt(rtv)
+                st.known[ax] = rtv
             else:
-                rfp = f"{init}+{self.expr(r, 9)}"
-                dp = f"{init}+{self.expr(r, 9)}+{self.expr(z, 9)}"
-            rtp = rfp if st.cycle_retract == "r_plane" else init
+                # otherwise the programmed position when the MCALL block is read
+                init = _fmt(zi) if zi is not None else f"$P_EP[{ax}]"
+                if absolute:
+                    rfp, dp = self.expr(r), self.expr(z)
+                else:
+                    rfp = f"{init}+{self.expr(r, 9)}"
+                    dp = f"{init}+{self.expr(r, 9)}+{self.expr(z, 9)}"
+                rtp = rfp if st.cycle_retract == "r_plane" else init
+                st.known[ax] = None
             args = [rtp, rfp, "0", dp]
             name = _ISO_CYCLES[st.cycle]
             if name in ("CYCLE82", "CYCLE89"):
@@ -551,6 +586,8 @@ class Emitter:
     # ---------------------------------------------------------------- structure
     def block(self, b: ir.Block, ind: str) -> None:
         self.span = b.span
+        if (b.label and b.label in self.targets) or (b.number and b.number in self.targets):
+            self.st.known = {}       # a jump target: the position depends on the path taken
         decls = [s for s in b.body if isinstance(s, ir.VarDecl)]
         rest = [s for s in b.body if not isinstance(s, ir.VarDecl)]
         line = _Line(only=len(rest) == 1, join=self.p.dialect == DIALECT)
@@ -625,6 +662,7 @@ class Emitter:
                 self.block(n, ind)
                 continue
             deco, self.pending = self.pending, None
+            self.st.known = {}       # loops and branches: positions depend on the path taken
             if isinstance(n, ir.If):
                 self.ctl(ind, f"IF {self.expr(n.cond)}", deco)
                 close = self.body(n.then, ind)
@@ -650,6 +688,7 @@ class Emitter:
                 self.ctl(ind, f"CASE {self.expr(n.subject)} OF " + " ".join(parts), deco)
             else:
                 self.refuse(f"{type(n).__name__} cannot be written")
+            self.st.known = {}
 
     def ctl(self, ind: str, text: str, deco) -> None:
         """A control-structure line, with the block number / comment of its source line."""
@@ -769,6 +808,31 @@ _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z_0-9]{0,30}$")
 
 
 _STRUCT = (ir.If, ir.While, ir.ForLoop, ir.Loop, ir.RepeatUntil, ir.Case)
+
+
+def _jump_targets(p: ir.Program) -> set:
+    """Labels and block numbers some jump can reach (where statically known positions end)."""
+    out: set = set()
+
+    def walk(ns):
+        for n in ns:
+            if isinstance(n, ir.Block):
+                for s in n.body:
+                    if isinstance(s, ir.Goto):
+                        out.add(s.target)
+                    elif isinstance(s, ir.Return) and s.to_label:
+                        out.add(s.to_label)
+            elif isinstance(n, ir.Case):
+                out.update(t for _, t in n.branches)
+                if n.default:
+                    out.add(n.default)
+            for attr in ("then", "orelse", "body"):
+                if isinstance(getattr(n, attr, None), list):
+                    walk(getattr(n, attr))
+    walk(p.body)
+    for sub in p.subprograms.values():
+        walk(sub.body)
+    return out
 
 
 def _deco(b: ir.Block):
