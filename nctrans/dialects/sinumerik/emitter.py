@@ -14,9 +14,10 @@ Lowerings for IR from other dialects (each reported as NC401 info, or NC402 when
 - ISO numbered subprograms ("1000", "O1000") are called and defined as L1000.
 - ISO canned cycles (ModeChange("cycle") + CycleParams + positioning motions) become
   `MCALL CYCLE8x(RTP, RFP, SDIS, DP)` before the first positioning block and `MCALL` at G80,
-  with RTP = R level under G99 and the initial level `$P_EP[<drill axis>]` (the programmed
-  position when the MCALL block is read = ISO initial level) under G98; incremental R/Z become
-  `$P_EP[..]+R` sums. Chosen for G81 drill, G82 drill_dwell, G85 bore_feed_out and G89
+  with RTP = R level under G99 and the ISO initial level under G98; incremental R/Z are added
+  to the initial level. The initial level is the last constant programmed position of the drill
+  axis when the program text fixes it (plain numbers), else `$P_EP[<drill axis>]` (the
+  programmed position when the MCALL block is read). Chosen for G81 drill, G82 drill_dwell, G85 bore_feed_out and G89
   bore_dwell_feed_out, whose Siemens cycles do the same strokes. Peck, tapping, fine/back/manual
   boring differ in stroke details from CYCLE83/84/86/87 and are refused with NC402 (convert with
   --flatten so the interpreter expands them into motion).
