@@ -9,22 +9,19 @@ unreadable file, unknown dialect or internal failure - always with a message, ne
 from __future__ import annotations
 
 import argparse
-import inspect
 import os
 import sys
-import tempfile
 from pathlib import Path
 from typing import Iterable, Optional
 
 from nctrans import __version__
-from nctrans import catalogue as _catalogue
-from nctrans import detect as _detect
-from nctrans import equiv as _equiv
 from nctrans import output as _output
 from nctrans import pipeline
 from nctrans import source as _source
-from nctrans import toolpath_io
 from nctrans.diagnostics import SEVERITY_RANK, Diagnostic
+
+# catalogue, detect, equiv, toolpath_io, inspect and tempfile are imported by the commands that
+# use them: start-up time is a large share of a `toolpath` or `lint` run on one file.
 
 EXIT_OK, EXIT_DIAGNOSTICS, EXIT_USAGE = 0, 1, 2
 NOT_IMPLEMENTED = ("check", "backplot", "audit", "fuzz", "lsp")
@@ -98,6 +95,7 @@ def _check_dialect(name: Optional[str]) -> None:
 # --------------------------------------------------------------------------- convert
 
 def _target_extension(dialect: str) -> str:
+    from nctrans import detect as _detect
     exts = _detect.EXTENSIONS.get(dialect) or (".nc",)
     return exts[0]
 
@@ -114,6 +112,7 @@ def _same_file(a: Path, b: Path) -> bool:
 def write_atomic(path: Path, text: str) -> None:
     """Write `text` to `path` through a temporary file in the same directory and os.replace, so a
     reader never sees a half-written program and a failure leaves any old file intact."""
+    import tempfile
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -141,6 +140,7 @@ def _flatten(program, machine, diags: list[Diagnostic], ld: pipeline.Loaded):
         raise UsageError("--flatten is not available in this build yet") from None
     offered = {"diagnostics": diags, "resolver": pipeline.make_resolver(ld.source_dir, ld.dialect),
                "source_dir": ld.source_dir}
+    import inspect
     try:
         params = inspect.signature(flatten).parameters
         kwargs = {k: v for k, v in offered.items() if k in params}
@@ -287,7 +287,7 @@ def cmd_lint(args) -> int:
     try:
         for f in files:
             try:
-                ld = pipeline.load(f, args.from_)
+                ld = pipeline.load(f, args.from_, stream=True)
                 m = machine or pipeline.load_machine(None, ld.dialect)
                 diags = pipeline.lint(ld, m)
                 done += 1
@@ -320,12 +320,13 @@ def cmd_lint(args) -> int:
 
 def cmd_toolpath(args) -> int:
     _check_dialect(args.from_)
-    ld = pipeline.load(args.src, args.from_)
+    ld = pipeline.load(args.src, args.from_, stream=True)
     machine = pipeline.load_machine(args.machine, ld.dialect)
     if ld.program is None:
         _print_text_diags(ld.diagnostics, sys.stderr)
         return EXIT_DIAGNOSTICS
     records = pipeline.toolpath_of(ld, machine)
+    from nctrans import toolpath_io
     out = sys.stdout
     if args.summary:
         summ = toolpath_io.Summary(machine)
@@ -344,6 +345,9 @@ def cmd_toolpath(args) -> int:
 # --------------------------------------------------------------------------- equiv
 
 def cmd_equiv(args) -> int:
+    from nctrans import equiv as _equiv
+    if args.tol is None:
+        args.tol = _equiv.DEFAULT_TOL
     if not args.tol > 0:
         raise UsageError("--tol must be a positive number of mm")
     _check_dialect(args.from_a)
@@ -386,6 +390,7 @@ def cmd_detect(args) -> int:
             _print_text_diags(src.diagnostics, sys.stderr)
             status = max(status, EXIT_DIAGNOSTICS)
             continue
+        from nctrans import detect as _detect
         g = _detect.detect(src.text, None if f == _source.STDIN else f)
         if g.ambiguous:
             print(f"{label}: ambiguous ({g.describe()}): use --from DIALECT")
@@ -396,6 +401,7 @@ def cmd_detect(args) -> int:
 
 
 def cmd_rules(args) -> int:
+    from nctrans import catalogue as _catalogue
     cat = _catalogue.load()
     if args.rule:
         r = cat.get(args.rule)
@@ -456,7 +462,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--from-a", metavar="DIALECT")
     p.add_argument("--from-b", metavar="DIALECT")
     p.add_argument("--machine", metavar="MACHINE.toml")
-    p.add_argument("--tol", type=float, default=_equiv.DEFAULT_TOL, metavar="MM")
+    p.add_argument("--tol", type=float, default=None, metavar="MM",
+                   help="tolerance in mm (default 0.001)")
     p.set_defaults(func=cmd_equiv)
 
     p = sub.add_parser("detect", help="guess the dialect of files")

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import re
 from collections import deque
+from itertools import islice
 from typing import Any, Callable, Iterator, Optional
 
 from nctrans.diagnostics import at_span
@@ -54,6 +55,7 @@ except ImportError:  # pragma: no cover
 
 BLOCK, JUMP, JFALSE, EXEC, CASE = range(5)
 MAX_CALL_DEPTH = 16
+STREAM_BATCH = 256          # blocks of a streamed main body compiled at a time
 MOVE_KINDS = frozenset(("rapid", "linear", "arc"))
 NORMAL = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 ROT_AXIS = NORMAL
@@ -1344,7 +1346,15 @@ class Interpreter:
     # ================================================================ the loop
     def run(self) -> Iterator[ToolpathRecord]:
         prog = self.program
-        main = self.unit_for(id(prog), prog.name or "main", prog.body, prog.file, [])
+        body = prog.body
+        # A main body that is not a list is streamed (iso-m parse_stream: no jumps, no calls):
+        # it is compiled a batch of blocks at a time, run, and the batch dropped, so memory does
+        # not grow with the program. Labels are per batch (nothing jumps to them).
+        stream = None
+        if type(body) is not list:
+            stream = iter(body)
+            body = []
+        main = self.unit_for(id(prog), prog.name or "main", body, prog.file, [])
         unit, code = main, main.code
         pc = sidx = 0
         steps = 0
@@ -1357,6 +1367,16 @@ class Interpreter:
         try:
             while True:
                 if pc >= len(code):
+                    if stream is not None and unit is main and not self.stack:
+                        batch = list(islice(stream, STREAM_BATCH))
+                        if batch:
+                            code.clear()
+                            main.labels.clear()
+                            self._emit_nodes(batch, main)
+                            main.seen = bytearray(len(code))
+                            pc = sidx = 0
+                            continue
+                        stream = None
                     # falling off the end of a body: implicit return / end of program
                     if not self.stack:
                         break

@@ -733,15 +733,103 @@ def _parse_program(text: str, file: str):
     from nctrans.dialects.base import ParseResult
 
     diags: list[Diagnostic] = []
+    program = Program(file, DIALECT, [], {}, {}, None)
+    for _ in _parse_lines(text, file, program, diags, program.body, False):
+        pass
+    return ParseResult(program, diags)
+
+
+# What needs the main body held whole: a jump (GOTO, IF, WHILE/DO/END, M99 P), a call (M98, M97,
+# G65, G66/G67, M17/M99 returns) or a macro expression (# [ ]). Matches inside comments are skipped;
+# anything else that matches only costs the streaming (the full parse is always correct).
+# Subprograms later in the file need no look: only a call reaches them, and calls are in the list
+# (their blocks are still parsed, into Program.subprograms, so the diagnostics are the same).
+_CONTROL = re.compile(r"GOTO|IF|WHILE|END[ \t]*\d|DO[ \t]*\d|#|\[|G[ \t]*0*6[ \t]*[567]|"
+                      r"M[ \t]*0*(?:9[ \t]*[789]|1[ \t]*7)")
+_SCAN_CHUNK = 1 << 16
+
+
+def _control_flow_at(text: str, semicolon_comment: bool) -> Optional[int]:
+    """Offset of the first control-flow mark outside a comment (None: the program runs straight
+    through, block after block). Searched in upper-cased chunks of whole lines (a case-insensitive
+    pattern with these alternatives is ~15x slower; chunks keep the copy small)."""
+    n = len(text)
+    base = 0
+    while base < n:
+        cut = text.rfind("\n", base, base + _SCAN_CHUNK) if base + _SCAN_CHUNK < n else n
+        if cut <= base:
+            cut = min(n, base + _SCAN_CHUNK)
+        chunk = text[base:cut].upper()
+        for m in _CONTROL.finditer(chunk):
+            pos = m.start()
+            head = chunk[chunk.rfind("\n", 0, pos) + 1:pos]
+            if head.count("(") > head.count(")") or (semicolon_comment and ";" in head):
+                continue                        # inside a comment
+            return base + pos
+        base = cut
+    return None
+
+
+class StreamedBody:
+    """The main body of a streamed Program: iterating it parses the next blocks, once. The
+    interpreter runs each block as it comes and drops it; `drain()` parses what is left (after a
+    program end) so that the diagnostics match a full parse."""
+    __slots__ = ("_blocks",)
+
+    def __init__(self, blocks):
+        self._blocks = blocks
+
+    def __iter__(self):
+        return self._blocks
+
+    def drain(self) -> None:
+        for _ in self._blocks:
+            pass
+
+
+def parse_stream(text: str, file: str = "<stdin>"):
+    """Lazy parse for programs whose main body runs straight through (the common CAM output): a
+    ParseResult whose Program.body is a StreamedBody and whose diagnostics list fills as the body
+    is iterated (complete once it is drained). None when the text has control flow, a macro
+    variable or subprograms (see _CONTROL): those need `parse_program`, which holds the IR whole.
+    Memory then stays bounded by one batch of blocks instead of growing with the file."""
+    from nctrans.dialects.base import ParseResult
+
+    diags: list[Diagnostic] = []
+    program = Program(file, DIALECT, [], {}, {}, None)
+    opts = load_table(DIALECT).options
+    if _control_flow_at(text, opts.get("eob_semicolon", "comment") != "eob") is not None:
+        return None
+    program.body = StreamedBody(_parse_lines(text, file, program, diags, [], True))
+    return ParseResult(program, diags)
+
+
+def _split_lines(text: str, sep: str):
+    """text.split(sep), one piece at a time (no list of every line)."""
+    find = text.find
+    start = 0
+    while True:
+        i = find(sep, start)
+        if i < 0:
+            yield text[start:]
+            return
+        yield text[start:i]
+        start = i + 1
+
+
+def _parse_lines(text: str, file: str, program: Program, diags: list, main: list, stream: bool):
+    """The parse proper. Fills program.meta/name/subprograms and `main`; with `stream` the blocks
+    of the main body are yielded (and dropped from `main`) line by line instead."""
     low = Lowering(file, diags)
     opts = low.table.options
     semicolon_comment = opts.get("eob_semicolon", "comment") != "eob"
-    meta: dict = {"program_number": None, "percent": False, "defaults": low.table.defaults(),
-                  "options": dict(opts)}
+    meta: dict = program.meta
+    meta.update({"program_number": None, "percent": False, "defaults": low.table.defaults(),
+                 "options": dict(opts)})
     name = None
-    main: list = []
-    subprograms: dict[str, Subprogram] = {}
+    subprograms: dict[str, Subprogram] = program.subprograms
     cur = main
+    main_seen = False
     stack: list[_Frame] = []
     seen_block = False
     lowercase_noted = False
@@ -750,7 +838,8 @@ def _parse_program(text: str, file: str):
         diags.append(Diagnostic("NC001", "error", "NUL bytes: not NC program text (UTF-16 or binary?)",
                                 file, 1))
         text = text.replace("\x00", "")
-    lines = text.split("\n") if "\n" in text else text.split("\r")
+    sep = "\n" if "\n" in text else "\r"
+    lines = _split_lines(text, sep) if stream else text.split(sep)
     fast_plain = PLAIN.fullmatch
     fast_words = WORD.findall
     lower = low.lower
@@ -769,6 +858,10 @@ def _parse_program(text: str, file: str):
     _block = Block
     _span = Span
     for lineno, raw in enumerate(lines, 1):
+        if stream and main:
+            main_seen = True
+            yield from main
+            main.clear()
         # Hot path: a comment-free line of plain axis words (most of CAM output).
         if not ("(" in raw or ";" in raw or ")" in raw):
             code = raw.replace(" ", "")
@@ -843,6 +936,7 @@ def _parse_program(text: str, file: str):
                 key = f"O{int(prog)}" if prog.isdigit() else f"O{prog}"
                 if name is None and not low.main_ended and cur is main:
                     name = key
+                    program.name = name
                     meta["program_number"] = int(prog) if prog.isdigit() else prog
                     if comment is not None:
                         meta["title"] = comment
@@ -938,10 +1032,11 @@ def _parse_program(text: str, file: str):
         diags.append(Diagnostic("NC006", "error",
                                 f"DO{fr.label} (line {fr.line}) has no END{fr.label}: the program is truncated",
                                 file, fr.line))
-    if not main and not subprograms:
+    if not main and not main_seen and not subprograms:
         diags.append(Diagnostic("NC004", "error", "the file holds no NC blocks", file, 1))
-    program = Program(file, DIALECT, main, subprograms, meta, name)
-    return ParseResult(program, diags)
+    if stream and main:
+        yield from main
+        main.clear()
 
 
 _DROP_TABLE = {c: None for c in list(range(0x00, 0x21)) + [0x7F, 0x85, 0xA0, 0xFEFF]}
