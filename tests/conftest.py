@@ -10,6 +10,7 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 TESTS = Path(__file__).resolve().parent
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
@@ -52,3 +53,19 @@ def rs274() -> Path:
 def rs274_cache(tmp_path_factory) -> Path:
     """Per-session directory for rs274 outputs, so each program runs through rs274 once."""
     return tmp_path_factory.mktemp("rs274")
+
+
+# Hypothesis profiles: `make test` runs the fuzzers briefly (the default profile), `make fuzz` runs
+# them long with --hypothesis-profile=fuzz (NCTRANS_FUZZ_EXAMPLES sets the count).
+
+settings.register_profile(
+    "fuzz",
+    max_examples=int(os.environ.get("NCTRANS_FUZZ_EXAMPLES", "20000")),
+    deadline=None,
+    suppress_health_check=list(HealthCheck),
+    print_blob=True,
+)
+settings.register_profile("default", max_examples=60, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+if not os.environ.get("NCTRANS_FUZZ_PROFILE_SET"):
+    settings.load_profile("default")
