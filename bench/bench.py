@@ -1,10 +1,12 @@
 """Throughput and memory of lint and toolpath on the largest ISO milling corpus programs (`make bench`).
 
 For each program: lines/s in-process (parse + interpret, and parse + interpret + JSONL serialisation
-to a null sink), the CLI end to end (subprocess wall time, output to /dev/null), LinuxCNC rs274 on the
-same file in the same run and the CLI/rs274 time ratio. Then peak memory (tracemalloc) for one
-program and for the same program repeated 10x: the IR is held whole (it grows with the text), the
-interpreter streams, so its peak beyond the IR must stay flat. Plain-text table; no assertions.
+to a null sink, with the whole IR; then the streamed path the CLI takes: pipeline.load(stream=True)
++ toolpath_io.write_jsonl), the CLI end to end (subprocess wall time, output to /dev/null), LinuxCNC
+rs274 on the same file in the same run and the CLI/rs274 time ratio. Then peak memory (tracemalloc)
+for one program and for the same program repeated 10x: the full parse holds the IR (it grows with
+the text) and the interpreter's peak is measured above it; the streamed parse + run + serialisation
+(source text held by the caller) must stay flat. Plain-text table; no assertions.
 """
 from __future__ import annotations
 
@@ -76,6 +78,28 @@ def toolpath_in_process(text: str, name: str) -> int:
     return n
 
 
+def stream_in_process(text: str, name: str) -> int:
+    """What `nctrans toolpath --from iso-m` runs: streamed parse + interpret + jsonl writer."""
+    from nctrans import pipeline, source, toolpath_io
+    ld = pipeline.load_source(source.decode(text.encode("utf-8"), name), name, "iso-m", stream=True)
+    return toolpath_io.write_jsonl(pipeline.toolpath_of(ld, pipeline.load_machine(None, "iso-m")),
+                                   NullSink())
+
+
+def stream_peak(text: str, name: str) -> float:
+    """Peak MiB of the streamed load + run + jsonl, above the decoded source text."""
+    from nctrans import pipeline, source, toolpath_io
+    src = source.decode(text.encode("utf-8"), name)
+    machine = pipeline.load_machine(None, "iso-m")
+    gc.collect()
+    tracemalloc.start()
+    ld = pipeline.load_source(src, name, "iso-m", stream=True)
+    toolpath_io.write_jsonl(pipeline.toolpath_of(ld, machine), NullSink())
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return peak / 2**20
+
+
 def best_time(fn, repeat: int) -> float:
     best = float("inf")
     for _ in range(repeat):
@@ -144,9 +168,11 @@ def main(argv=None) -> int:
         path, times = Path(args.peak[0]), int(args.peak[1])
         text = read_text(path)
         peaks(text, path.name)                      # warm-up: one-time caches are not the program's
+        stream_peak(text, path.name)
         t = repeated(text, times) if times > 1 else text
         p, i = peaks(t, path.name)
-        print(t.count("\n"), p, i)
+        sp = stream_peak(t, path.name)
+        print(t.count("\n"), p, i, sp)
         return 0
     paths = [Path(p) for p in args.programs] or [CORPUS / p for p in PROGRAMS]
     paths = [p for p in paths if p.exists()]
@@ -155,7 +181,7 @@ def main(argv=None) -> int:
         return 0
     print(f"python {sys.version.split()[0]}, rs274 {'found' if Path(RS274).exists() else 'missing'}, "
           f"best of {args.repeat}; lines/s = source lines / seconds")
-    head = (f"{'program':34} {'lines':>6} {'records':>8} {'lint l/s':>10} {'toolpath l/s':>12} "
+    head = (f"{'program':34} {'lines':>6} {'records':>8} {'lint l/s':>10} {'toolpath l/s':>12} {'stream l/s':>10} "
             f"{'CLI lint s':>10} {'CLI tp s':>9} {'CLI tp l/s':>10} {'rs274 s':>8} {'CLI/rs274':>9}")
     print(head)
     print("-" * len(head))
@@ -165,11 +191,12 @@ def main(argv=None) -> int:
         for path in paths:
             text = read_text(path)
             lines = text.count("\n") or 1
-            records = lint_rate = tp_rate = None
+            records = lint_rate = tp_rate = st_rate = None
             try:
                 records = toolpath_in_process(text, path.name)
                 lint_rate = lines / best_time(lambda: lint_in_process(text, path.name), args.repeat)
                 tp_rate = lines / best_time(lambda: toolpath_in_process(text, path.name), args.repeat)
+                st_rate = lines / best_time(lambda: stream_in_process(text, path.name), args.repeat)
             except Exception as e:                      # a missing stage: report, keep benchmarking
                 notes.append(f"{path.name}: in-process: {type(e).__name__}: {e}")
             cli_lint, rc_l = wall(NCTRANS + ["lint", str(path), "--from", "iso-m"], args.repeat)
@@ -184,22 +211,23 @@ def main(argv=None) -> int:
             rs = rs274_time(path, args.repeat, tmp)
             ratio = cli_tp / rs if cli_tp and rs else None
             print(f"{path.name[:34]:34} {lines:>6} {fmt(records):>8} {fmt(lint_rate):>10} {fmt(tp_rate):>12} "
+                  f"{fmt(st_rate):>10} "
                   f"{fmt(cli_lint, '.3f'):>10} {fmt(cli_tp, '.3f'):>9} "
                   f"{fmt(lines / cli_tp if cli_tp else None):>10} {fmt(rs, '.3f'):>8} {fmt(ratio, '.2f'):>9}")
         print()
-        print("peak memory (tracemalloc, MiB; fresh process, after one warm-up run): parse holds the IR;")
-        print("interpret+serialise is measured above it")
-        print(f"{'program':40} {'lines':>7} {'parse peak':>11} {'interp peak':>12}")
+        print("peak memory (tracemalloc, MiB; fresh process, after one warm-up run): the full parse holds")
+        print("the IR, interpret+serialise is measured above it; streamed = parse+run+jsonl as the CLI does")
+        print(f"{'program':40} {'lines':>7} {'parse peak':>11} {'interp peak':>12} {'streamed peak':>14}")
         base = paths[0]
         for times in (1, 10):
             label = base.name + (f" x{times}" if times > 1 else "")
             proc = subprocess.run([sys.executable, __file__, "--peak", str(base), str(times)],
                                   capture_output=True, text=True)
             try:
-                lines, p, i = proc.stdout.split()
-                print(f"{label[:40]:40} {int(lines):>7} {float(p):>11.1f} {float(i):>12.2f}")
+                lines, p, i, sp = proc.stdout.split()
+                print(f"{label[:40]:40} {int(lines):>7} {float(p):>11.1f} {float(i):>12.2f} {float(sp):>14.2f}")
             except ValueError:
-                print(f"{label[:40]:40} {'n/a':>7} {'n/a':>11} {'n/a':>12}")
+                print(f"{label[:40]:40} {'n/a':>7} {'n/a':>11} {'n/a':>12} {'n/a':>14}")
                 notes.append(f"memory: {(proc.stderr.strip().splitlines() or ['?'])[-1]}")
     for n in notes:
         print("note:", n)
