@@ -8,17 +8,33 @@ number spellings (tests/test_iso_roundtrip.py).
 
 Constructs from other dialects get an ISO equivalent where one exists, reported as NC401 (info):
 named variables and R parameters -> common variables, FOR/REPEAT/LOOP/CASE -> WHILE/IF..GOTO,
-messages -> `(MSG, ...)` comments. Where none exists the construct is reported as NC402 (error)
-naming it and its source line, and left out of the text as a comment.
+messages -> `(MSG, ...)` comments, labels -> fresh N numbers, named subprograms -> O numbers
+(O9000..O9999 from the name, written after the main program as O blocks ending M99), PROC
+parameters -> G65 Type I arguments read as #1..#26 in the body (the subprogram's DEF scalars take
+the locals left over, so such subprograms are always called with G65: their own local level),
+numeric arrays with constant dimensions -> a row-major block of common variables above the
+R parameters, R[expr] -> #[500+expr], three-point arcs with constant points -> G2/G3 with the
+centre computed here, additive translations (ATRANS) with constant values and no rotation, scale or
+mirror active -> G52 with the accumulated shift. Where none exists the construct is reported as
+NC402 (error) naming it and its source line, and left out of the text as a comment.
+
+Not lowered, on purpose: Sinumerik G500 (work_offset "G53", no settable offset) -- ISO has no
+modal "no work offset" (G53 is one-shot machine coordinates, and G54 is only the same when its
+offset happens to be zero); additive rotation/scale/mirror (G68/G51 replace, they do not add);
+calls of subprograms that are not in the program (the ISO text would call an O number nothing
+defines); by-reference (VAR) and array parameters (G65 passes values only).
 """
 from __future__ import annotations
 
+import math
 from decimal import Decimal
 from typing import Any, Optional
 
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.ir import nodes as n
 from nctrans.rules import load_table
+
+from . import plan as pl
 
 POINT_LETTERS = frozenset("XYZUVWABCIJKQRF")
 AXES = "XYZABCUVW"
@@ -117,7 +133,7 @@ def _var(v: n.Var, ctx) -> str:
         return f"#{v.key}"
     if ctx is None:
         raise NotExpressible(f"variable {v.space}:{v.key}")
-    return f"#{ctx.map_var(v)}"
+    return ctx.var_text(v)
 
 
 def format_value(e: Any, ctx=None) -> str:
@@ -138,6 +154,10 @@ class _Line:
         self.used: set[str] = set()
 
 
+class _Lines(list):
+    """Words a statement writes on lines of their own (one list of words per line)."""
+
+
 class _Emitter:
     def __init__(self, program: n.Program):
         self.program = program
@@ -154,6 +174,21 @@ class _Emitter:
         # approach from other dialects) can be followed by the G90 that restores it
         self.distance = "absolute"
         self.restore_absolute = False
+        # the plan: labels, locals and O numbers per unit (None = the main program)
+        self.unit: Optional[str] = None
+        self.plans: dict[Optional[str], pl.UnitPlan] = {}
+        self.targets: dict[Optional[str], set[str]] = {}
+        self.sub_numbers: dict[str, int] = {}
+        self.arrays: dict[tuple, pl.ArrayPlan] = {}
+        top_r, dynamic_r = pl.max_r_used(program)
+        self.next_array = 900 if dynamic_r else 500 + top_r + 1
+        # what is known at emit time: constant programmed position, plane, the constant
+        # programmable translation (None: unknown) and whether rotation/scale/mirror may be active
+        self.pos: dict[str, float] = {}
+        self.plane = "XY"
+        self.cip_mode = False
+        self.frame_trans: Optional[dict[str, float]] = {}
+        self.frame_other = False
 
     # -------------------------------------------------------------- reporting
     def lowered(self, what: str) -> None:
@@ -163,6 +198,45 @@ class _Emitter:
         line = self.span.line if self.span is not None else 1
         self.diags.append(at_span("NC402", "error",
                                   f"ISO milling cannot express {what} (source line {line})", self.span))
+
+    def forget(self) -> None:
+        """A place reached from elsewhere (jump target, structure, call): positions and the
+        programmable frame are no longer known constants."""
+        self.pos = {}
+        self.frame_trans = None
+        self.frame_other = True
+
+    def var_text(self, v: n.Var) -> str:
+        if v.space == "name":
+            key = str(v.key).upper()
+            arr = self.arrays.get((self.unit, key)) or self.arrays.get((None, key))
+            if arr is not None:
+                return self._element(arr, v)
+            local = self.plans[self.unit].locals.get(key) if self.unit in self.plans else None
+            if local is not None:
+                if v.indices:
+                    raise NotExpressible(f"indexing the scalar {v.key}")
+                return f"#{local}"
+        if v.space == "R" and v.key is None and v.indices and len(v.indices) == 1:
+            self.lowered("R[expr] written as #[500+expr]")
+            return f"#[500+{format_expr(v.indices[0], self)}]"
+        return f"#{self.map_var(v)}"
+
+    def _element(self, arr: pl.ArrayPlan, v: n.Var) -> str:
+        idx = v.indices or []
+        if len(idx) != len(arr.dims):
+            raise NotExpressible(f"the array {v.key} used without all {len(arr.dims)} indices")
+        for e, dim in zip(idx, arr.dims):
+            c = pl.constant(e)
+            if c is not None and (c != int(c) or not 0 <= c < dim):
+                raise NotExpressible(f"index {format_number(c)} of the array {v.key} (size {dim})")
+        offset = idx[0]
+        for e, dim in zip(idx[1:], arr.dims[1:]):
+            offset = n.Binary("+", n.Binary("*", offset, n.Num(float(dim))), e)
+        c = pl.constant(offset)
+        if c is not None:
+            return f"#{arr.base + int(c)}"
+        return f"#[{format_expr(n.Binary('+', n.Num(float(arr.base)), offset), self)}]"
 
     def map_var(self, v: n.Var) -> int:
         key = (v.space, v.key)
@@ -201,6 +275,7 @@ class _Emitter:
         self._collect_numbers(p.body)
         for sub in p.subprograms.values():
             self._collect_numbers(sub.body)
+        self._plan()
         meta = p.meta or {}
         percent = meta.get("percent", True) if p.dialect == "iso-m" else True
         if percent:
@@ -208,23 +283,64 @@ class _Emitter:
         if meta.get("archive_header"):
             self.out.append(str(meta["archive_header"]))
         head = self._program_word(p.name, meta.get("program_number"))
+        if self.sub_numbers and (head is None or p.dialect != "iso-m"):
+            # an O block after a headless main program would be read as the main program's number
+            head = f"O{pl.stable_number('MAIN ' + (p.name or ''), set(self.sub_numbers.values()))}"
+            self.lowered(f"main program numbered {head} (its subprograms follow as O blocks)")
         if head:
             title = meta.get("title")
             self.out.append(head + (f" {self._comment(str(title))}" if title is not None else ""))
         self.nodes(p.body)
         for key, sub in p.subprograms.items():
-            word = self._program_word(key, None)
+            self.unit = key
+            self.forget()
             self.span = sub.span
+            if key in self.sub_numbers:
+                word = f"O{self.sub_numbers[key]}"
+                self.lowered(f"subprogram {key} written as {word}")
+            else:
+                word = self._program_word(key, None)
             if word is None:
                 self.refuse(f"subprogram name {key!r} (ISO programs are O numbers)")
                 word = f"({key})"
             self.out.append(word)
-            if sub.params:
-                self.refuse(f"parameters of subprogram {key}")
+            unit = self.plans[key]
+            if unit.refusal:
+                self.refuse(unit.refusal)
+            elif sub.params:
+                self.lowered(f"parameters of {key} passed as G65 arguments: " + ", ".join(
+                    f"{prm.name}={letter} (#{pl.ARG_LOCALS[letter]})"
+                    for prm, letter in zip(sub.params, unit.params)))
             self.nodes(sub.body)
+            if key in self.sub_numbers and not _ends(sub.body):
+                self.out.append("M99")
         if percent:
             self.out.append("%")
         return "\n".join(self.out) + "\n"
+
+    def _plan(self) -> None:
+        """Labels, locals and O numbers of every unit, before any jump or call is written."""
+        p = self.program
+        self.plans[None] = pl.unit_plan(None, p.body, self.fresh_label)
+        self.targets[None] = pl.jump_targets(p.body)
+        for key, sub in p.subprograms.items():
+            self.plans[key] = pl.unit_plan(sub, sub.body, self.fresh_label)
+            self.targets[key] = pl.jump_targets(sub.body)
+        if p.dialect == "iso-m":
+            return
+        taken = {pl.iso_number(k) for k in p.subprograms if pl.iso_number(k) is not None}
+        for key in p.subprograms:
+            if pl.iso_number(key) is None:
+                self.sub_numbers[key] = pl.stable_number(key, taken)
+                taken.add(self.sub_numbers[key])
+
+    def _callee(self, name: str):
+        """(O number, unit plan) of a subprogram of this program called by name, else None."""
+        for key in self.program.subprograms:
+            if key.upper() == name.upper():
+                num = self.sub_numbers.get(key, pl.iso_number(key))
+                return (num, self.plans[key]) if num is not None else None
+        return None
 
     @staticmethod
     def _program_word(name, number) -> Optional[str]:
@@ -241,14 +357,20 @@ class _Emitter:
             if type(node) is n.Block:
                 if node.number:
                     self.used_numbers.add(node.number.lstrip("0") or "0")
-            elif hasattr(node, "body"):
-                self._collect_numbers(node.body)
+            else:
+                for attr in ("then", "orelse", "body"):
+                    self._collect_numbers(getattr(node, attr, None) or [])
 
     # -------------------------------------------------------------- structure
     def nodes(self, nodes_) -> None:
         for node in nodes_:
             self.span = node.span
+            structure = type(node) is not n.Block
+            if structure:
+                self.forget()
             getattr(self, "s_" + type(node).__name__)(node)
+            if structure:
+                self.forget()
 
     @staticmethod
     def _comment(text: str) -> str:
@@ -268,10 +390,18 @@ class _Emitter:
         prefix = ""
         if b.skip is not None:
             prefix = "/" if b.skip == 0 else f"/{b.skip}"
+        targets = self.targets.get(self.unit, ())
+        if b.label or (b.number is not None and b.number in targets):
+            self.forget()
+        if b.label:
+            num = self.plans[self.unit].labels[b.label]
+            self.lowered(f"label {b.label} written as N{num}")
+            if b.number is None:
+                prefix += f"N{num} "
+            else:
+                self.out.append(f"N{num}")
         if b.number is not None:
             prefix += f"N{b.number} "
-        if b.label:
-            self.lowered(f"label {b.label} kept as a comment")
         lines = self.statements(b.body)
         comment = b.comment
         if b.label:
@@ -390,7 +520,10 @@ class _Emitter:
         t = str(target)
         if t.isdigit():
             return t
-        self.refuse(f"jump to label {t!r} (ISO jumps to N numbers)")
+        labels = self.plans[self.unit].labels if self.unit in self.plans else {}
+        if t in labels:
+            return labels[t]
+        self.refuse(f"jump to label {t!r} (no such label in this program unit)")
         return "0"
 
     # -------------------------------------------------------------- statements
@@ -403,6 +536,14 @@ class _Emitter:
                 self.refuse(f"{type(s).__name__}: {err}")
                 continue
             if not words:
+                continue
+            if type(words) is _Lines:
+                for group in words:
+                    line = _Line()
+                    lines.append(line)
+                    line.words.extend(w for _, w in group)
+                    line.used.update(k for k, _ in group if k)
+                lines.append(_Line())
                 continue
             line = lines[-1]
             keys = [k for k, _ in words if k]
@@ -426,6 +567,17 @@ class _Emitter:
     def w_ModeChange(self, s: n.ModeChange):
         if s.group == "distance":
             self.distance = s.value
+        elif s.group == "plane":
+            self.plane = s.value
+        elif s.group in ("units", "work_offset", "tool_length", "diameter", "cycle"):
+            self.pos = {}
+        if s.group == "motion":
+            self.cip_mode = s.value == "arc_3point"
+            if self.cip_mode:
+                return []                   # written as G2/G3 by the CIP block itself
+        if s.group == "work_offset" and s.value == "G53":
+            raise NotExpressible(f"work offset {s.code or 'G53'} (no settable offset): ISO has no modal "
+                                 "'no work offset', and G54 is the same only when its offset is zero")
         if s.group == "work_offset" and s.value.startswith("G54.1P"):
             return [("G:14", "G54.1"), ("P", "P" + s.value[6:])]
         if s.group == "work_offset" and s.value not in ("G54", "G55", "G56", "G57", "G58", "G59"):
@@ -444,19 +596,105 @@ class _Emitter:
             words.append((k, self.addr(k, av.value)))
         return words
 
+    def _track(self, s: n.Motion) -> None:
+        """The constant programmed end point, where the words say it."""
+        if s.polar or s.machine_coords:
+            for k in s.target:
+                self.pos.pop(k, None)
+            if s.polar:
+                self.pos = {}
+            return
+        for k, av in s.target.items():
+            v = pl.constant(av.value)
+            inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
+            if v is None or (inc and k not in self.pos):
+                self.pos.pop(k, None)
+            else:
+                self.pos[k] = self.pos[k] + v if inc else v
+
+    def _cip(self, s: n.Motion):
+        """A three-point arc as G2/G3 with the centre of the circle through start, via and end."""
+        a1, a2, a3 = pl.PLANE.get(self.plane, pl.PLANE["XY"])
+        if s.center or s.radius is not None or s.turns is not None or s.polar or s.machine_coords:
+            raise NotExpressible("a three-point arc (CIP) with centre, radius or turn words")
+        extra = (set(s.target) | set(s.via)) - {a1, a2, a3}
+        if extra:
+            raise NotExpressible(f"a three-point arc (CIP) moving {', '.join(sorted(extra))}")
+        start = dict(self.pos)
+
+        def point(words):
+            out = dict(start)
+            for k, av in words.items():
+                v = pl.constant(av.value)
+                inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
+                if v is None or (inc and k not in start):
+                    raise NotExpressible("a three-point arc (CIP) whose points are not constants")
+                out[k] = start[k] + v if inc else v
+            return out
+        mid, end = point(s.via), point(s.target)
+        if any(a not in start for a in (a1, a2)):
+            raise NotExpressible("a three-point arc (CIP) from a start point that is not a known constant")
+        if (a3 in s.via or a3 in s.target) and not (start.get(a3) == mid.get(a3) == end.get(a3)):
+            raise NotExpressible("a three-point arc (CIP) outside the working plane")
+        c = pl.circle_through((start[a1], start[a2]), (mid[a1], mid[a2]), (end[a1], end[a2]))
+        if c is None:
+            raise NotExpressible("a three-point arc (CIP) through collinear points")
+        c1, c2, cw = c
+        words = [self._g("motion", "arc_cw" if cw else "arc_ccw")]
+        for a in (a1, a2, a3):
+            if a in s.target or a != a3:
+                v = end[a] if self.distance != "incremental" else end[a] - start[a]
+                words.append((a, a + format_number(v + 0.0, True)))
+        for a, c_ in ((a1, c1), (a2, c2)):
+            letter = {"X": "I", "Y": "J", "Z": "K"}[a]
+            words.append((letter, letter + format_number(c_ - start[a] + 0.0, True)))
+        self.lowered(f"three-point arc (CIP) written as {words[0][1]} with its centre computed from "
+                     "the constant points")
+        self.pos.update({a: end[a] for a in (a1, a2, a3) if a in end})
+        return words
+
+    def _aperture_radius(self, s: n.Motion, start: dict) -> str:
+        """Opening angle AR= with an end point: the ISO R word of that arc (negative over 180 deg),
+        when the start, the end and the angle are constants."""
+        a1, a2, _ = pl.PLANE.get(self.plane, pl.PLANE["XY"])
+        ang = pl.constant(s.aperture)
+        if s.center or s.radius is not None or ang is None or not 0 < ang < 360:
+            raise NotExpressible("an arc by opening angle (AR=) with a centre or a computed angle")
+        if any(a not in start or a not in self.pos for a in (a1, a2)):
+            raise NotExpressible("an arc by opening angle (AR=) from or to a point that is not a constant")
+        chord = math.hypot(self.pos[a1] - start[a1], self.pos[a2] - start[a2])
+        r = chord / (2 * math.sin(math.radians(ang) / 2))
+        self.lowered("arc by opening angle (AR=) written with the radius R of that arc")
+        return format_number(-r if ang > 180 else r, True)
+
     def w_Motion(self, s: n.Motion):
         if s.via:
-            raise NotExpressible("a three-point arc (CIP)")
+            return self._cip(s)
+        if self.cip_mode and s.target:
+            raise NotExpressible("a three-point arc (CIP) without an intermediate point")
+        start = dict(self.pos)
+        self._track(s)
         if s.polar:
             raise NotExpressible("polar motion words")
         words = []
         if s.machine_coords:
             words.append(("", "G53"))
         words += self._axes(s.target)
+        if s.aperture is not None:
+            words.append(("R", "R" + self._aperture_radius(s, start)))
         if s.center:
             for k, av in s.center.items():
                 letter = {"X": "I", "Y": "J", "Z": "K"}.get(k, k)
-                words.append((letter, self.addr(letter, av.value)))
+                value = av.value
+                if av.mode == "abs":
+                    # an absolute centre (Sinumerik I=AC(..)) from the known constant start point
+                    axis = {"I": "X", "J": "Y", "K": "Z"}.get(k, k)
+                    c = pl.constant(value)
+                    if c is None or axis not in start:
+                        raise NotExpressible(f"an absolute arc centre {k} from an unknown start point")
+                    self.lowered(f"absolute arc centre {k} written incremental from the start point")
+                    value = n.Num(c - start[axis] + 0.0)
+                words.append((letter, self.addr(letter, value)))
         if s.radius is not None:
             words.append(("R", self.addr("R", s.radius)))
         if s.turns is not None:
@@ -481,9 +719,11 @@ class _Emitter:
         return [("T", self.addr("T", s.tool))]
 
     def w_ToolChange(self, s):
+        self.pos = {}
         return [("", "M6")]
 
     def w_OffsetSelect(self, s):
+        self.pos = {}
         letter = "H" if s.kind == "length" else "D"
         return [(letter, self.addr(letter, s.index))]
 
@@ -501,12 +741,15 @@ class _Emitter:
         return [("G:18", "G4"), ("X", "X" + self.val(sec))]
 
     def w_SetPosition(self, s):
+        self.pos = {}
         return [("G:18", "G92")] + self._axes(s.target)
 
     def w_ResetSetPosition(self, s):
+        self.pos = {}
         return [("G:18", "G92.1")]
 
     def w_HomeReturn(self, s):
+        self.pos = {}
         words = [("G:18", "G28" if s.ref == 1 else "G30")]
         modes = {av.mode for av in s.via.values()}
         if modes == {"inc"}:
@@ -527,9 +770,54 @@ class _Emitter:
             words.append(("P", self.addr("P", s.ref_index)))
         return words
 
+    def _frame_state(self, s: n.FrameOp) -> None:
+        """Follow the programmable frame as far as it is constant (source semantics: an op that is
+        not additive, local or pivoted replaces the whole frame)."""
+        self.pos = {}
+        if s.op == "all" and s.clear:
+            self.frame_trans, self.frame_other = {}, False
+        elif s.op == "trans":
+            if s.clear:
+                self.frame_trans = {}
+                return
+            vals = {k: pl.constant(v) for k, v in s.values.items()}
+            self.frame_trans = None if None in vals.values() else vals
+            if not s.local:
+                self.frame_other = False
+        elif not s.clear:
+            self.frame_other = True
+            if not s.local and s.center is None:
+                self.frame_trans = {}
+
+    def _additive_trans(self, s: n.FrameOp):
+        """ATRANS with no rotation, scale or mirror active: G52 with the accumulated shift."""
+        vals = {k: pl.constant(v) for k, v in s.values.items()}
+        if self.frame_trans is None or self.frame_other:
+            raise NotExpressible("an additive translation (ATRANS) where the frame is not a known plain shift")
+        if None in vals.values() or set(vals) - set("XYZ"):
+            raise NotExpressible("an additive translation (ATRANS) with computed values or non-XYZ axes")
+        total = dict(self.frame_trans)
+        for k, v in vals.items():
+            total[k] = total.get(k, 0.0) + v
+        self.frame_trans = total
+        self.pos = {}
+        self.lowered("additive translation (ATRANS) written as G52 with the accumulated shift")
+        return [("G:18", "G52")] + [(k, k + format_number(v + 0.0, True)) for k, v in total.items()]
+
     def w_FrameOp(self, s: n.FrameOp):
         if s.additive:
+            if s.op == "trans" and not s.clear:
+                return self._additive_trans(s)
             raise NotExpressible(f"an additive frame ({s.op})")
+        other = self.frame_other
+        self._frame_state(s)
+        if s.op == "all" and s.clear:
+            # the whole programmable frame off (Sinumerik TRANS/ROT without values): cancel the
+            # local shift, and rotation, scaling and mirroring when they may be active
+            words = [("G:18", "G52")] + [(k, k + "0.") for k in "XYZ"]
+            if other:
+                words += [("G:16", "G69"), ("G:11", "G50"), ("G:22", "G50.1")] + [(k, k + "0.") for k in "XYZ"]
+            return words
         if s.op == "trans":
             if s.clear:
                 return [("G:18", "G52")] + [(k, k + "0.") for k in "XYZ"]
@@ -577,6 +865,7 @@ class _Emitter:
         return self.val(v)
 
     def w_CycleParams(self, s: n.CycleParams):
+        self.pos = {}
         words = []
         letters = {"r_plane": "R", "peck": "Q", "shift": "Q", "repeat": "K"}
         for key, v in s.values.items():
@@ -597,6 +886,15 @@ class _Emitter:
         raise NotExpressible(f"the cycle call {s.name or s.kind} (expand cycles first)")
 
     def w_SubCall(self, s: n.SubCall):
+        self.forget()
+        callee = None
+        if self.program.dialect != "iso-m" and s.name and pl.iso_number(s.name) is None:
+            callee = self._callee(s.name)
+            if callee is None:
+                raise NotExpressible(f"a call of {s.name!r}: it is not in this program, so it has no "
+                                     "O number here")
+        if callee is not None:
+            return self._named_call(s, *callee)
         kind = s.kind if s.kind in ("m98", "g65", "g66") else ("g66" if s.modal != "none" else "m98")
         if kind != s.kind:
             self.lowered(f"call of {s.name} written as {kind.upper()}")
@@ -635,6 +933,27 @@ class _Emitter:
             for letter in "IJK":
                 if letter in sets[i]:
                     words.append(("", self.addr(letter, sets[i][letter])))
+        return words
+
+    def _named_call(self, s: n.SubCall, number: int, unit: pl.UnitPlan):
+        """A call by name of a subprogram of this program: M98/G65/G66 P<its O number>; positional
+        arguments become the G65 letters its parameters were given."""
+        if unit.refusal:
+            raise NotExpressible(unit.refusal)
+        if len(s.args) > len(unit.params):
+            raise NotExpressible(f"{len(s.args)} arguments to {s.name}, which takes {len(unit.params)}")
+        if s.named_args:
+            raise NotExpressible(f"named arguments of the call to {s.name}")
+        if s.modal != "none":
+            kind = "G66"
+        else:
+            kind = "G65" if unit.uses_locals else "M98"
+        words = [("G:12" if kind == "G66" else "", kind), ("P", f"P{number}")]
+        if s.repeat is not None:
+            words.append(("L", "L" + self.val(s.repeat)))
+        for letter, arg in zip(unit.params, s.args):
+            words.append(("", self.addr(letter, arg)))
+        self.lowered(f"call of {s.name} written as {kind} P{number}")
         return words
 
     def w_ModalCallOff(self, s):
@@ -676,17 +995,46 @@ class _Emitter:
         return [("#3000", f"#3000={num}{text}")]
 
     def w_VarDecl(self, s: n.VarDecl):
-        if s.dims:
-            raise NotExpressible(f"the array {s.name}")
         if s.type in ("STRING", "CHAR", "FRAME", "AXIS"):
             raise NotExpressible(f"a {s.type} variable {s.name}")
+        if s.dims:
+            return self._array(s)
         var = n.Var("name", s.name)
+        local = self.plans[self.unit].locals.get(s.name.upper()) if self.unit in self.plans else None
+        if local is not None:
+            # a G65 local starts vacant; DEF starts at its initial value or 0
+            init = s.init[0] if s.init else n.Num(0.0)
+            self.lowered(f"local variable {s.name} written as #{local}")
+            return [("#", f"#{local}={format_expr(init, self)}")]
         if s.init:
             return [("#", f"{self.val(var)}={format_expr(s.init[0], self)}")]
         self.map_var(var)
         return []
 
+    def _array(self, s: n.VarDecl):
+        """A numeric array: a row-major block of common variables, every element set (DEF sets
+        them to their initial values or 0; commons keep old values across runs)."""
+        dims = list(s.dims)
+        if not dims or any(not isinstance(d, int) or d <= 0 for d in dims):
+            raise NotExpressible(f"the array {s.name} without constant dimensions")
+        size = 1
+        for d in dims:
+            size *= d
+        base = self.next_array
+        if base + size - 1 > pl.COMMON_END:
+            raise NotExpressible(f"the array {s.name} ({size} elements): no room left in #500-#999")
+        init = list(s.init or [])
+        if len(init) > size:
+            raise NotExpressible(f"{len(init)} initial values for the array {s.name} of {size}")
+        self.next_array += size
+        self.arrays[(self.unit, s.name.upper())] = pl.ArrayPlan(base, dims)
+        self.lowered(f"array {s.name}[{','.join(map(str, dims))}] stored row-major in "
+                     f"#{base}..#{base + size - 1}")
+        return _Lines([[("#", f"#{base + i}={format_expr(init[i] if i < len(init) else n.Num(0.0), self)}")]
+                       for i in range(size)])
+
     def w_Passthrough(self, s: n.Passthrough):
+        self.forget()
         if s.dialect not in ("", "iso-m"):
             raise NotExpressible(f"{s.dialect} text {s.text!r}")
         return [("", s.text)]
@@ -704,6 +1052,16 @@ class _Emitter:
         elif "value" in s.values:
             words.append(("R", self.addr("R", s.values["value"])))
         return words
+
+
+def _ends(body) -> bool:
+    """Whether a unit's last block returns or ends the program (else the O block needs M99)."""
+    for node in reversed(body):
+        if type(node) is not n.Block:
+            return False
+        if node.body:
+            return any(type(s) in (n.Return, n.ProgramEnd) for s in node.body)
+    return False
 
 
 def _same(values) -> bool:

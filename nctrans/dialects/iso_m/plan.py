@@ -1,0 +1,216 @@
+"""What the ISO emitter decides about a program before writing a line of it.
+
+ISO has no names: labels become N numbers, named subprograms O numbers, PROC parameters G65
+argument locals (#1..#33), declared arrays blocks of common variables. These maps must exist
+before the first GOTO or call is written (a jump may go forward), so they are computed here in
+one pass over the whole program. Also the geometry the emitter needs to turn a three-point arc
+(Sinumerik CIP) into a centre-format arc.
+"""
+from __future__ import annotations
+
+import math
+import re
+import zlib
+from dataclasses import dataclass, field
+from typing import Optional
+
+from nctrans.ir import nodes as n
+
+# G65 Type I letters for PROC parameters in order, and the local each one lands in (spec §1.8.1).
+# I/J/K are left out (their Type II repetition makes the order ambiguous), G L N O P are not arguments.
+ARG_LETTERS = "ABCDEFHMQRSTUVWXYZ"
+ARG_LOCALS = {"A": 1, "B": 2, "C": 3, "D": 7, "E": 8, "F": 9, "H": 11, "M": 13, "Q": 17, "R": 18,
+              "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24, "Y": 25, "Z": 26}
+LOCALS = range(1, 34)
+COMMON_END = 999                 # last common variable of the #500 block
+PLANE = {"XY": ("X", "Y", "Z"), "ZX": ("Z", "X", "Y"), "YZ": ("Y", "Z", "X")}
+_ISO_NUMBER = re.compile(r"O?\d+$", re.I)
+
+
+def iso_number(name: str) -> Optional[int]:
+    """The O number a name already is ("O1000", "1000"), or None for a name."""
+    return int(name.lstrip("Oo")) if _ISO_NUMBER.match(name or "") else None
+
+
+def stable_number(name: str, taken: set[int]) -> int:
+    """O9000..O9999 from the name alone (the same name gets the same number in every file that
+    defines it), the next free one on a clash within this program."""
+    num = 9000 + zlib.crc32(name.upper().encode()) % 1000
+    while num in taken:
+        num = 9000 + (num - 9000 + 1) % 1000
+    return num
+
+
+@dataclass
+class ArrayPlan:
+    base: int
+    dims: list[int]
+
+    @property
+    def size(self) -> int:
+        return math.prod(self.dims)
+
+
+@dataclass
+class UnitPlan:
+    """One program unit (main program or subprogram): its labels and its locals."""
+    labels: dict[str, str] = field(default_factory=dict)        # label -> N number
+    locals: dict[str, int] = field(default_factory=dict)        # param/DEF name -> #n
+    params: list[str] = field(default_factory=list)             # G65 letter per parameter
+    uses_locals: bool = False                                   # called with G65 (own local level)
+    refusal: Optional[str] = None                               # why its calls cannot be written
+
+
+def walk(nodes_):
+    """Every Block of a node list, in source order, with the structures' bodies."""
+    for node in nodes_:
+        if type(node) is n.Block:
+            yield node
+        for attr in ("then", "orelse", "body"):
+            sub = getattr(node, attr, None)
+            if sub and type(node) is not n.Block:
+                yield from walk(sub)
+
+
+def jump_targets(nodes_) -> set[str]:
+    """Block numbers and labels some jump in this unit can reach (positions are unknown there)."""
+    out: set[str] = set()
+
+    def scan(ns):
+        for node in ns:
+            if type(node) is n.Case:
+                out.update(str(lbl) for _, lbl in node.branches)
+                if node.default is not None:
+                    out.add(str(node.default))
+            elif type(node) is n.Block:
+                for s in node.body:
+                    if type(s) is n.Goto:
+                        out.add(str(s.target))
+            for attr in ("then", "orelse", "body"):
+                sub = getattr(node, attr, None)
+                if sub and type(node) is not n.Block:
+                    scan(sub)
+    scan(nodes_)
+    return out
+
+
+def circle_through(p1, p2, p3) -> Optional[tuple[float, float, bool]]:
+    """Centre (c1, c2) and clockwise flag of the circle through three plane points, or None when
+    they are collinear (no arc)."""
+    (x1, y1), (x2, y2), (x3, y3) = p1, p2, p3
+    den = 2 * (x1 * (y2 - y3) + x2 * (y3 - y1) + x3 * (y1 - y2))
+    if abs(den) < 1e-12:
+        return None
+    s1, s2, s3 = x1 * x1 + y1 * y1, x2 * x2 + y2 * y2, x3 * x3 + y3 * y3
+    cx = (s1 * (y2 - y3) + s2 * (y3 - y1) + s3 * (y1 - y2)) / den
+    cy = (s1 * (x3 - x2) + s2 * (x1 - x3) + s3 * (x2 - x1)) / den
+    cw = ((x2 - x1) * (y3 - y2) - (y2 - y1) * (x3 - x2)) < 0
+    return cx, cy, cw
+
+
+def constant(e) -> Optional[float]:
+    """The value of a constant expression (numbers and + - * / only), else None."""
+    t = type(e)
+    if t is n.Num:
+        return e.value
+    if t is n.Unary and e.op in ("-", "+"):
+        v = constant(e.operand)
+        return None if v is None else (-v if e.op == "-" else v)
+    if t is n.Binary and e.op in ("+", "-", "*", "/"):
+        a, b = constant(e.left), constant(e.right)
+        if a is None or b is None or (e.op == "/" and b == 0):
+            return None
+        return {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else 0.0}[e.op]
+    return None
+
+
+def max_r_used(program: n.Program) -> tuple[int, bool]:
+    """Highest constant R number the program uses, and whether any R is indexed by an expression."""
+    top, dynamic = -1, False
+
+    def expr(e):
+        nonlocal top, dynamic
+        if e is None:
+            return
+        if type(e) is n.Var:
+            if e.space == "R":
+                if isinstance(e.key, int):
+                    top = max(top, e.key)
+                else:
+                    dynamic = True
+            for i in e.indices or ():
+                expr(i)
+        elif type(e) is n.Binary:
+            expr(e.left)
+            expr(e.right)
+        elif type(e) is n.Unary:
+            expr(e.operand)
+        elif type(e) is n.Func:
+            for a in e.args:
+                expr(a)
+        elif type(e) is n.AxisValue:
+            expr(e.value)
+        elif isinstance(e, dict):
+            for v in e.values():
+                expr(v)
+        elif isinstance(e, list):
+            for v in e:
+                expr(v)
+        elif hasattr(e, "__slots__") and not isinstance(e, (n.Num, n.Str)):
+            for f in e.__slots__:
+                expr(getattr(e, f, None))
+
+    units = [program.body] + [s.body for s in program.subprograms.values()]
+    for body in units:
+        for node in _all_nodes(body):
+            if type(node) is n.Block:
+                for s in node.body:
+                    expr(s)
+            else:
+                for attr in ("cond", "subject", "start", "end", "step", "var"):
+                    expr(getattr(node, attr, None))
+    return top, dynamic
+
+
+def _all_nodes(nodes_):
+    for node in nodes_:
+        yield node
+        for attr in ("then", "orelse", "body"):
+            sub = getattr(node, attr, None)
+            if sub and type(node) is not n.Block:
+                yield from _all_nodes(sub)
+
+
+def unit_plan(sub: Optional[n.Subprogram], body, fresh_number) -> UnitPlan:
+    """Labels -> fresh N numbers; for a subprogram, parameters -> G65 letters/locals and its DEF
+    scalars -> the locals left over (a G65 call gives the body its own local level)."""
+    plan = UnitPlan()
+    for b in walk(body):
+        if b.label and b.label not in plan.labels:
+            plan.labels[b.label] = fresh_number()
+    if sub is None:
+        return plan
+    decls = [s for b in walk(body) for s in b.body if type(s) is n.VarDecl and not s.dims]
+    if not sub.params and not decls:
+        return plan
+    plan.uses_locals = True
+    if len(sub.params) > len(ARG_LETTERS):
+        plan.refusal = f"{len(sub.params)} parameters of {sub.name} (G65 passes {len(ARG_LETTERS)})"
+        return plan
+    for p, letter in zip(sub.params, ARG_LETTERS):
+        if p.by_ref:
+            plan.refusal = f"the by-reference (VAR) parameter {p.name} of {sub.name}"
+        elif p.dims:
+            plan.refusal = f"the array parameter {p.name} of {sub.name}"
+        plan.params.append(letter)
+        plan.locals[p.name.upper()] = ARG_LOCALS[letter]
+    free = [i for i in LOCALS if i not in plan.locals.values()]
+    for d in decls:
+        key = d.name.upper()
+        if key in plan.locals:
+            continue
+        if not free:
+            plan.refusal = f"more than 33 parameters and local variables in {sub.name}"
+            break
+        plan.locals[key] = free.pop(0)
+    return plan
