@@ -75,7 +75,8 @@ def _axes(d: dict) -> str:
         f = "{" + ",".join('"%s":%%s' % k.replace("%", "%%") for k in keys) + "}"
         if len(_AXES_FORMAT) < 1024:
             _AXES_FORMAT[keys] = f
-    return f % tuple([_spell(v) for v in d.values()])
+    get = _SPELLED.get
+    return f % tuple([get(v) or _spell(v) for v in d.values()])
 
 
 _FILE_JSON: dict[str, str] = {}

@@ -1372,7 +1372,11 @@ class Interpreter:
                         if batch:
                             code.clear()
                             main.labels.clear()
-                            self._emit_nodes(batch, main)
+                            if all(type(x) is n.Block for x in batch):
+                                # straight blocks: no labels to index (nothing jumps)
+                                code.extend([(BLOCK, None, x, x.span) for x in batch])
+                            else:
+                                self._emit_nodes(batch, main)
                             main.seen = bytearray(len(code))
                             pc = sidx = 0
                             continue
