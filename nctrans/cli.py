@@ -157,16 +157,6 @@ def _flatten(program, machine, diags: list[Diagnostic], ld: pipeline.Loaded):
     return result
 
 
-def _strict(diags: list[Diagnostic]) -> list[Diagnostic]:
-    out = []
-    for d in diags:
-        if d.rule == "NC401" and d.severity != "error":
-            d = Diagnostic(d.rule, "error", f"{d.message} (refused by --strict)", d.file, d.line, d.column,
-                           d.end_line, d.end_column, d.fix)
-        out.append(d)
-    return out
-
-
 def cmd_convert(args) -> int:
     _check_dialect(args.from_)
     target = pipeline.get_dialect(args.to)
@@ -225,14 +215,17 @@ def cmd_convert(args) -> int:
         diags = ld.diagnostics
         text = None
         if ld.program is not None and not _at_or_above(diags, "error"):
+            from nctrans.convert import convert
             program = ld.program
-            if args.flatten:
-                program = _flatten(program, machine or pipeline.load_machine(None, ld.dialect), diags, ld)
-            res = target.emit(program)
-            diags.extend(res.diagnostics)
-            text = res.text
-        if args.strict:
-            diags[:] = _strict(diags)
+            flat_machine = machine or pipeline.load_machine(None, ld.dialect)
+            result = convert(
+                program, target, flatten=args.flatten, strict_mode=args.strict,
+                flatten_with=lambda into, p=program, m=flat_machine, l=ld: _flatten(p, m, into, l))
+            diags.extend(result.diagnostics)
+            text = result.text
+        elif args.strict:
+            from nctrans.convert import strict
+            diags[:] = strict(diags)
         _print_text_diags(diags, sys.stderr)
         if text is None or _at_or_above(diags, "error"):
             _err(f"{ld.label}: not converted (errors above)")

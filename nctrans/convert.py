@@ -18,7 +18,7 @@ from typing import Callable, Optional
 
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import Dialect
-from nctrans.ir.nodes import Program
+from nctrans.ir.nodes import Block, Program
 
 
 @dataclass
@@ -38,6 +38,27 @@ def _as_lowering(d: Diagnostic, target: str) -> Diagnostic:
                       f"motion (as with --flatten)", d.file, d.line, d.column, d.end_line, d.end_column)
 
 
+def _library_entry(program: Program) -> Optional[str]:
+    """The subprogram a file exists to define (a Sinumerik PROC file), when its main body does
+    nothing of its own: such a file has no toolpath until something calls it, so lowering it to
+    plain motion would silently produce an empty program."""
+    entry = program.meta.get("entry") if program.meta else None
+    if not entry or entry not in program.subprograms:
+        return None
+    for node in program.body:
+        if not isinstance(node, Block) or node.body:
+            return None
+    return str(entry)
+
+
+def _library_refusal(program: Program, entry: str, target: str) -> Diagnostic:
+    sub = program.subprograms[entry]
+    return Diagnostic("NC402", "error",
+                      f"{entry} is a subprogram library with no main program: it cannot be lowered to "
+                      f"plain motion for {target} on its own; convert the programs that call it "
+                      f"(with --flatten) instead", sub.span.file, sub.span.line, sub.span.col)
+
+
 def strict(diags: list[Diagnostic]) -> list[Diagnostic]:
     """--strict: every lowering (NC401) becomes an error."""
     out = []
@@ -55,12 +76,18 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
     (it closes over the machine and the subprogram resolver); None when lowering is unavailable."""
     diags: list[Diagnostic] = []
     flattened = False
+    library = _library_entry(program)
+    if flatten and library is not None:
+        return Conversion(None, [_library_refusal(program, library, target.name)])
     if flatten and flatten_with is not None:
         program = flatten_with(diags)
         flattened = True
     result = target.emit(program)
     refusals = [d for d in result.diagnostics if _is_refusal(d)]
-    if refusals and not flattened and flatten_with is not None and not strict_mode:
+    if refusals and library is not None:
+        diags.extend(result.diagnostics)
+        diags.append(_library_refusal(program, library, target.name))
+    elif refusals and not flattened and flatten_with is not None and not strict_mode:
         lowered = [_as_lowering(d, target.name) for d in refusals]
         flat_diags: list[Diagnostic] = []
         flat = flatten_with(flat_diags)

@@ -311,8 +311,12 @@ def test_convert_lowering_strict_and_refusal(fake, capsys):
     assert rc == 0 and out and "info[NC401]" in err
     rc, out, err = run(capsys, "convert", "l.fk", "--to", "fake", "--strict", "-o", "l.out")
     assert rc == 1 and out == "" and "error[NC401]" in err and not Path("l.out").exists()
+    # a construct the target cannot express: the program is lowered to plain motion (NC401 at the
+    # construct's line), and --strict refuses instead
     Path("r.fk").write_text("G0 X1 (REFUSE)\n")
     rc, out, err = run(capsys, "convert", "r.fk", "--to", "fake")
+    assert rc == 0 and out and "r.fk:1:1: info[NC401]" in err and "lowered to plain motion" in err
+    rc, out, err = run(capsys, "convert", "r.fk", "--to", "fake", "--strict")
     assert rc == 1 and out == "" and "NC402" in err and "not converted" in err
 
 

@@ -174,6 +174,7 @@ class _Emitter:
         # approach from other dialects) can be followed by the G90 that restores it
         self.distance = "absolute"
         self.restore_absolute = False
+        self.arc_distance = "incremental"
         # the plan: labels, locals and O numbers per unit (None = the main program)
         self.unit: Optional[str] = None
         self.plans: dict[Optional[str], pl.UnitPlan] = {}
@@ -191,13 +192,17 @@ class _Emitter:
         self.frame_other = False
 
     # -------------------------------------------------------------- reporting
+    def _where(self):
+        """The current block's span, or the program's first line outside any block."""
+        return self.span if self.span is not None else n.Span(self.program.file, 1)
+
     def lowered(self, what: str) -> None:
-        self.diags.append(at_span("NC401", "info", f"lowered for ISO: {what}", self.span))
+        self.diags.append(at_span("NC401", "info", f"lowered for ISO: {what}", self._where()))
 
     def refuse(self, what: str) -> None:
         line = self.span.line if self.span is not None else 1
         self.diags.append(at_span("NC402", "error",
-                                  f"ISO milling cannot express {what} (source line {line})", self.span))
+                                  f"ISO milling cannot express {what} (source line {line})", self._where()))
 
     def forget(self) -> None:
         """A place reached from elsewhere (jump target, structure, call): positions and the
@@ -567,6 +572,8 @@ class _Emitter:
     def w_ModeChange(self, s: n.ModeChange):
         if s.group == "distance":
             self.distance = s.value
+        if s.group == "arc_distance":       # under G90.1 ISO writes absolute centres as they are
+            self.arc_distance = s.value
         elif s.group == "plane":
             self.plane = s.value
         elif s.group in ("units", "work_offset", "tool_length", "diameter", "cycle"):
@@ -686,7 +693,7 @@ class _Emitter:
             for k, av in s.center.items():
                 letter = {"X": "I", "Y": "J", "Z": "K"}.get(k, k)
                 value = av.value
-                if av.mode == "abs":
+                if av.mode == "abs" and self.arc_distance != "absolute":
                     # an absolute centre (Sinumerik I=AC(..)) from the known constant start point
                     axis = {"I": "X", "J": "Y", "K": "Z"}.get(k, k)
                     c = pl.constant(value)
