@@ -27,3 +27,20 @@ def test_machine_position_includes_the_work_offset():
 def test_unknown_axis_system_variable_is_flagged_not_fatal():
     moves, diags = _run("G0 X1\nR1=$AA_XYZ[X]\nG1 X=R1 F100\nM30\n")
     assert any(d.rule == "NC107" for d in diags)
+
+
+def test_tool_selected_by_name_gets_the_machine_tool_with_that_name():
+    from nctrans.machine import Tool
+    machine = Machine(tools=[Tool(number=7, length=0.0, radius=1.0, name="DRILL")])
+    program = get("sinumerik").parse('T="DRILL" M6\nG0 X1\nM30\n', "t.mpf").program
+    diags: list = []
+    changes = [r.tool for r in interpret(program, machine, diagnostics=diags) if r.kind == "tool_change"]
+    assert changes == [7] and not diags
+
+
+def test_unknown_tool_name_is_numbered_once_and_reported():
+    program = get("sinumerik").parse('T="A" M6\nT="B" M6\nT="A" M6\nM30\n', "t.mpf").program
+    diags: list = []
+    changes = [r.tool for r in interpret(program, None, diagnostics=diags) if r.kind == "tool_change"]
+    assert changes[0] == changes[2] != changes[1]
+    assert [d.rule for d in diags] == ["NC107", "NC107"]

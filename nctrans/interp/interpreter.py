@@ -598,9 +598,28 @@ class Interpreter:
         return (self._h_tool, self.ev.compile(s.tool))
 
     def _h_tool(self, f):
-        v = self._value(f, "tool number")
+        raw = f()
+        if isinstance(raw, str):          # Sinumerik tool management: T="DRILL"
+            self.st.tool_selected = self._named_tool(raw)
+            return
+        v = self._value(lambda: raw, "tool number")
         if v is not None:
             self.st.tool_selected = int(round(v))
+
+    def _named_tool(self, name: str) -> int:
+        """The number of a tool selected by name: the machine's tool with that `name`, else a
+        stable number of its own above the machine's tools (reported once as NC107)."""
+        key = name.strip().upper()
+        numbers = self.__dict__.setdefault("_tool_names", {})
+        if key not in numbers:
+            tools = getattr(self.machine, "tools", None) or []
+            match = next((t.number for t in tools if str(getattr(t, "name", "")).upper() == key), None)
+            if match is None:
+                match = max([t.number for t in tools] + [999] + list(numbers.values())) + 1
+                self.diag("NC107", "info", f"tool {name!r} is not named in the machine's tool table; "
+                          f"analysed as tool {match} with no geometry")
+            numbers[key] = match
+        return numbers[key]
 
     def _h_toolchange(self, s):
         st = self.st
