@@ -76,6 +76,7 @@ class _State:
     cycle_params: dict = field(default_factory=dict)
     cycle_pending: bool = False
     cycle_active: bool = False
+    cycle_call: str = ""                    # the active cycle call text, for holes at the current position
     cycle_init: Optional[float] = None      # ISO initial level when known statically
     known: dict = field(default_factory=dict)   # axis -> last programmed value when constant
 
@@ -513,9 +514,14 @@ class Emitter:
             if name in ("CYCLE82", "CYCLE89"):
                 args += ["", self.expr(p.get("dwell", ir.Num(0.0)))]
             self.info("cycle", "ISO canned cycle written as MCALL of the Siemens standard cycle")
-            out.alone(f"MCALL {name}({', '.join(args)})".replace(", ,", ",,"))
+            st.cycle_call = f"{name}({', '.join(args)})".replace(", ,", ",,")
+            out.alone("MCALL " + st.cycle_call)
             st.cycle_pending, st.cycle_active = False, True
         words = ["G0"] + [self.axis(a, v) for a, v in pos.items()]
+        if not pos:
+            # ISO drills at the current position when the block moves nothing in the plane; an
+            # MCALL only fires on a block that moves, so call the cycle once, here
+            words = [st.cycle_call]
         n = 1
         rep = st.cycle_params.get("repeat")
         if isinstance(rep, ir.Num):
