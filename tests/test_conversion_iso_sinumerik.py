@@ -73,9 +73,7 @@ def _motions(records) -> list[h.Motion]:
 
 @pytest.fixture(scope="session")
 def zero_table(rs274_cache) -> Path:
-    # 1000+: the numbers nctrans gives tools selected by name (T="DRILL") absent from the machine
-    tools = [*range(1, 100), *range(1000, 1010)]
-    return h.write_tool_table(rs274_cache / "conv-zero.tbl", [(i, 0.0, 0.0) for i in tools])
+    return h.write_tool_table(rs274_cache / "conv-zero.tbl", [(i, 0.0, 0.0) for i in range(1, 100)])
 
 
 @pytest.fixture(scope="session")

@@ -34,7 +34,8 @@ from typing import Any, Callable, Iterator, Optional
 
 from nctrans.diagnostics import at_span
 from nctrans.interp import arcs
-from nctrans.interp.evaluate import UNKNOWN, EvalError, Evaluator, Scope, constant
+from nctrans.interp.evaluate import (UNKNOWN, EvalError, Evaluator, FrameValue, Scope,
+                                     constant)
 from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.state import LINEAR_AXES, ModalState
 from nctrans.ir import nodes as n
@@ -87,8 +88,9 @@ def program_key(name: str) -> str:
 
 
 class Unit:
-    """A compiled program body: instructions, label positions, parameters."""
-    __slots__ = ("name", "code", "labels", "params", "file", "seen")
+    """A compiled program body: instructions, label positions, parameters.
+    save: the subprogram has the SAVE attribute (modal G codes and frames restored on return)."""
+    __slots__ = ("name", "code", "labels", "params", "file", "seen", "save")
 
     def __init__(self, name: str, file: str, params: list):
         self.name = name
@@ -97,15 +99,36 @@ class Unit:
         self.labels: dict[Any, list[int]] = {}
         self.params = params
         self.seen = bytearray()
+        self.save = False
 
 
 class Frame:
-    """A call-stack entry: where to resume in the caller, and how to repeat the callee."""
-    __slots__ = ("unit", "pc", "sidx", "scope", "callee", "repeats", "args", "make_scope", "modal")
+    """A call-stack entry: where to resume in the caller, and how to repeat the callee.
+    saved: the caller's modal state and frames, restored on return from a SAVE subprogram."""
+    __slots__ = ("unit", "pc", "sidx", "scope", "callee", "repeats", "args", "make_scope", "modal",
+                 "saved")
 
-    def __init__(self, unit, pc, sidx, scope, callee, repeats, make_scope, modal=False):
+    def __init__(self, unit, pc, sidx, scope, callee, repeats, make_scope, modal=False, saved=None):
         self.unit, self.pc, self.sidx, self.scope = unit, pc, sidx, scope
         self.callee, self.repeats, self.make_scope, self.modal = callee, repeats, make_scope, modal
+        self.saved = saved
+
+
+# Modal groups a SAVE subprogram does not restore: not G codes (spindle, coolant, tool length),
+# or state whose restoring mid-path would need its own approach (cutter compensation, cycles).
+NOT_SAVED_GROUPS = frozenset(("spindle", "coolant", "tool_length", "cutter_comp", "cycle"))
+SAVED_ATTRS = ("motion", "plane", "incremental", "arc_absolute", "scale", "feed_mode",
+               "work_offset", "cycle_retract")
+
+
+def copy_frame(src: ProgrammableFrame, dst: Optional[ProgrammableFrame] = None) -> ProgrammableFrame:
+    """A copy of a programmable frame (dicts copied, tuples shared), or `src` copied into `dst`."""
+    if dst is None:
+        dst = ProgrammableFrame.__new__(ProgrammableFrame)
+    for slot in ProgrammableFrame.__slots__:
+        v = getattr(src, slot)
+        setattr(dst, slot, dict(v) if type(v) is dict else v)
+    return dst
 
 
 class _Stop(Exception):
@@ -114,7 +137,7 @@ class _Stop(Exception):
 
 class Interpreter:
     def __init__(self, program: n.Program, machine=None, *, diagnostics: list, resolver=None,
-                 max_steps: int = 2_000_000, flatten_hook=None):
+                 max_steps: int = 2_000_000, flatten_hook=None, preload=()):
         if machine is None:
             from nctrans.machine import default_mill
             machine = default_mill()
@@ -158,6 +181,25 @@ class Interpreter:
         self.stack: list[Frame] = []
         self.span: Optional[n.Span] = None
         self._register_system()
+        for prog in preload or ():
+            self._preload(prog)
+
+    def _preload(self, prog: n.Program) -> None:
+        """Run the declarations of a definition file (Sinumerik GUD *.DEF) as global variables
+        before the program starts. Their own errors belong to that file's lint, not this run."""
+        ev = self.ev
+        stack = list(prog.body)
+        for sub in (prog.subprograms or {}).values():
+            stack.extend(sub.body)
+        for node in stack:
+            if type(node) is not n.Block:
+                continue
+            for st in node.body:
+                if type(st) is n.VarDecl:
+                    try:
+                        ev.declare(st, scope="global")
+                    except EvalError:
+                        pass
 
     # ================================================================ diagnostics
     def diag(self, rule: str, severity: str, message: str, span=None) -> None:
@@ -242,11 +284,25 @@ class Interpreter:
     def _compile_block(self, block: n.Block) -> list:
         out = []
         comp = self.compilers
+        trigger = False
         for s in block.body:
             c = comp.get(type(s))
             if c is not None:
                 out.append(c(s))
+            t = type(s)
+            if (t is n.ModeChange and s.group == "motion" and s.value in ("rapid", "linear")) or \
+                    t is n.Feed or t is n.SpindleSpeed:
+                trigger = True
+        if trigger:
+            out.append((self._h_mcall_trigger, None))
         return out
+
+    def _h_mcall_trigger(self, _):
+        """Sinumerik MCALL also calls after a block without path motion that programs G0/G1, or S
+        or F while G0/G1 is active (seed L5076-5080); ISO G66 calls after moves only."""
+        mc = self.modal_call
+        if mc is not None and mc[0].kind == "mcall" and self.st.motion in ("rapid", "linear"):
+            self.moved = True
 
     def _cond(self, expr) -> Callable[[], Any]:
         f = self.ev.compile(expr)
@@ -615,7 +671,7 @@ class Interpreter:
             tools = getattr(self.machine, "tools", None) or []
             match = next((t.number for t in tools if str(getattr(t, "name", "")).upper() == key), None)
             if match is None:
-                match = max([t.number for t in tools] + [999] + list(numbers.values())) + 1
+                match = max([t.number for t in tools] + [0] + list(numbers.values())) + 1
                 self.diag("NC107", "info", f"tool {name!r} is not named in the machine's tool table; "
                           f"analysed as tool {match} with no geometry")
             numbers[key] = match
@@ -669,7 +725,14 @@ class Interpreter:
         self._record("dwell", dwell_s=t)
 
     def _c_assign(self, s: n.Assign):
+        v = s.value
+        if type(v) is n.Func and v.name.upper() in ("SET", "REP") and s.target.indices:
+            return (self._h_exec, self.ev.compile_assign(s.target, v))
         return (self._h_assign, (self.ev.compile_store(s.target), self.ev.compile(s.value)))
+
+    @staticmethod
+    def _h_exec(f):
+        f()
 
     def _h_assign(self, d):
         put, f = d
@@ -1287,6 +1350,27 @@ class Interpreter:
             mend[a] = 0.0
         self._move("rapid", self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()}))
 
+    def _set_pframe(self, value: Any) -> None:
+        """$P_PFRAME = frame: the programmable frame becomes `value`, each step acting as the
+        frame instruction it stands for: the first replaces (TRANS/ROT/SCALE/MIRROR), the
+        following ones add in the system it produced (ATRANS/AROT/ASCALE/AMIRROR)."""
+        if value is UNKNOWN:
+            self.diag("NC107", "info", "$P_PFRAME is assigned a frame unknown at analysis time; "
+                      "the programmable frame is kept")
+            return
+        if not isinstance(value, FrameValue):
+            raise EvalError("NC104", "$P_PFRAME needs a frame (CTRANS(..), a FRAME variable)")
+        self.frame.clear()
+        first = True
+        for step in value.steps:
+            op, vals = step
+            if op == "state":
+                copy_frame(vals, self.frame)
+            else:
+                self._h_frame(n.FrameOp(op, {a: n.Num(v) for a, v in vals}, additive=not first))
+            first = False
+        self._resync()
+
     # ---------------------------------------------------------------- calls
     def _h_call(self, s: n.SubCall):
         if s.modal == "after_move":
@@ -1298,8 +1382,12 @@ class Interpreter:
         self.modal_call = None
         self.modal_cycle = None
 
-    def _call_args(self, s: n.SubCall) -> tuple[list, dict]:
-        pos = [self.ev.compile(e)() for e in s.args]
+    def _call_args(self, s: n.SubCall, params: Optional[list] = None) -> tuple[list, dict]:
+        """Argument values; a VAR (by_ref) parameter of the callee gets a reference instead."""
+        byref = [bool(getattr(p, "by_ref", False)) for p in params or ()]
+        ev = self.ev
+        pos = [ev.make_ref(e) if i < len(byref) and byref[i] else ev.compile(e)()
+               for i, e in enumerate(s.args)]
         named = {k.upper(): self.ev.compile(e)() for k, e in s.named_args.items()}
         # ISO-style call arguments are in program units; they are passed as written
         return pos, named
@@ -1325,7 +1413,9 @@ class Interpreter:
         if hit is None:
             return None
         sub, file = hit
-        return self.unit_for(id(sub), sub.name, sub.body, file, sub.params)
+        unit = self.unit_for(id(sub), sub.name, sub.body, file, sub.params)
+        unit.save = any(str(a).upper() == "SAVE" for a in (sub.attrs or ()))
+        return unit
 
     def _make_scope(self, s: n.SubCall, unit: Unit, args: tuple) -> Callable[[], Scope]:
         pos, named = args
@@ -1357,6 +1447,8 @@ class Interpreter:
             sysv[5001 + i] = (lambda a=a: self.pos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
             sysv[5041 + i] = sysv[5001 + i]
             sysv[5021 + i] = (lambda a=a: self.mpos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
+        sysv["$P_PFRAME"] = lambda: FrameValue((("state", copy_frame(self.frame)),))
+        self.ev.system_setters["$P_PFRAME"] = self._set_pframe
         sysv["$P_TOOLNO"] = lambda: float(st.tool or 0)
         sysv["$P_TOOL"] = lambda: float(st.radius_index or 0)
         sysv["$P_F"] = lambda: st.feed or 0.0
@@ -1532,7 +1624,7 @@ class Interpreter:
                 return unit, unit.code, pc, sidx
             try:
                 if args is None:
-                    args = self._call_args(s)
+                    args = self._call_args(s, callee.params)
                 rep = 1
                 if s.repeat is not None:
                     r = self._value(self.ev.compile(s.repeat), "repeat count")
@@ -1543,7 +1635,9 @@ class Interpreter:
             if rep < 1:
                 return unit, unit.code, pc, sidx
             make = self._make_scope(s, callee, args)
-            self.stack.append(Frame(unit, pc, sidx, self.ev.scope, callee, rep - 1, make))
+            saved = self._save_state() if callee.save else None
+            self.stack.append(Frame(unit, pc, sidx, self.ev.scope, callee, rep - 1, make,
+                                    saved=saved))
             self.ev.scope = make()
             return callee, callee.code, 0, 0
         return unit, unit.code, pc, sidx
@@ -1556,6 +1650,8 @@ class Interpreter:
             return fr.callee, fr.callee.code, 0, 0
         self.stack.pop()
         self.ev.scope = fr.scope
+        if fr.saved is not None:
+            self._restore_state(fr.saved)
         unit, pc, sidx = fr.unit, fr.pc, fr.sidx
         if to_label is not None:
             target = self._find_label(unit, to_label, "any", pc)
@@ -1564,6 +1660,30 @@ class Interpreter:
             else:
                 return unit, unit.code, target, 0
         return unit, unit.code, pc, sidx
+
+    def _save_state(self) -> tuple:
+        st = self.st
+        return (dict(st.groups), {a: getattr(st, a) for a in SAVED_ATTRS}, st.feed,
+                copy_frame(self.frame))
+
+    def _restore_state(self, saved: tuple) -> None:
+        """Return from a SAVE subprogram (spec 1.6): the modal G codes, the settable and the
+        programmable frame as at the call; F too when the feed type (G group 15) changed."""
+        groups, attrs, feed, frame = saved
+        st = self.st
+        feed_mode = st.feed_mode
+        work = st.work_offset
+        for g, v in groups.items():
+            if g not in NOT_SAVED_GROUPS:
+                st.groups[g] = v
+        for a, v in attrs.items():
+            setattr(st, a, v)
+        if st.feed_mode != feed_mode:
+            st.feed = feed
+        if st.work_offset != work:
+            self.off.set_work(self._work_offset(st.work_offset) if st.work_offset else {})
+        copy_frame(frame, self.frame)
+        self._resync()
 
     @staticmethod
     def _find_label(unit: Unit, target, direction: str, pc: int) -> Optional[int]:
@@ -1586,7 +1706,9 @@ class Interpreter:
 
 
 def interpret(program: n.Program, machine=None, *, diagnostics: list, resolver=None,
-              max_steps: int = 2_000_000, flatten_hook=None) -> Iterator[ToolpathRecord]:
-    """Run `program` and yield its canonical motions one by one (see the module docstring)."""
+              max_steps: int = 2_000_000, flatten_hook=None, preload=()) -> Iterator[ToolpathRecord]:
+    """Run `program` and yield its canonical motions one by one (see the module docstring).
+    preload: programs whose declarations (VarDecl) run first as global variables, such as the
+    definition files (Sinumerik GUD *.DEF) beside the program."""
     return Interpreter(program, machine, diagnostics=diagnostics, resolver=resolver,
-                       max_steps=max_steps, flatten_hook=flatten_hook).run()
+                       max_steps=max_steps, flatten_hook=flatten_hook, preload=preload).run()
