@@ -209,6 +209,56 @@ def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> O
     return Resolver([source_dir or os.getcwd()], parse_file)
 
 
+# Dialects whose programs read variables declared in definition files beside them (Sinumerik
+# GUD modules _N_*GUD*_DEF, spec 1.8): dialect -> file endings of those files (lower case).
+_DEFINITION_FILES = {"sinumerik": (".def",)}
+# (path, mtime_ns, dialect) -> parsed definition file; a directory lint parses each once
+_DEFINITION_CACHE: dict[tuple, Optional[Program]] = {}
+
+
+def definition_programs(source_dir: Optional[str], dialect: Optional[str],
+                        search_paths: Iterable[str] = ()) -> list[Program]:
+    """The parsed definition files (*.DEF for Sinumerik) of the source directory and the search
+    paths, in file-name order, for the interpreter to preload their declarations. Unreadable or
+    unparsable files are skipped: they are reported when they are linted themselves."""
+    endings = _DEFINITION_FILES.get(dialect or "")
+    if not endings:
+        return []
+    dirs: list[Path] = []
+    for d in [source_dir or os.getcwd(), *search_paths]:
+        p = Path(d).resolve()
+        if p.is_dir() and p not in dirs:
+            dirs.append(p)
+    out = []
+    for d in dirs:
+        for f in sorted(d.iterdir()):
+            if f.suffix.lower() not in endings or f.name.startswith(".") or not f.is_file():
+                continue
+            try:
+                key = (str(f), f.stat().st_mtime_ns, dialect)
+            except OSError:
+                continue
+            if key not in _DEFINITION_CACHE:
+                _DEFINITION_CACHE[key] = _parse_definition(f, dialect)
+            prog = _DEFINITION_CACHE[key]
+            if prog is not None:
+                out.append(prog)
+    return out
+
+
+def _parse_definition(path: Path, dialect: str) -> Optional[Program]:
+    try:
+        src = _source.decode(_source.read_bytes(path), _display_path(path))
+    except _source.SourceError:
+        return None
+    if not src.ok:
+        return None
+    try:
+        return get_dialect(dialect).parse(src.text, src.file).program
+    except PipelineError:
+        return None
+
+
 def _interpret():
     try:
         from nctrans.interp import interpret
@@ -229,6 +279,9 @@ def run_toolpath(program: Program, machine: Optional[Machine], diagnostics: list
     if interpret is None:
         raise PipelineError("the interpreter is not available in this build yet")
     kwargs = {"diagnostics": diagnostics, "resolver": make_resolver(source_dir, dialect)}
+    preload = definition_programs(source_dir, dialect)
+    if preload:
+        kwargs["preload"] = preload
     if max_steps is not None:
         kwargs["max_steps"] = max_steps
     return interpret(program, machine, **kwargs)

@@ -130,7 +130,6 @@ def test_calls_subprograms_repetition_and_modal_call():
     assert e[5][0] == 20 and [p[2] for p in e[5:8]] == [0, 1, 2]   # MCALL L48 after G0 X20, CALL
 
 
-@pytest.mark.xfail(reason="interpreter: VAR (call-by-reference) parameters are bound by value", strict=False)
 def test_calls_var_parameter_is_by_reference():
     recs, _ = run("calls.mpf")
     assert ends(recs)[2][1] == 6                        # WIDTH=4, BORDER adds 2 through VAR WID
@@ -148,7 +147,6 @@ def test_variables_r_parameters():
     assert ends(recs)[0] == (0, 20, 0)                  # R[2]=R1*2 with R1=10
 
 
-@pytest.mark.xfail(reason="interpreter: SET/REP array initialisation not evaluated yet", strict=False)
 def test_variables_arrays_set_rep():
     recs, _ = run("variables.mpf")
     # TABLE[0,1]=2 from SET(1,2,,4); FIELD[4]=0 after FIELD[2]=REP(0) over REP(9)

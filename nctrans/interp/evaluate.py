@@ -9,6 +9,7 @@ closures raise EvalError, the interpreter turns it into a diagnostic at the stat
 from __future__ import annotations
 
 import math
+import re
 from typing import Any, Callable, Optional
 
 from nctrans.ir import nodes as n
@@ -38,8 +39,69 @@ class EvalError(Exception):
 # Local ISO macro variables (#1..#33) live in the call frame; the rest are global.
 LOCAL_NUM_MAX = 33
 
+class AxisName(str):
+    """An axis identifier used as a value (Sinumerik DEF AXIS A=(X), CTRANS(X,5), $AA_IM[A]): a
+    string that compares with other axis names and serves as an axis index or address."""
+    __slots__ = ()
+
+    @property
+    def geometry(self) -> str:
+        """The axis letter a channel/machine axis name stands for (X1 -> X)."""
+        return self.rstrip("0123456789")
+
+
+# names that are axis identifiers when no variable of that name is declared
+AXIS_NAME = re.compile(r"^(?:[XYZABCUVW][0-9]{0,2})$")
+
+
+class Ref:
+    """A by-reference binding (Sinumerik PROC VAR parameter): reads and writes go to the caller's
+    variable (a name, an R parameter, an ISO number or one array element)."""
+    __slots__ = ("store", "key", "array")
+
+    def __init__(self, store: Any, key: Any, array: bool = False):
+        self.store, self.key, self.array = store, key, array
+
+    def get(self) -> Any:
+        return self.store.get(self.key) if self.array else self.store.get(self.key, 0.0)
+
+    def set(self, value: Any) -> None:
+        if self.array:
+            self.store.set(self.key, value)
+        else:
+            self.store[self.key] = value
+
+
+class FrameValue:
+    """A FRAME value (Sinumerik CTRANS(..):CROT(..), a FRAME variable, $P_PFRAME read back).
+
+    steps, applied in order, each in the system the previous ones produce (M(F1:F2) = M(F1)·M(F2)):
+    ("trans"|"rot"|"scale"|"mirror", {axis: value}) as the frame instructions TRANS/ROT/SCALE/
+    MIRROR would take them, or ("state", snapshot) for a frame read back from the interpreter.
+    No steps is the neutral frame."""
+    __slots__ = ("steps",)
+
+    def __init__(self, steps: tuple = ()):
+        self.steps = tuple(steps)
+
+    def __eq__(self, other: Any) -> bool:
+        return isinstance(other, FrameValue) and self.steps == other.steps
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"FrameValue{self.steps!r}"
+
+
+NEUTRAL_FRAME = FrameValue()
+
+# frame constructors (Sinumerik spec 7.2) -> the frame instruction each step acts as
+_FRAME_FUNCS = {"CTRANS": "trans", "CFINE": "trans", "CROT": "rot", "CSCALE": "scale",
+                "CMIRROR": "mirror", "TRANS": "trans", "ROT": "rot", "SCALE": "scale",
+                "MIRROR": "mirror"}
+
 _TYPE_DEFAULTS = {"INT": 0, "REAL": 0.0, "BOOL": False, "CHAR": "", "STRING": "", "AXIS": "",
-                  "FRAME": None}
+                  "FRAME": NEUTRAL_FRAME}
 
 
 class Scope:
@@ -71,6 +133,14 @@ class Array:
 
     def set(self, idx: tuple, value: Any) -> None:
         self.data[self.key(idx)] = value
+
+    def keys_from(self, idx: tuple) -> list[tuple]:
+        """Element keys in storage order (right index fastest) from `idx` to the end."""
+        self.key(idx)
+        keys: list[tuple] = [()]
+        for d in self.dims:
+            keys = [k + (i,) for k in keys for i in range(d)]
+        return keys[keys.index(tuple(idx)):]
 
 
 def _num(v: Any) -> Any:
@@ -239,6 +309,8 @@ class Evaluator:
         self.R: dict[int, Any] = {}
         self.global_names: dict[str, Any] = {}
         self.system: dict[Any, Callable[[], Any]] = {}
+        # writable system variables with an effect ($P_PFRAME): name -> setter(value)
+        self.system_setters: dict[str, Callable[[Any], None]] = {}
         self.unknown_used = False     # set when UNKNOWN was read; the interpreter reports it
 
     # ---------------------------------------------------------------- compiler
@@ -314,10 +386,14 @@ class Evaluator:
                 if op in ("<", "<=", ">", ">=") and isinstance(a, str) and isinstance(b, str):
                     return fn(a, b)
                 raise EvalError("NC104", f"string operand of {op!r}")
+            if isinstance(a, FrameValue) or isinstance(b, FrameValue):
+                raise EvalError("NC104", f"frame operand of {op!r} (frames chain with ':' only)")
             try:
                 return fn(a, b)
             except (OverflowError, ValueError) as ex:
                 raise EvalError("NC106", f"arithmetic error in {op!r}: {ex}") from None
+            except TypeError:
+                raise EvalError("NC104", f"operands of {op!r} have the wrong type") from None
 
         # fast paths: two floats (the normal case) skip the vacant/unknown/string checks
         if op == "+":
@@ -356,6 +432,12 @@ class Evaluator:
         name = e.name.lower()
         fn = _FUNCS.get(name)
         if fn is None:
+            if name == "frame_chain":
+                return self._compile_chain(e)
+            if e.name.upper() in _FRAME_FUNCS:
+                return self._compile_frame(e)
+            if e.name.upper() in ("SET", "REP"):
+                return self._bad(f"{e.name.upper()}() initialises an array or array element only")
             return self._bad(f"unknown function {e.name!r}")
         args = [self.compile(a) for a in e.args]
 
@@ -392,6 +474,55 @@ class Evaluator:
             except (TypeError, ValueError, OverflowError) as ex:
                 raise EvalError("NC106", f"{name}: {ex}") from None
         return call1 or call
+
+    # ---------------------------------------------------------------- frames
+    def _compile_frame(self, e: n.Func) -> Callable[[], Any]:
+        """CTRANS(X,5,Y,0) / CROT(Z,30) / CSCALE(X,2) / CMIRROR(X,Y): a one-step frame."""
+        op = _FRAME_FUNCS[e.name.upper()]
+        fns = [self.compile(a) for a in e.args]
+        pairs = op != "mirror"
+        fname = e.name.upper()
+
+        def frame():
+            vals = [f() for f in fns]
+            if not vals:
+                return NEUTRAL_FRAME
+            if pairs and len(vals) % 2:
+                raise EvalError("NC104", f"{fname} takes axis, value pairs")
+            axes = vals[0::2] if pairs else vals
+            out: dict[str, Any] = {}
+            for i, ax in enumerate(axes):
+                if not isinstance(ax, str) or not ax:
+                    raise EvalError("NC104", f"{fname}: {ax!r} is not an axis name")
+                key = AxisName(ax.upper()).geometry
+                if pairs:
+                    v = vals[2 * i + 1]
+                    if v is UNKNOWN:
+                        self.unknown_used = True
+                        return UNKNOWN
+                    if isinstance(v, str) or isinstance(v, FrameValue):
+                        raise EvalError("NC104", f"{fname}: the value for {ax} is not a number")
+                    out[key] = float(_num(v))
+                else:
+                    out[key] = 0.0
+            return FrameValue(((op, tuple(out.items())),))
+        return frame
+
+    def _compile_chain(self, e: n.Func) -> Callable[[], Any]:
+        """F1 : F2 : ... — the frames applied one after the other (spec 7.2)."""
+        fns = [self.compile(a) for a in e.args]
+
+        def chain():
+            steps: list = []
+            for f in fns:
+                v = f()
+                if v is UNKNOWN:
+                    return UNKNOWN
+                if not isinstance(v, FrameValue):
+                    raise EvalError("NC104", "the ':' operator chains frames only")
+                steps.extend(v.steps)
+            return FrameValue(tuple(steps))
+        return chain
 
     # ---------------------------------------------------------------- variables
     def _index_fns(self, var: n.Var) -> list[Callable[[], Any]]:
@@ -440,6 +571,15 @@ class Evaluator:
             axis = _axis_index(var)
             if axis is not None:
                 return lambda: self.read_axis_system(name, axis)
+            if len(fns) == 1:
+                (f1,) = fns
+
+                def read_indexed():
+                    ix = f1()
+                    if isinstance(ix, AxisName):      # $AA_IM[AXNAME], AXNAME an AXIS variable
+                        return self.read_axis_system(name, ix.geometry)
+                    return self.read_system(name, self._indices(fns))
+                return read_indexed
             return lambda: self.read_system(name, self._indices(fns) if fns else None)
         if space == "arg":
             key = str(var.key).upper()
@@ -483,8 +623,12 @@ class Evaluator:
     def read_name(self, name: str, idx: Optional[tuple]) -> Any:
         store = self._lookup_name(name)
         if store is None:
+            if idx is None and AXIS_NAME.match(name):
+                return AxisName(name)          # an axis identifier as a value: CTRANS(X,..), =(X)
             raise EvalError("NC101", f"variable {name} is not defined")
         v = store[name]
+        if type(v) is Ref:
+            v = v.get()
         if isinstance(v, Array):
             if idx is None:
                 raise EvalError("NC104", f"array {name} used without an index")
@@ -509,23 +653,103 @@ class Evaluator:
         self.unknown_used = True
         return UNKNOWN
 
-    def declare(self, decl: n.VarDecl) -> None:
+    def declare(self, decl: n.VarDecl, scope: Optional[str] = None) -> None:
+        """Run a DEF: `scope` overrides the declaration's own (preloaded GUD files are global)."""
         name = decl.name.upper()
-        default = _TYPE_DEFAULTS.get(decl.type.upper(), 0.0)
-        store = self.global_names if decl.scope != "local" else self.scope.names
-        inits = [self.compile(e)() for e in (decl.init or [])]
+        typ = decl.type.upper()
+        default = _TYPE_DEFAULTS.get(typ, 0.0)
+        store = self.global_names if (scope or decl.scope) != "local" else self.scope.names
+        init = decl.init or []
+        rep = len(init) == 1 and type(init[0]) is n.Func and init[0].name.upper() == "REP"
+        if rep:
+            init = init[0].args[:1]
+        inits = [self._typed(typ, self.compile(e)()) for e in init]
         if decl.dims:
             arr = Array(decl.dims, default)
-            # initialisers fill the array in row-major order
+            # initialisers fill the array in storage order (right index fastest); REP fills all
             if inits:
-                flat = [()]
-                for d in decl.dims:
-                    flat = [p + (i,) for p in flat for i in range(d)]
-                for key, v in zip(flat, inits):
-                    arr.data[key] = v
+                keys = arr.keys_from((0,) * len(decl.dims))
+                if rep:
+                    for key in keys:
+                        arr.data[key] = inits[0]
+                else:
+                    if len(inits) > len(keys):
+                        raise EvalError("NC105", f"{len(inits)} initial values for the "
+                                        f"{len(keys)} elements of {name}")
+                    for key, v in zip(keys, inits):
+                        arr.data[key] = v
             store[name] = arr
         else:
             store[name] = inits[0] if inits else default
+
+    @staticmethod
+    def _typed(typ: str, v: Any) -> Any:
+        """AXIS values are axis names (DEF AXIS A=(X) and DEF AXIS A="X" alike)."""
+        if typ == "AXIS" and isinstance(v, str):
+            return AxisName(v.upper())
+        return v
+
+    def make_ref(self, expr: Any) -> Any:
+        """A by-reference argument (PROC VAR parameter): a Ref to the caller's variable, the array
+        itself for a whole array, or the plain value when the argument is not a variable."""
+        if type(expr) is n.Var:
+            fns = self._index_fns(expr)
+            if expr.space == "name":
+                name = str(expr.key).upper()
+                store = self._lookup_name(name)
+                if store is not None:
+                    cur = store[name]
+                    if type(cur) is Ref and not fns:
+                        return cur                       # passed on: same caller variable
+                    if isinstance(cur, Array):
+                        return Ref(cur, self._indices(fns), True) if fns else cur
+                    if not fns:
+                        return Ref(store, name)
+            elif expr.space == "R":
+                k = self._indices(fns)[0] if fns else int(expr.key or 0)
+                return Ref(self.R, k)
+        return self.compile(expr)()
+
+    def compile_assign(self, target: n.Var, value: Any) -> Callable[[], None]:
+        """An assignment; A[i,j]=SET(a,b,..) writes consecutive elements from [i,j] on and
+        A[i,j]=REP(v) every element from [i,j] to the end (spec 3.4); R[i]=SET(..) likewise."""
+        kind = value.name.upper() if type(value) is n.Func else ""
+        if kind not in ("SET", "REP") or not target.indices:
+            put, f = self.compile_store(target), self.compile(value)
+            return lambda: put(f())
+        vals = [self.compile(a) for a in (value.args[:1] if kind == "REP" else value.args)]
+        fns = self._index_fns(target)
+        omitted = [type(a) is n.Num and a.text == "" for a in value.args]
+
+        def fill():
+            idx = self._indices(fns)
+            if target.space == "R":
+                if kind == "REP":
+                    raise EvalError("NC104", "REP() fills arrays; R parameters have no end to fill to")
+                keys = [(k,) for k in range(idx[0], idx[0] + len(vals))]
+                arr = None
+            else:
+                store = self._lookup_name(str(target.key).upper()) if target.space == "name" else None
+                arr = store[str(target.key).upper()] if store is not None else None
+                if not isinstance(arr, Array):
+                    raise EvalError("NC104", f"{kind}() assigned to {target.key}, which is not an array")
+                keys = arr.keys_from(idx)
+            if kind == "REP":
+                v = vals[0]()
+                for k in keys:
+                    arr.set(k, v)
+                return
+            if len(vals) > len(keys):
+                raise EvalError("NC105", f"SET() writes {len(vals)} values but {target.key} has "
+                                f"{len(keys)} elements from {list(idx)}")
+            for k, f, gap in zip(keys, vals, omitted):
+                if gap:
+                    continue                      # SET(1,,3): the gap keeps its element
+                if arr is None:
+                    self.R[k[0]] = f()
+                else:
+                    arr.set(k, f())
+        return fill
 
     def compile_store(self, var: n.Var) -> Callable[[Any], None]:
         """A setter closure for an assignment target."""
@@ -546,7 +770,9 @@ class Evaluator:
                 if store is None:
                     raise EvalError("NC101", f"variable {name} is not defined")
                 cur = store[name]
-                if isinstance(cur, Array):
+                if type(cur) is Ref and not fns:
+                    cur.set(v)
+                elif isinstance(cur, Array):
                     if not fns:
                         raise EvalError("NC104", f"array {name} assigned without an index")
                     cur.set(self._indices(fns), v)
@@ -560,7 +786,11 @@ class Evaluator:
             name = str(var.key).upper()
 
             def set_sys(v):        # writable system data: kept so later reads see the value
-                self.system[name] = lambda: v
+                setter = self.system_setters.get(name)
+                if setter is not None and not fns:
+                    setter(v)
+                else:
+                    self.system[name] = lambda: v
             return set_sys
         return lambda v: (_ for _ in ()).throw(EvalError("NC104", f"cannot assign to {space}"))
 
