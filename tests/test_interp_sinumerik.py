@@ -176,6 +176,12 @@ M30""")
     assert ends(recs) == [(3, 1, 0), (2, 1, 0), (3, 11, 0)]
 
 
+def test_frame_component_write_keeps_the_frame_with_a_note():
+    recs, diags = run("TRANS X10\n$P_PFRAME[X,TR]=25\nG0 X1\nM30")
+    assert ends(recs) == [(11, 0, 0)]
+    assert [d.rule for d in diags] == ["NC107"]
+
+
 def test_frame_value_in_arithmetic_is_a_type_error():
     _, diags = run("R1=CTRANS(X,1)+1\nM30")
     assert any(d.rule == "NC104" for d in diags)

@@ -787,7 +787,11 @@ class Evaluator:
 
             def set_sys(v):        # writable system data: kept so later reads see the value
                 setter = self.system_setters.get(name)
-                if setter is not None and not fns:
+                if setter is not None and fns:
+                    # $P_PFRAME[X,TR]=25: component writes are not modelled; keep the frame
+                    raise EvalError("NC107", f"{name}[..] component write is not analysed; the "
+                                    "frame is kept as it was", "info")
+                if setter is not None:
                     setter(v)
                 else:
                     self.system[name] = lambda: v
