@@ -273,8 +273,6 @@ def cmd_lint(args) -> int:
     keep = _rule_filter(args.select or [], args.ignore or [])
     all_diags: list[Diagnostic] = []
     status = EXIT_OK
-    if not pipeline.interpreter_available():
-        _err("note: the interpreter is not available in this build; only parse diagnostics are reported")
     bar = _progress(len(files), "lint")
     done = 0
     try:

@@ -259,25 +259,11 @@ def _parse_definition(path: Path, dialect: str) -> Optional[Program]:
         return None
 
 
-def _interpret():
-    try:
-        from nctrans.interp import interpret
-    except ImportError:
-        return None
-    return interpret
-
-
-def interpreter_available() -> bool:
-    return _interpret() is not None
-
-
 def run_toolpath(program: Program, machine: Optional[Machine], diagnostics: list[Diagnostic], *,
                  source_dir: Optional[str] = None, dialect: Optional[str] = None,
                  max_steps: Optional[int] = None) -> Iterator[ToolpathRecord]:
     """Stream the program's toolpath; interpreter diagnostics are appended to `diagnostics`."""
-    interpret = _interpret()
-    if interpret is None:
-        raise PipelineError("the interpreter is not available in this build yet")
+    from nctrans.interp import interpret     # deferred: `detect` and `rules` need no interpreter
     kwargs = {"diagnostics": diagnostics, "resolver": make_resolver(source_dir, dialect)}
     preload = definition_programs(source_dir, dialect)
     if preload:
@@ -316,7 +302,7 @@ def _streamed_toolpath(ld: Loaded, machine: Optional[Machine]) -> Iterator[Toolp
 
 def lint(ld: Loaded, machine: Optional[Machine] = None) -> list[Diagnostic]:
     """Parse diagnostics plus the interpreter's (records are drained and dropped)."""
-    if ld.program is not None and interpreter_available():
+    if ld.program is not None:
         for _ in toolpath_of(ld, machine):
             pass
     _finish_stream(ld, [])
