@@ -20,7 +20,7 @@ run: $(STAMP)
 	$(BIN)/nctrans toolpath $(SAMPLE) --from iso-m --summary
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider
+	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider --basetemp=$(CURDIR)/.pytest-tmp
 
 bench: $(STAMP)
 	$(BIN)/python bench/bench.py
