@@ -89,6 +89,16 @@ def _word_text(letter: str, v: Any) -> str:
     return letter + format_value(v)
 
 
+
+def _signed_float(text: str) -> float:
+    """A word's number; repeated signs (`Z--17.352`, unary minus applied twice) fold into one."""
+    try:
+        return float(text)
+    except ValueError:
+        digits = text.lstrip("+-")
+        sign = -1.0 if (len(text) - len(digits) - text[: len(text) - len(digits)].count("+")) % 2 else 1.0
+        return sign * float(digits)
+
 class _Blk:
     """Per-block lowering context (one per non-trivial block)."""
     __slots__ = ("vals", "out", "owner", "owner_rule", "machine", "motion_g", "cycle_g",
@@ -182,11 +192,12 @@ class Lowering:
         """A word value as an expression; applies standard decimal notation when the profile asks."""
         if type(v) is not str:
             return v
+        value = _signed_float(v)
         if self.standard and "." not in v:
             f = self._factor(letter)
             if f != 1.0:
-                return Num(float(v) * f, v)
-        return Num(float(v), v)
+                return Num(value * f, v)
+        return Num(value, v)
 
     def _factor(self, letter: str) -> float:
         fs = self.factors
