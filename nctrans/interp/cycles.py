@@ -262,11 +262,28 @@ class HolePattern(BaseModel):
     params: list[str]
 
 
+class SwivelCycle(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    name: str
+    kind: Literal["swivel_plane"]
+    meaning: str = ""
+    params: list[str]
+
+
+class SwivelModes(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    modes: dict[str, str]
+    axes: dict[str, Literal["X", "Y", "Z"]] = Field(default_factory=dict)
+
+
 class CycleTable(BaseModel):
     model_config = ConfigDict(extra="forbid")
     names: dict[str, str] = Field(default_factory=dict)
     cycle: list[SinumerikCycle] = Field(default_factory=list)
     pattern: list[HolePattern] = Field(default_factory=list)
+    swivel: list[SwivelCycle] = Field(default_factory=list)
+    swivel_mode: SwivelModes = Field(default_factory=lambda: SwivelModes(modes={"0": "axis"}))
+    swivel_retract: SwivelModes = Field(default_factory=lambda: SwivelModes(modes={"0": "none"}))
 
     def neutral(self, name: str) -> str:
         """The neutral key of a Siemens parameter name, or its lowercase spelling if it has none."""
@@ -336,3 +353,60 @@ def hole_pattern(name: str, args: Sequence[float | None]) -> list[tuple[float, f
     inda = v["INDA"] if v["INDA"] else 360.0 / num
     return [(v["CPA"] + v["RAD"] * math.cos(math.radians(v["STA1"] + i * inda)),
              v["CPO"] + v["RAD"] * math.sin(math.radians(v["STA1"] + i * inda))) for i in range(num)]
+
+
+# ---------------------------------------------------------------------------------------------
+# CYCLE800 swivel plane
+
+class SwivelPlan(BaseModel):
+    """What one CYCLE800 call does, decoded from its neutral parameters (see `swivel_plan`)."""
+    model_config = ConfigDict(extra="forbid")
+    retract: str = "none"                    # [swivel_retract] value, or "unknown"
+    retract_inc: float = 0.0
+    mode: str = "axis"                       # [swivel_mode] value, or "unknown"
+    additive: bool = False
+    deselect: bool = False
+    ref: dict[str, float] = Field(default_factory=dict)       # TRANS / ATRANS before rotation
+    rotations: list[tuple[str, float]] = Field(default_factory=list)   # AROT, in order
+    shift: dict[str, float] = Field(default_factory=dict)     # ATRANS after rotation
+
+
+def swivel_axis_order(mode: int) -> list[Optional[str]]:
+    """The three rotation axes of axis-by-axis _MODE (bits 1-0, 3-2, 5-4; 01 X, 10 Y, 11 Z, 00 none).
+
+    [GK] Siemens cycles manual: 57 = 0b111001 is X, Y, Z (the usual ShopMill setting).
+    """
+    axes = cycle_table().swivel_mode.axes
+    return [axes.get(str((mode >> (2 * i)) & 3)) for i in range(3)]
+
+
+def swivel_plan(params: dict[str, object]) -> SwivelPlan:
+    """Decode CYCLE800 parameters (numbers in program units, `swivel_record` a string) [GK].
+
+    _TC "0", "" or missing with every angle 0 deselects: the plane is then new (never additive),
+    so the rotation is gone and only the translations (normally 0) remain. _ST: only the ones
+    digit (0 new, 1 additive) is read; the tens digit (tool tip / TRAORI options) does not change
+    the frame. The angles _A/_B/_C are the 1st, 2nd, 3rd rotation in the _MODE order.
+    """
+    def num(key: str) -> float:
+        v = params.get(key)
+        return float(v) if isinstance(v, (int, float)) else 0.0
+
+    t = cycle_table()
+    mode = int(num("swivel_mode"))
+    fr = str(int(num("swivel_retract")))
+    plan = SwivelPlan(retract=t.swivel_retract.modes.get(fr, "unknown"),
+                      retract_inc=num("retract_inc"),
+                      mode=t.swivel_mode.modes.get(str(mode & 0xC0), "unknown"),
+                      additive=int(abs(num("swivel_state"))) % 10 == 1)
+    angles = [num("angle_1"), num("angle_2"), num("angle_3")]
+    record = params.get("swivel_record")
+    record = "" if record is None else str(record).strip()
+    if record in ("", "0") and not any(angles):
+        plan.deselect, plan.additive = True, False
+    plan.ref = {a: num(k) for a, k in (("X", "ref_x"), ("Y", "ref_y"), ("Z", "ref_z"))}
+    plan.shift = {a: num(k) for a, k in (("X", "shift_x"), ("Y", "shift_y"), ("Z", "shift_z"))}
+    if plan.mode == "axis":
+        plan.rotations = [(ax, ang) for ax, ang in zip(swivel_axis_order(mode), angles)
+                          if ax is not None and ang]
+    return plan

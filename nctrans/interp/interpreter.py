@@ -46,9 +46,9 @@ try:  # the colleague's modules; without them the feature is skipped
 except ImportError:  # pragma: no cover
     expand_cycle = None
 try:
-    from nctrans.interp.cycles import cycle_table, hole_pattern, sinumerik_cycle_levels
+    from nctrans.interp.cycles import cycle_table, hole_pattern, sinumerik_cycle_levels, swivel_plan
 except ImportError:  # pragma: no cover
-    cycle_table = hole_pattern = sinumerik_cycle_levels = None
+    cycle_table = hole_pattern = sinumerik_cycle_levels = swivel_plan = None
 try:
     from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
 except ImportError:  # pragma: no cover
@@ -1189,6 +1189,9 @@ class Interpreter:
         if s.kind in ("holes_line", "holes_circle"):
             self._hole_pattern(s)
             return
+        if s.kind == "swivel_plane":
+            self._swivel_plane(s)
+            return
         if s.modal:
             self.modal_cycle = s
             return
@@ -1233,6 +1236,75 @@ class Interpreter:
         approach, bottom, retract = sinumerik_cycle_levels(params, current=self.pos.get(ax, 0.0))
         hole = dict(self.pos) if hole is None else hole
         self._expand(s.kind, hole, approach, bottom, retract, params)
+
+    def _swivel_plane(self, s: n.CycleCall) -> None:
+        """Sinumerik CYCLE800 [GK]: retract in machine coordinates (_FR), then the programmable
+        frame becomes TRANS(_X0..) : AROT(axis by axis) : ATRANS(_X1..) (_ST 1: composed on the
+        current frame). Rotary axes are not positioned: that needs the machine's swivel data
+        record (kinematics), which the machine model does not hold (NC107 info)."""
+        if swivel_plan is None:
+            return
+        params: dict[str, Any] = {}
+        for k, e in s.params.items():
+            if k == "swivel_record":
+                v = self.ev.compile(e)()
+                params[k] = None if v is None or v is UNKNOWN else v
+            else:
+                v = self._value(self.ev.compile(e), f"CYCLE800 {k}")
+                if v is not None:
+                    params[k] = v
+        plan = swivel_plan(params)
+        self._swivel_retract(plan)
+        if plan.mode != "axis":
+            self.diag("NC107", "info", f"CYCLE800 swivel mode {plan.mode!r} (_MODE "
+                      f"{int(params.get('swivel_mode', 0))}) needs the machine's swivel data record "
+                      "and is not interpreted; the programmable frame is kept")
+            return
+        if plan.rotations:
+            rec = params.get("swivel_record")
+            self.diag("NC107", "info", f"rotary axis positioning needs the swivel data record "
+                      f"{str(rec or '')!r} (machine kinematics, not in the machine model); the rotary "
+                      "axes are not moved, only the programmable frame is swivelled")
+
+        def op(kind: str, vals: dict[str, float], additive: bool) -> None:
+            self._h_frame(n.FrameOp(kind, {a: n.Num(v) for a, v in vals.items()}, additive=additive))
+
+        op("trans", plan.ref, plan.additive)
+        for axis, angle in plan.rotations:
+            op("rot", {axis: angle}, True)
+        op("trans", plan.shift, True)
+
+    def _swivel_retract(self, plan) -> None:
+        """CYCLE800 _FR: rapid moves in machine Z (then X and Y) to the machine model's max travel."""
+        if plan.retract == "none":
+            return
+        if plan.retract == "unknown":
+            self.diag("NC105", "error", "CYCLE800 retract mode _FR must be 0, 1, 2, 4 or 5; no retract")
+            return
+        steps: list[dict[str, float]] = []
+        z = self.mpos.get("Z", 0.0)
+        if plan.retract == "tool_inc":
+            steps.append({"Z": z + plan.retract_inc * self.st.scale})
+        else:
+            axes = [("Z",)] + ([("X", "Y")] if plan.retract == "z_xy" else [])
+            for group in axes:
+                target = {}
+                for a in group:
+                    ax = self.machine.axes.get(a)
+                    if ax is None or ax.max is None:
+                        self.diag("NC107", "info", f"the machine model has no max travel for {a}; "
+                                  "CYCLE800 does not retract that axis")
+                        continue
+                    target[a] = float(ax.max)
+                if target:
+                    steps.append(target)
+        tot = self.off.total
+        for target in steps:
+            mend = dict(self.mpos)
+            mend.update(target)
+            if all(abs(mend[a] - self.mpos.get(a, 0.0)) < 1e-12 for a in target):
+                continue
+            self._move("rapid", self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()}))
 
     # ---------------------------------------------------------------- offsets and frames
     def _h_setpos(self, s: n.SetPosition):

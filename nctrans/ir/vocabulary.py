@@ -34,11 +34,15 @@ MODAL_GROUPS: dict[str, tuple[str, ...]] = {
 
 # Cycle-parameter keys used in CycleParams / CycleCall (neutral, all lengths in program units).
 CYCLE_PARAMS = ("bottom", "r_plane", "retract_plane", "safety", "peck", "dwell", "shift",
-                "repeat", "feed", "depth_rel", "first_peck", "decrement", "min_peck", "relief")
+                "repeat", "feed", "depth_rel", "first_peck", "decrement", "min_peck", "relief",
+                # Sinumerik CYCLE800 swivel plane (rules/cycles.toml [[swivel]])
+                "swivel_retract", "swivel_record", "swivel_state", "swivel_mode",
+                "ref_x", "ref_y", "ref_z", "angle_1", "angle_2", "angle_3",
+                "shift_x", "shift_y", "shift_z", "swivel_dir", "retract_inc")
 
 # Variable spaces of nodes.Var
 VAR_SPACES = ("num", "R", "name", "system", "arg")
 
 # CycleCall kinds beyond the "cycle" modal values: hole patterns that run the modal cycle at each
 # position (Sinumerik HOLES1/HOLES2, parameters in rules/cycles.toml [[pattern]]).
-CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle")
+CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle", "swivel_plane")

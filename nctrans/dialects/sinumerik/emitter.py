@@ -458,10 +458,12 @@ class Emitter:
         t = cycle_table()
         entries = {x.name: x.params for x in t.cycle}
         entries.update({x.name: x.params for x in t.pattern})
+        entries.update({x.name: x.params for x in t.swivel})
         name = c.name if c.name in entries else next(
             (x.name for x in t.cycle if x.kind == c.kind), None)
         if name is None:
-            name = {"holes_line": "HOLES1", "holes_circle": "HOLES2"}.get(c.kind)
+            name = {"holes_line": "HOLES1", "holes_circle": "HOLES2",
+                    "swivel_plane": "CYCLE800"}.get(c.kind)
         if name is None:
             self.refuse(f"cycle kind {c.kind!r} has no Sinumerik standard cycle")
             return

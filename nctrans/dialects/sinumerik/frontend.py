@@ -70,6 +70,8 @@ def _cycles():
     for p in t.pattern:
         out[p.name] = ("holes_line" if p.shape == "row" else "holes_circle",
                        [t.neutral(x) for x in p.params], None)
+    for c in t.swivel:                   # CYCLE800 swivel plane: a frame change, not a hole
+        out[c.name] = (c.kind, [t.neutral(x) for x in c.params], None)
     return out
 
 
