@@ -200,11 +200,19 @@ def write_tool_table(path: Path, tools: Iterable[tuple[int, float, float]]) -> P
     return path
 
 
+def _private_home(out: Path) -> dict:
+    """rs274 keeps its tool table in $HOME/.tool.mmap, truncated on start: two runs at once (pytest
+    -n 2) crash each other with a bus error. Each run gets the directory of its output as HOME."""
+    home = out.parent / ".rs274-home"
+    home.mkdir(parents=True, exist_ok=True)
+    return {**os.environ, "HOME": str(home)}
+
+
 def run_rs274(program: Path, tool_table: Path, out: Path, timeout: float = 120.0) -> Run:
     """Run rs274 in batch mode on `program`; canonical output goes to `out` (reused if present)."""
     message = ""
     if not out.exists():
-        proc = subprocess.run([RS274, "-t", str(tool_table), "-g", str(program), str(out)],
+        proc = subprocess.run([RS274, "-t", str(tool_table), "-g", str(program), str(out)], env=_private_home(out),
                               stdin=subprocess.DEVNULL, capture_output=True, timeout=timeout)
         message = (proc.stdout + proc.stderr).decode("utf-8", "replace")
         out.with_suffix(".msg").write_text(message, encoding="utf-8")
@@ -315,3 +323,28 @@ def compare(ref_moves: list[Move], got: list[Motion], name: str = "") -> Optiona
         return (f"{name}: rs274 has {len(ref)} motions, nctrans {len(mine)} (all of the first {n} agree)"
                 f"\n  {extra}")
     return None
+
+
+_MARKED_CALL = re.compile(r"N\.+\s+([A-Z_]+)\((.*)\)\s*$")
+
+
+def calls_between_markers(workdir: Path, program: str, tool_table: str) -> tuple[list[tuple[str, str]], str]:
+    """Run rs274 on `program` (text) with `tool_table` (text); return the canonical calls printed
+    between its `(BEGIN)` and `(END)` comments as (name, argument text), and rs274's own message —
+    how the small cycle and cutter-compensation oracles read rs274."""
+    prog, tbl, out = workdir / "p.ngc", workdir / "t.tbl", workdir / "out"
+    prog.write_text(program)
+    tbl.write_text(tool_table)
+    proc = subprocess.run([RS274, "-t", str(tbl), "-g", str(prog), str(out)], stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True, timeout=60, env=_private_home(out))
+    calls, inside = [], False
+    for line in out.read_text().splitlines() if out.exists() else []:
+        m = _MARKED_CALL.search(line)
+        if not m:
+            continue
+        name, args = m.groups()
+        if name == "COMMENT":
+            inside = {'"BEGIN"': True, '"END"': False}.get(args, inside)
+        elif inside:
+            calls.append((name, args))
+    return calls, proc.stdout + proc.stderr

@@ -7,18 +7,16 @@ rs274 and into PlannedMoves for CutterCompensator, and compares the compensated 
 from __future__ import annotations
 
 import math
-import re
 import shutil
-import subprocess
 
 import pytest
+import rs274 as h
 from hypothesis import assume, given, settings, strategies as st
 
 from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
 
 RS274 = shutil.which("rs274")
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="LinuxCNC rs274 not installed")
-CALL = re.compile(r"N\.+\s+([A-Z_]+)\((.*)\)\s*$")
 
 PLANES = {"XY": ("G17", "X", "Y", "Z", "I", "J"), "ZX": ("G18", "Z", "X", "Y", "K", "I")}
 
@@ -53,25 +51,10 @@ def _prev_point(start, segs, upto):
 
 
 def rs274_moves(tmp_path, text, radius, plane="XY"):
-    prog = tmp_path / "c.ngc"
-    prog.write_text(text)
-    tbl = tmp_path / "t.tbl"
     # standalone rs274 reads the tool table in inches: diameter 2r mm
-    tbl.write_text(f"T1 P1 Z0 D{2 * radius / 25.4:.12f} ;\n")
-    out = tmp_path / "out"
-    res = subprocess.run([RS274, "-t", str(tbl), "-g", str(prog), str(out)], stdin=subprocess.DEVNULL,
-                         capture_output=True, text=True, timeout=60)
-    moves, inside = [], False
-    for line in out.read_text().splitlines():
-        m = CALL.search(line)
-        if not m:
-            continue
-        name, args = m.groups()
-        if name == "COMMENT":
-            inside = {'"BEGIN"': True, '"END"': False}.get(args, inside)
-            continue
-        if not inside:
-            continue
+    calls, message = h.calls_between_markers(tmp_path, text, f"T1 P1 Z0 D{2 * radius / 25.4:.12f} ;\n")
+    moves = []
+    for name, args in calls:
         v = [float(x) for x in args.split(",")] if name in ("STRAIGHT_FEED", "STRAIGHT_TRAVERSE", "ARC_FEED") else []
         if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"):
             # straight moves print X, Y, Z; reorder to (first, second, third) of the plane like ARC_FEED
@@ -79,7 +62,7 @@ def rs274_moves(tmp_path, text, radius, plane="XY"):
             moves.append(("rapid" if name == "STRAIGHT_TRAVERSE" else "linear", xyz, None, 0))
         elif name == "ARC_FEED":
             moves.append(("arc", (v[0], v[1], v[5]), (v[2], v[3]), int(v[4])))
-    return moves, res.stdout + res.stderr
+    return moves, message
 
 
 def run_comp(start, segs, side, radius, exit_pt, plane="XY"):

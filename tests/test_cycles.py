@@ -7,12 +7,11 @@ numbers rs274 printed (LinuxCNC 2.9), so the behaviour stays fixed where rs274 i
 from __future__ import annotations
 
 import math
-import re
 import shutil
-import subprocess
 from pathlib import Path
 
 import pytest
+import rs274 as h
 from hypothesis import given, settings, strategies as st
 
 from nctrans.interp.cycles import (
@@ -24,31 +23,16 @@ from nctrans.ir.vocabulary import CYCLE_PARAMS, MODAL_GROUPS
 RS274 = shutil.which("rs274")
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="LinuxCNC rs274 not installed")
 
-CALL = re.compile(r"N\.+\s+([A-Z_]+)\((.*)\)\s*$")
 
 
 def rs274_steps(tmp_path: Path, prelude: str, body: str, inch: bool = False) -> list[tuple]:
     """rs274's canonical calls for `body` as expand_cycle steps (lengths converted to mm)."""
-    prog = tmp_path / "p.ngc"
     units = "G20" if inch else "G21"
-    prog.write_text(f"{units} G17 G90 G40 G49 G80\n{prelude}\n(BEGIN)\n{body}\n(END)\nG80\nM2\n")
-    tbl = tmp_path / "t.tbl"
-    tbl.write_text("T1 P1 Z0 D0 ;\n")
-    out = tmp_path / "out"
-    subprocess.run([RS274, "-t", str(tbl), "-g", str(prog), str(out)], stdin=subprocess.DEVNULL,
-                   capture_output=True, timeout=60)
+    program = f"{units} G17 G90 G40 G49 G80\n{prelude}\n(BEGIN)\n{body}\n(END)\nG80\nM2\n"
+    calls, _ = h.calls_between_markers(tmp_path, program, "T1 P1 Z0 D0 ;\n")
     scale = 25.4 if inch else 1.0
-    steps, inside = [], False
-    for line in out.read_text().splitlines():
-        m = CALL.search(line)
-        if not m:
-            continue
-        name, args = m.groups()
-        if name == "COMMENT":
-            inside = {'"BEGIN"': True, '"END"': False}.get(args, inside)
-            continue
-        if not inside:
-            continue
+    steps = []
+    for name, args in calls:
         vals = [v.strip() for v in args.split(",")]
         if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"):
             x, y, z = (float(v) * scale for v in vals[:3])
