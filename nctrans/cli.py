@@ -426,6 +426,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--strict", action="store_true", help="turn every lowering (NC401) into an error")
     p.add_argument("--flatten", action="store_true", help="emit plain motion only (no macros, loops, calls, cycles)")
     p.add_argument("--machine", metavar="MACHINE.toml", help="machine for --flatten (offsets, tools)")
+    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
+                   help="directory searched for called subprograms and definition files after the "
+                        "source's own directory (repeatable; also NCTRANS_PATH)")
     p.set_defaults(func=cmd_convert)
 
     p = sub.add_parser("lint", help="report diagnostics")
@@ -436,6 +439,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--select", action="append", metavar="RULES", help="only these rules (prefixes, comma-separated)")
     p.add_argument("--ignore", action="append", metavar="RULES", help="drop these rules (prefixes, comma-separated)")
     p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error")
+    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
+                   help="directory searched for called subprograms and definition files after the "
+                        "source's own directory (repeatable; also NCTRANS_PATH)")
     p.set_defaults(func=cmd_lint)
 
     p = sub.add_parser("toolpath", help="print the canonical toolpath")
@@ -445,6 +451,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("jsonl", "csv"), default="jsonl")
     p.add_argument("--summary", action="store_true",
                    help="print a short summary (counts, lengths, bounding box, tools, cycle time) instead")
+    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
+                   help="directory searched for called subprograms and definition files after the "
+                        "source's own directory (repeatable; also NCTRANS_PATH)")
     p.set_defaults(func=cmd_toolpath)
 
     p = sub.add_parser("equiv", help="compare two programs' toolpaths")
@@ -455,6 +464,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--machine", metavar="MACHINE.toml")
     p.add_argument("--tol", type=float, default=None, metavar="MM",
                    help="tolerance in mm (default 0.001)")
+    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
+                   help="directory searched for called subprograms and definition files after the "
+                        "source's own directory (repeatable; also NCTRANS_PATH)")
     p.set_defaults(func=cmd_equiv)
 
     p = sub.add_parser("detect", help="guess the dialect of files")
@@ -478,6 +490,11 @@ def _main(argv: Optional[list[str]]) -> int:
     if not args.command:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
+    for d in getattr(args, "search_path", []):
+        if not os.path.isdir(d):
+            _err(f"--search-path {d}: not a directory")
+            return EXIT_USAGE
+    pipeline.SEARCH_PATHS[:] = getattr(args, "search_path", [])
     try:
         return args.func(args)
     except (UsageError, pipeline.PipelineError) as e:

@@ -206,7 +206,17 @@ def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> O
         except PipelineError:
             return None
 
-    return Resolver([source_dir or os.getcwd()], parse_file)
+    return Resolver([source_dir or os.getcwd(), *search_paths()], parse_file)
+
+
+# Directories searched for called subprograms and definition files after the source's own directory
+# (CLI --search-path, then the NCTRANS_PATH environment variable). Lookups stay inside them.
+SEARCH_PATHS: list[str] = []
+
+
+def search_paths() -> list[str]:
+    env = [d for d in os.environ.get("NCTRANS_PATH", "").split(os.pathsep) if d]
+    return [*SEARCH_PATHS, *env]
 
 
 # Dialects whose programs read variables declared in definition files beside them (Sinumerik
@@ -265,7 +275,7 @@ def run_toolpath(program: Program, machine: Optional[Machine], diagnostics: list
     """Stream the program's toolpath; interpreter diagnostics are appended to `diagnostics`."""
     from nctrans.interp import interpret     # deferred: `detect` and `rules` need no interpreter
     kwargs = {"diagnostics": diagnostics, "resolver": make_resolver(source_dir, dialect)}
-    preload = definition_programs(source_dir, dialect)
+    preload = definition_programs(source_dir, dialect, search_paths())
     if preload:
         kwargs["preload"] = preload
     if max_steps is not None:
