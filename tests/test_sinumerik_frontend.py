@@ -413,3 +413,16 @@ def test_parse_never_raises(text):
     assert isinstance(res.program, ir.Program)
     for d in res.diagnostics:
         assert d.line >= 1 and d.column >= 1
+
+
+def test_motion_word_table_names_real_parts_of_a_block():
+    """rules/sinumerik.toml [options.motion_words] drives the lowering of CR=, AR=, AP= ...: every
+    part it names must exist, or a typo in the table would drop the word silently."""
+    import dataclasses
+    from nctrans.dialects.sinumerik.frontend import _Words
+    from nctrans.rules import load_table
+    fields = {f.name for f in dataclasses.fields(_Words)}
+    table = load_table("sinumerik").options["motion_words"]
+    assert table
+    for name, part in table.items():
+        assert part.startswith("polar.") or part in fields, (name, part)

@@ -322,6 +322,7 @@ class Lowerer:
         self.axes = set(t.options.get("axes", []))
         self.centre = t.options.get("centre_words", {})
         self.via = t.options.get("via_words", {})
+        self.motion_words = t.options.get("motion_words", {})
         self.pass_words = t.options.get("passthrough_words", {})
         self.commands = t.options.get("machine_commands", {})
         self.whole_block = set(t.options.get("whole_block_commands", []))
@@ -409,22 +410,12 @@ class Lowerer:
             w.center[name] = _axis_value(value)
         elif name in self.via:
             w.via[self.via[name]] = _axis_value(value)
-        elif name == "CR":
-            w.radius = value
-        elif name == "AR":
-            w.aperture = value
-        elif name == "AP":
-            w.polar["angle"] = value
-        elif name == "RP":
-            w.polar["radius"] = value
-        elif name == "TURN":
-            w.turns = value
-        elif name == "RPL":
-            w.rpl = value
-        elif name == "FP":
-            w.fixed_point = value
-        elif name == "F":
-            w.feed = value
+        elif name in self.motion_words:
+            part = self.motion_words[name]
+            if part.startswith("polar."):
+                w.polar[part[6:]] = value
+            else:
+                setattr(w, part, value)
         elif name == "S" or re.fullmatch(r"S\d+", name):
             w.speed.append((int(name[1:] or 1), value))
         elif name == "T" or re.fullmatch(r"T\d+", name):
