@@ -1543,9 +1543,7 @@ class Interpreter:
         steps = 0
         max_steps = self.max_steps
         out = self.out
-        seq = 0
-        hook = self.hook
-        hookq = self._hookq
+        self._seq = 0
         diag = self.diag
         try:
             while True:
@@ -1645,20 +1643,18 @@ class Interpreter:
                         unit, code, pc, sidx = self._control(("goto", target, "forward"),
                                                              unit, pc - 1, 0)
                 if out:
-                    for rec in out:
-                        seq += 1
-                        rec.seq = seq
-                        if hook is not None:
-                            w = hookq.popleft() if hookq else None
-                            hook(rec, *(w or (None, None)))
-                        yield rec
-                    out.clear()
+                    yield from self._release(out)
         except _Stop:
             pass
         self._comp_flush()
+        yield from self._release(out)
+
+    def _release(self, out: list) -> Iterator[ToolpathRecord]:
+        """Number the records a block produced, show them to the flatten hook, and hand them on."""
+        hook, hookq = self.hook, self._hookq
         for rec in out:
-            seq += 1
-            rec.seq = seq
+            self._seq += 1
+            rec.seq = self._seq
             if hook is not None:
                 w = hookq.popleft() if hookq else None
                 hook(rec, *(w or (None, None)))
