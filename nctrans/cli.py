@@ -411,6 +411,12 @@ def cmd_not_implemented(args) -> int:
 
 # --------------------------------------------------------------------------- parser
 
+def _add_search_path(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
+                   help="directory searched for called subprograms and definition files after the "
+                        "source's own directory (repeatable; also NCTRANS_PATH)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="nctrans",
                                  description="Transpiler and static analyzer between CNC part-program dialects.")
@@ -426,9 +432,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--strict", action="store_true", help="turn every lowering (NC401) into an error")
     p.add_argument("--flatten", action="store_true", help="emit plain motion only (no macros, loops, calls, cycles)")
     p.add_argument("--machine", metavar="MACHINE.toml", help="machine for --flatten (offsets, tools)")
-    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
-                   help="directory searched for called subprograms and definition files after the "
-                        "source's own directory (repeatable; also NCTRANS_PATH)")
+    _add_search_path(p)
     p.set_defaults(func=cmd_convert)
 
     p = sub.add_parser("lint", help="report diagnostics")
@@ -439,9 +443,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--select", action="append", metavar="RULES", help="only these rules (prefixes, comma-separated)")
     p.add_argument("--ignore", action="append", metavar="RULES", help="drop these rules (prefixes, comma-separated)")
     p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error")
-    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
-                   help="directory searched for called subprograms and definition files after the "
-                        "source's own directory (repeatable; also NCTRANS_PATH)")
+    _add_search_path(p)
     p.set_defaults(func=cmd_lint)
 
     p = sub.add_parser("toolpath", help="print the canonical toolpath")
@@ -451,9 +453,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("jsonl", "csv"), default="jsonl")
     p.add_argument("--summary", action="store_true",
                    help="print a short summary (counts, lengths, bounding box, tools, cycle time) instead")
-    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
-                   help="directory searched for called subprograms and definition files after the "
-                        "source's own directory (repeatable; also NCTRANS_PATH)")
+    _add_search_path(p)
     p.set_defaults(func=cmd_toolpath)
 
     p = sub.add_parser("equiv", help="compare two programs' toolpaths")
@@ -464,9 +464,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--machine", metavar="MACHINE.toml")
     p.add_argument("--tol", type=float, default=None, metavar="MM",
                    help="tolerance in mm (default 0.001)")
-    p.add_argument("--search-path", action="append", default=[], metavar="DIR",
-                   help="directory searched for called subprograms and definition files after the "
-                        "source's own directory (repeatable; also NCTRANS_PATH)")
+    _add_search_path(p)
     p.set_defaults(func=cmd_equiv)
 
     p = sub.add_parser("detect", help="guess the dialect of files")
