@@ -34,7 +34,10 @@ def _assert_normalised_equivalent(text: str, name: str) -> None:
     assert diff is None, diff.format() + "\n--- normalised ---\n" + normalised.text[:2000]
 
 
-@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# derandomized: equiv discretises arcs by chord error, so a generated arc of a 10 m radius costs
+# ~10^4 chords; a fixed example set keeps this test's time stable in CI (make fuzz explores more)
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow],
+          derandomize=True)
 @given(iso_program())
 def test_generated_program_equals_its_normalised_form(text):
     _assert_normalised_equivalent(text, "gen.nc")
