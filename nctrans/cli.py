@@ -133,28 +133,10 @@ def write_atomic(path: Path, text: str) -> None:
 
 
 def _flatten(program, machine, diags: list[Diagnostic], ld: pipeline.Loaded):
-    """Call nctrans.lower.flatten.flatten when a colleague's module provides it."""
-    try:
-        from nctrans.lower.flatten import flatten
-    except ImportError:
-        raise UsageError("--flatten is not available in this build yet") from None
-    offered = {"diagnostics": diags, "resolver": pipeline.make_resolver(ld.source_dir, ld.dialect),
-               "source_dir": ld.source_dir}
-    import inspect
-    try:
-        params = inspect.signature(flatten).parameters
-        kwargs = {k: v for k, v in offered.items() if k in params}
-    except (TypeError, ValueError):
-        kwargs = {}
-    result = flatten(program, machine, **kwargs)
-    if isinstance(result, tuple):
-        result = result[0]
-    if hasattr(result, "program"):
-        extra = getattr(result, "diagnostics", None)
-        if extra and extra is not diags:
-            diags.extend(extra)
-        result = result.program
-    return result
+    """Plain-motion form of `program` on `machine`, resolving calls as the source's toolpath does."""
+    from nctrans.lower.flatten import flatten
+    return flatten(program, machine, diagnostics=diags,
+                   resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
 
 
 def cmd_convert(args) -> int:

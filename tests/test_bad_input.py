@@ -10,7 +10,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import pipeline
-from nctrans.dialects import base
 from nctrans.source import decode
 
 NCTRANS = [sys.executable, "-m", "nctrans"]
@@ -18,15 +17,6 @@ TIMEOUT = 120
 LOC = r"^(?P<file>[^:]+):(?P<line>\d+):(?P<col>\d+): (?P<sev>error|warning|info)\[(?P<rule>NC\d{3})\]"
 
 
-def available(name: str) -> bool:
-    try:
-        return base.get(name) is not None
-    except Exception:
-        return False
-
-
-needs_iso = pytest.mark.skipif(not available("iso-m"), reason="iso-m front end not there yet")
-needs_sinumerik = pytest.mark.skipif(not available("sinumerik"), reason="sinumerik front end not there yet")
 
 
 def digest(paths):
@@ -62,7 +52,7 @@ def only(doc, rule):
 ])
 def test_not_text_is_nc001(tmp_path, name, data, words):
     (tmp_path / name).write_bytes(data)
-    for extra in ([], ["--from", "iso-m"] if available("iso-m") else []):
+    for extra in ([], ["--from", "iso-m"]):
         rc, doc, _ = lint_json(tmp_path, name, *extra)
         assert rc == 1
         [d] = doc["diagnostics"]
@@ -91,7 +81,6 @@ def test_missing_unreadable_and_directory_inputs_exit_2(tmp_path):
 
 # --------------------------------------------------------------------------- malformed programs (real front ends)
 
-@needs_iso
 @pytest.mark.parametrize("text,rule,line,col", [
     ("G0 X10\nG1 X[1+2 Y3 F100\nM30\n", "NC003", 2, 5),          # expression bracket not closed
     ("G0 X10 (comment\nM30\n", "NC003", 1, 8),                     # comment not closed
@@ -107,7 +96,6 @@ def test_iso_malformed_blocks_are_located(tmp_path, text, rule, line, col):
     assert (hits[0]["file"], hits[0]["line"], hits[0]["column"]) == ("p.nc", line, col)
 
 
-@needs_iso
 def test_file_cut_in_the_middle_of_a_block(tmp_path):
     full = (Path(__file__).resolve().parents[1] / "corpus" / "iso-m" / "sample-pocket.nc").read_bytes()
     cut = full[: full.index(b"N230 G00 X[15.") + len(b"N230 G00 X[15.")]
@@ -120,8 +108,6 @@ def test_file_cut_in_the_middle_of_a_block(tmp_path):
     assert any(d["line"] == last for d in errors) or only(doc, "NC006")
 
 
-@needs_iso
-@needs_sinumerik
 def test_wrong_dialect_is_nc005(tmp_path):
     (tmp_path / "part.nc").write_text("DEF REAL LEN=5\nR1=2\nG1 X=LEN F100\nIF R1>1 GOTOF END\nEND:\nM30\n")
     rc, doc, _ = lint_json(tmp_path, "part.nc", "--from", "iso-m")
@@ -134,7 +120,6 @@ def test_wrong_dialect_is_nc005(tmp_path):
     assert rc == 0 and "sinumerik" in out
 
 
-@needs_iso
 def test_cp1252_comments_and_crlf_read_like_utf8_lf(tmp_path):
     text = "%\nO0001 (WÜRFEL Ø10 – Späne)\nG21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F100 (naß)\nG2 X10 Y0 R5\nM30\n%\n"
     (tmp_path / "utf8.nc").write_bytes(text.encode("utf-8"))
@@ -152,7 +137,6 @@ def test_cp1252_comments_and_crlf_read_like_utf8_lf(tmp_path):
     assert outs[0] == outs[1] == outs[2]
 
 
-@needs_iso
 def test_directory_with_mixed_files(tmp_path):
     d = tmp_path / "shop"
     (d / "sub").mkdir(parents=True)
@@ -183,7 +167,6 @@ def test_directory_with_mixed_files(tmp_path):
     assert rc == 1 and len(json.loads(out)["runs"][0]["results"]) == len(doc["diagnostics"])
 
 
-@needs_iso
 def test_stdin_and_endless_loop_finish(tmp_path):
     prog = b"#1=0\nWHILE [1 EQ 1] DO1\n#1=#1+1\nEND1\nM30\n"
     rc, out, _ = nctrans("lint", "-", "--from", "iso-m", cwd=tmp_path, stdin=prog)
@@ -191,7 +174,6 @@ def test_stdin_and_endless_loop_finish(tmp_path):
     assert rc == 0    # NC205 is a warning
 
 
-@needs_iso
 def test_convert_refuses_to_overwrite_its_input(tmp_path):
     (tmp_path / "a.nc").write_text("G0 X1\nG1 X2 F100\nM30\n")
     rc, _, err = nctrans("convert", "a.nc", "--from", "iso-m", "--to", "iso-m", "-o", "a.nc", cwd=tmp_path)
@@ -206,12 +188,9 @@ nc_alphabet = st.sampled_from(list("GXYZIJKFSTMNORPQ0123456789.-+ ()[]#=;%\n\t/*
                               ["DEF ", "WHILE ", "IF ", "GOTO", "DO1", "END1", "R1=", "\r\n", "é", "\x00"])
 
 
-@needs_iso
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(nc_alphabet, max_size=80).map("".join), st.sampled_from(["iso-m", "sinumerik"]))
 def test_any_text_gives_located_diagnostics_not_exceptions(text, dialect):
-    if not available(dialect):
-        return
     src = decode(text.encode("utf-8"), "fz.nc")
     ld = pipeline.load_source(src, "fz.nc", dialect)
     diags = pipeline.lint(ld)
@@ -222,7 +201,6 @@ def test_any_text_gives_located_diagnostics_not_exceptions(text, dialect):
         assert d.severity in ("error", "warning", "info")
 
 
-@needs_sinumerik
 def test_sinumerik_non_ascii_code_is_a_diagnostic_not_a_crash():
     for text in ("é", "G1 X10 é\n"):
         ld = pipeline.load_source(decode(text.encode("utf-8"), "fz.mpf"), "fz.mpf", "sinumerik")

@@ -2,8 +2,7 @@
 
 Two kinds of test: in-process ones against a small fake dialect (registered for the test only), so
 the CLI's own behaviour is pinned whatever the state of the real front ends; and end-to-end ones
-through a subprocess with the real dialects on real corpus programs (skipped while a dialect is
-not there yet).
+through a subprocess with the real dialects on real corpus programs.
 """
 import hashlib
 import json
@@ -290,16 +289,8 @@ def test_convert_usage_errors(fake, capsys):
 
 
 
-def test_convert_flatten_when_the_module_is_missing_or_there(fake, capsys, monkeypatch):
+def test_convert_flatten(fake, capsys):
     Path("a.fk").write_text("G0 X1\nG1 X2 F100\n")
-    with monkeypatch.context() as m:
-        m.setitem(sys.modules, "nctrans.lower.flatten", None)        # import fails
-        rc, _, err = run(capsys, "convert", "a.fk", "--to", "fake", "--flatten")
-        assert rc == 2 and "--flatten is not available" in err
-    try:
-        import nctrans.lower.flatten  # noqa: F401
-    except ImportError:
-        pytest.skip("nctrans.lower.flatten not there yet")
     rc, out, err = run(capsys, "convert", "a.fk", "--to", "fake", "--flatten")
     assert rc == 0, err
     assert out.strip()
@@ -414,18 +405,8 @@ def test_detect_on_the_corpus():
 
 # --------------------------------------------------------------------------- end to end with real dialects
 
-def available(name: str) -> bool:
-    try:
-        return base.get(name) is not None
-    except Exception:
-        return False
 
 
-needs_iso = pytest.mark.skipif(not available("iso-m"), reason="iso-m front end not there yet")
-needs_sinumerik = pytest.mark.skipif(not available("sinumerik"), reason="sinumerik front end not there yet")
-
-
-@needs_iso
 def test_e2e_iso_toolpath_contract_on_the_sample(tmp_path):
     sample = ROOT / "corpus" / "iso-m" / "sample-pocket.nc"
     rc, out, err = sh("toolpath", str(sample), "--from", "iso-m")
@@ -445,7 +426,6 @@ def test_e2e_iso_toolpath_contract_on_the_sample(tmp_path):
     assert rc == 0 and "T1 T2" in out
 
 
-@needs_iso
 def test_e2e_iso_lint_corpus_file_has_no_syntax_errors():
     f = CORPUS / "iso-mill" / "donpayne-haas-O2001-advanced-arcs.cnc"
     rc, out, err = sh("lint", str(f), "--format", "json", "--select", "NC0")
@@ -453,7 +433,6 @@ def test_e2e_iso_lint_corpus_file_has_no_syntax_errors():
     assert doc["files"] == 1 and doc["diagnostics"] == [], doc
 
 
-@needs_iso
 def test_e2e_equiv_program_with_itself_and_a_changed_copy(tmp_path):
     sample = ROOT / "corpus" / "iso-m" / "sample-pocket.nc"
     rc, out, _ = sh("equiv", str(sample), str(sample))
@@ -464,8 +443,6 @@ def test_e2e_equiv_program_with_itself_and_a_changed_copy(tmp_path):
     assert rc == 1 and f"{sample}:" in out and f"{changed}:" in out
 
 
-@needs_iso
-@needs_sinumerik
 def test_e2e_convert_iso_to_sinumerik_is_equivalent(tmp_path):
     sample = ROOT / "corpus" / "iso-m" / "sample-pocket.nc"
     out = tmp_path / "pocket.mpf"
@@ -541,16 +518,11 @@ def test_convert_a_directory_keeps_its_structure(fake, capsys):
     assert sorted(str(p.relative_to("dst")) for p in Path("dst").rglob("*") if p.is_file()) == ["a.nc", "sub/b.nc"]
 
 
-@needs_iso
 def test_e2e_flatten_is_equivalent_to_its_source(tmp_path):
     sample = ROOT / "corpus" / "iso-m" / "sample-pocket.nc"
     for target, name in (("iso-m", "flat.nc"), ("sinumerik", "flat.mpf")):
-        if not available(target):
-            continue
         out = tmp_path / name
         rc, _, err = sh("convert", str(sample), "--flatten", "--to", target, "-o", str(out))
-        if rc == 2 and "not available" in err:
-            pytest.skip("--flatten not there yet")
         assert rc == 0, err
         rc, text, err = sh("equiv", str(sample), str(out), "--from-a", "iso-m", "--from-b", target)
         assert rc == 0, text + err
