@@ -13,7 +13,6 @@ from typing import Iterable, Optional
 from urllib.parse import quote
 
 from nctrans import __version__
-from nctrans import catalogue as _catalogue
 from nctrans.diagnostics import SEVERITIES, Diagnostic
 
 FORMATS = ("text", "json", "sarif", "github")
@@ -82,7 +81,7 @@ def _region(d: Diagnostic) -> dict:
             "endLine": max(end_line, 1), "endColumn": max(end_col, 1)}
 
 
-def _sarif_rule(r: _catalogue.Rule) -> dict:
+def _sarif_rule(r: "_catalogue.Rule") -> dict:
     help_text = f"{r.summary}\n\nWhy: {r.why}\n\nBad: {r.bad or '(an empty file)'}\nGood: {r.good}"
     if r.fix:
         help_text += f"\nFix: {r.fix}"
@@ -98,6 +97,7 @@ def _sarif_rule(r: _catalogue.Rule) -> dict:
 
 
 def sarif_document(diags: list[Diagnostic], cat: Optional[_catalogue.Catalogue] = None) -> dict:
+    from nctrans import catalogue as _catalogue    # pydantic: only SARIF needs the catalogue
     cat = cat or _catalogue.load()
     rules = [_sarif_rule(r) for r in cat.rule]
     index = {r.code: i for i, r in enumerate(cat.rule)}
