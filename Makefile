@@ -7,7 +7,7 @@ SAMPLE ?= corpus/iso-m/sample-pocket.nc
 
 .PHONY: run test bench fuzz clean venv
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py nctrans/_plainrun.c
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e '.[dev]'

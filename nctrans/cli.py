@@ -298,7 +298,8 @@ def cmd_toolpath(args) -> int:
     if ld.program is None:
         _print_text_diags(ld.diagnostics, sys.stderr)
         return EXIT_DIAGNOSTICS
-    records = pipeline.toolpath_of(ld, machine)
+    jsonl = not args.summary and args.format != "csv"
+    records = pipeline.toolpath_of(ld, machine, fast_sink="jsonl" if jsonl else None)
     from nctrans import toolpath_io
     out = sys.stdout
     if args.summary:

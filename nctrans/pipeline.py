@@ -271,10 +271,14 @@ def _parse_definition(path: Path, dialect: str) -> Optional[Program]:
 
 def run_toolpath(program: Program, machine: Optional[Machine], diagnostics: list[Diagnostic], *,
                  source_dir: Optional[str] = None, dialect: Optional[str] = None,
-                 max_steps: Optional[int] = None) -> Iterator[ToolpathRecord]:
-    """Stream the program's toolpath; interpreter diagnostics are appended to `diagnostics`."""
+                 max_steps: Optional[int] = None, fast_sink: Optional[str] = None
+                 ) -> Iterator[ToolpathRecord]:
+    """Stream the program's toolpath; interpreter diagnostics are appended to `diagnostics`.
+    fast_sink: see interp.interpret (the jsonl writer and lint pass it; other consumers get
+    ToolpathRecords only)."""
     from nctrans.interp import interpret     # deferred: `detect` and `rules` need no interpreter
-    kwargs = {"diagnostics": diagnostics, "resolver": make_resolver(source_dir, dialect)}
+    kwargs = {"diagnostics": diagnostics, "resolver": make_resolver(source_dir, dialect),
+              "fast_sink": fast_sink}
     preload = definition_programs(source_dir, dialect, search_paths())
     if preload:
         kwargs["preload"] = preload
@@ -283,13 +287,16 @@ def run_toolpath(program: Program, machine: Optional[Machine], diagnostics: list
     return interpret(program, machine, **kwargs)
 
 
-def toolpath_of(ld: Loaded, machine: Optional[Machine] = None) -> Iterator[ToolpathRecord]:
-    """Toolpath of a loaded file (nothing when it did not parse); diagnostics go to ld.diagnostics."""
+def toolpath_of(ld: Loaded, machine: Optional[Machine] = None,
+                fast_sink: Optional[str] = None) -> Iterator[ToolpathRecord]:
+    """Toolpath of a loaded file (nothing when it did not parse); diagnostics go to ld.diagnostics.
+    fast_sink="jsonl": the items may include plainrun.JsonChunk (toolpath_io.write_jsonl takes them)."""
     if ld.program is None:
         return iter(())
     if ld.streamed is not None:
-        return _streamed_toolpath(ld, machine)
-    return run_toolpath(ld.program, machine, ld.diagnostics, source_dir=ld.source_dir, dialect=ld.dialect)
+        return _streamed_toolpath(ld, machine, fast_sink)
+    return run_toolpath(ld.program, machine, ld.diagnostics, source_dir=ld.source_dir,
+                        dialect=ld.dialect, fast_sink=fast_sink)
 
 
 # Allocations between young-generation collections while a streamed program runs. Parse and run
@@ -298,13 +305,14 @@ def toolpath_of(ld: Loaded, machine: Optional[Machine] = None) -> Iterator[Toolp
 STREAM_GC_THRESHOLD = 100_000
 
 
-def _streamed_toolpath(ld: Loaded, machine: Optional[Machine]) -> Iterator[ToolpathRecord]:
+def _streamed_toolpath(ld: Loaded, machine: Optional[Machine],
+                       fast_sink: Optional[str]) -> Iterator[ToolpathRecord]:
     run_diags: list[Diagnostic] = []
     thresholds = gc.get_threshold()
     gc.set_threshold(max(thresholds[0], STREAM_GC_THRESHOLD), *thresholds[1:])
     try:
         yield from run_toolpath(ld.program, machine, run_diags, source_dir=ld.source_dir,
-                                dialect=ld.dialect)
+                                dialect=ld.dialect, fast_sink=fast_sink)
         _finish_stream(ld, run_diags)
     finally:
         gc.set_threshold(*thresholds)
@@ -313,7 +321,7 @@ def _streamed_toolpath(ld: Loaded, machine: Optional[Machine]) -> Iterator[Toolp
 def lint(ld: Loaded, machine: Optional[Machine] = None) -> list[Diagnostic]:
     """Parse diagnostics plus the interpreter's (records are drained and dropped)."""
     if ld.program is not None:
-        for _ in toolpath_of(ld, machine):
+        for _ in toolpath_of(ld, machine, fast_sink="discard"):
             pass
     _finish_stream(ld, [])
     return ld.diagnostics

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import IO, Iterable, Optional
 
 from nctrans.machine import Machine
+from nctrans.plainrun import JsonChunk
 from nctrans.toolpath import ToolpathRecord
 
 CSV_AXES = ("X", "Y", "Z", "A", "B", "C")
@@ -159,11 +160,18 @@ def to_json_line(r: ToolpathRecord) -> str:
     return s
 
 
-def write_jsonl(records: Iterable[ToolpathRecord], out: IO[str], on_record=None) -> int:
-    """Write each record as one line as it arrives; returns the count. on_record(rec) sees each one."""
+def write_jsonl(records: Iterable, out: IO[str], on_record=None) -> int:
+    """Write each record as one line as it arrives; returns the count. on_record(rec) sees each one.
+    The items may include JsonChunk (records the native kernel already wrote: toolpath_of(...,
+    fast_sink="jsonl")); on_record never sees those, so a caller that needs every record object
+    does not ask for them."""
     n = 0
     write = out.write
     for r in records:
+        if r.__class__ is JsonChunk:
+            write(r.text)
+            n += r.count
+            continue
         write(to_json_line(r) + "\n")
         if on_record is not None:
             on_record(r)

@@ -39,6 +39,8 @@ from nctrans.interp.evaluate import (UNKNOWN, EvalError, Evaluator, FrameValue, 
 from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.state import LINEAR_AXES, ModalState
 from nctrans.ir import nodes as n
+from nctrans import plainrun
+from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
 
 try:  # the colleague's modules; without them the feature is skipped
@@ -54,9 +56,10 @@ try:
 except ImportError:  # pragma: no cover
     CutterCompensator = PlannedMove = None
 
-BLOCK, JUMP, JFALSE, EXEC, CASE = range(5)
+BLOCK, JUMP, JFALSE, EXEC, CASE, PLAIN = range(6)
 MAX_CALL_DEPTH = 16
 STREAM_BATCH = 256          # blocks of a streamed main body compiled at a time
+PLAIN_EXPAND = 64           # blocks of a PlainRun expanded at a time when the kernel cannot run it
 MOVE_KINDS = frozenset(("rapid", "linear", "arc"))
 NORMAL = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 ROT_AXIS = NORMAL
@@ -137,7 +140,7 @@ class _Stop(Exception):
 
 class Interpreter:
     def __init__(self, program: n.Program, machine=None, *, diagnostics: list, resolver=None,
-                 max_steps: int = 2_000_000, flatten_hook=None, preload=()):
+                 max_steps: int = 2_000_000, flatten_hook=None, preload=(), fast_sink=None):
         if machine is None:
             from nctrans.machine import default_mill
             machine = default_mill()
@@ -148,6 +151,10 @@ class Interpreter:
         self.resolver = resolver
         self.max_steps = max_steps
         self.hook = flatten_hook
+        # "jsonl": the consumer takes JsonChunk items (already written records) among the records;
+        # "discard": it drops records unseen (lint). Either lets the native kernel run PlainRuns.
+        self.native = plainrun.native       # read per run: tests switch the kernel off
+        self.fast_sink = fast_sink if self.native is not None else None
         defaults = program.meta.get("defaults") if isinstance(program.meta, dict) else None
         self.st = ModalState(defaults if isinstance(defaults, dict) else None)
         self.ev = Evaluator()
@@ -239,6 +246,8 @@ class Interpreter:
                     unit.labels.setdefault(label_key(node.number), []).append(pc)
                 if node.label:
                     unit.labels.setdefault(label_key(node.label), []).append(pc)
+            elif t is PlainRun:
+                code.append((PLAIN, node, None, n.Span(node.file, node.line, 1, node.line, 1)))
             elif t is n.If:
                 j = len(code)
                 code.append(None)
@@ -1609,6 +1618,18 @@ class Interpreter:
                             ctl = ("modal_call",)
                     if ctl is not None:
                         unit, code, pc, sidx = self._control(ctl, unit, pc, sidx)
+                elif op == PLAIN:
+                    self.span = ins[3]
+                    done, rest = self._plain(ins[1], max_steps - steps + 1)
+                    steps += done - 1
+                    pc += 1
+                    if rest:
+                        # What the kernel left (Blocks, and the rest of the run) replaces what has
+                        # run: runs only come in streamed main bodies, where nothing jumps back,
+                        # so the batch stays short however long the run is.
+                        code[:pc] = rest
+                        pc = 0
+                        unit.seen = bytearray(len(code))
                 elif op == JUMP:
                     pc = ins[1]
                 elif op == JFALSE:
@@ -1649,10 +1670,84 @@ class Interpreter:
         self._comp_flush()
         yield from self._release(out)
 
+    # ---------------------------------------------------------------- plain runs
+    def _plain(self, run: PlainRun, budget: int) -> tuple[int, list]:
+        """Run a PlainRun: through the native kernel as far as it goes identically, then the
+        blocks it hands back through the Python path. Returns (blocks run here, code entries
+        still to run: the next Blocks and the rest of the run)."""
+        done = 0
+        tried = self._kernel_ready()
+        if tried:
+            done, run = self._plain_kernel(run, budget)
+            if run is None:
+                return done, []
+        blocks, rest = run.take(1 if tried else PLAIN_EXPAND)
+        entries = [(BLOCK, None, b, b.span) for b in blocks]
+        if rest is not None:
+            entries.append((PLAIN, rest, None, n.Span(rest.file, rest.line, 1, rest.line, 1)))
+        return done, entries
+
+    def _kernel_ready(self) -> bool:
+        """The state the kernel handles: _h_fast's (no cycle, comp, frame), no modal call or
+        flatten hook, feed per minute or per revolution, one axis order for both positions."""
+        st = self.st
+        if (self.fast_sink is None or st.cycle != "off" or self.modal_cycle is not None
+                or self.comp is not None or self.comp_exit or st.comp_side != "off"
+                or not self.frame.identity or self.modal_call is not None or self.hook is not None
+                or st.feed_mode not in ("per_min", "per_rev") or self.out):
+            return False
+        axes = "".join(self.pos)
+        return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)
+
+    def _plain_kernel(self, run: PlainRun, budget: int) -> tuple[int, Optional[PlainRun]]:
+        st = self.st
+        pos, mpos = self.pos, self.mpos
+        axes = "".join(pos)
+        tot = self.off.total
+        motion = {"rapid": 0, "linear": 1}.get(st.motion, 2)
+        tail = ""
+        if st.spindle_speed is not None:
+            tail += ',"spindle":' + _spell(st.spindle_speed)
+        if st.tool is not None:
+            tail += f',"tool":{int(st.tool)}'
+        write = self.fast_sink == "jsonl"
+        (stop, line, blocks, chunk, records, prog, mach, new_motion, feed, feed_seen,
+         last_from) = self.native.run(
+            run.text, run.start, run.end, run.sep, run.line, axes, list(pos.values()),
+            [tot.get(a, 0.0) for a in axes] if tot else None, list(mpos.values()), st.scale,
+            st.incremental, motion, st.feed, f',"feed_mode":"{st.feed_mode}"', tail, self._seq,
+            _json_str(run.file), budget, write)
+        if blocks:
+            self.pos = dict(zip(axes, prog))
+            self.mpos = dict(zip(axes, mach))
+            if last_from is not None:
+                self.last_from = dict(zip(axes, last_from))
+                self.last_arc = None
+                self.moved = True
+            if new_motion != motion:
+                st.set("motion", ("rapid", "linear")[new_motion])
+            if feed_seen:
+                st.feed = feed
+                self.feed_reported = False
+            if records:
+                if write:
+                    self.out.append(JsonChunk(chunk, records))
+                else:
+                    self._seq += records
+        rest = None
+        if blocks < run.blocks:
+            rest = PlainRun(run.file, run.text, stop, run.end, line, run.sep, run.blocks - blocks,
+                            run.lower)
+        return blocks, rest
+
     def _release(self, out: list) -> Iterator[ToolpathRecord]:
         """Number the records a block produced, show them to the flatten hook, and hand them on."""
         hook, hookq = self.hook, self._hookq
         for rec in out:
+            if rec.__class__ is JsonChunk:
+                self._seq += rec.count
+                yield rec
+                continue
             self._seq += 1
             rec.seq = self._seq
             if hook is not None:
@@ -1774,9 +1869,26 @@ class Interpreter:
 
 
 def interpret(program: n.Program, machine=None, *, diagnostics: list, resolver=None,
-              max_steps: int = 2_000_000, flatten_hook=None, preload=()) -> Iterator[ToolpathRecord]:
+              max_steps: int = 2_000_000, flatten_hook=None, preload=(),
+              fast_sink: Optional[str] = None) -> Iterator[ToolpathRecord]:
     """Run `program` and yield its canonical motions one by one (see the module docstring).
     preload: programs whose declarations (VarDecl) run first as global variables, such as the
-    definition files (Sinumerik GUD *.DEF) beside the program."""
+    definition files (Sinumerik GUD *.DEF) beside the program. fast_sink: "jsonl" when the
+    consumer also takes JsonChunk items (records the native kernel already wrote as JSON lines),
+    "discard" when it drops records unseen; either lets plain runs take the kernel."""
     return Interpreter(program, machine, diagnostics=diagnostics, resolver=resolver,
-                       max_steps=max_steps, flatten_hook=flatten_hook, preload=preload).run()
+                       max_steps=max_steps, flatten_hook=flatten_hook, preload=preload,
+                       fast_sink=fast_sink).run()
+
+
+_KERNEL_AXES = frozenset("XYZABCUVW")
+
+
+def _spell(v) -> str:
+    from nctrans.toolpath_io import _spell as spell
+    return spell(v)
+
+
+def _json_str(s: str) -> str:
+    from nctrans.toolpath_io import _str
+    return _str(s)

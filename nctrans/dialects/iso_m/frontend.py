@@ -16,6 +16,7 @@ import re
 from operator import itemgetter
 from typing import Any, Optional
 
+from nctrans import plainrun
 from nctrans.diagnostics import Diagnostic
 from nctrans.ir.nodes import (
     Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
@@ -31,6 +32,8 @@ from .prelex import clean, strip_comments
 DIALECT = "iso-m"
 AXES = "XYZABCUVW"
 AXIS_SET = frozenset(AXES)
+# Plain lines in a row before the streamed parse hands them over as one PlainRun.
+PLAIN_RUN_MIN = 2
 CENTER_LETTERS = frozenset("IJK")
 
 # rs274ngc order of execution (the interpreter runs Block.body as listed).
@@ -458,12 +461,22 @@ class Lowering:
         b.out.append((B_END, SubCall(name, [], named, repeat, modal, kind, bindings)))
 
     # ------------------------------------------------------------------ block
-    def hot(self, words: list, _axes=AXIS_SET, _av=AxisValue, _num=Num,
-            _float=float) -> Optional[tuple]:
+    def hot(self, words: list) -> Optional[tuple]:
         """Lowering of the commonest CAM blocks, [N] [G0|G1] axis words [F], exactly as lower()
         would do it (tests/test_iso_fastpath.py compares them); None sends the block to lower()."""
         if self.standard:
             return None
+        done = self.plain_block(words)
+        if done is not None and done[2] is not None:
+            self.motion = done[2]
+            self.cycle = None
+        return done
+
+    def plain_block(self, words: list, _axes=AXIS_SET, _av=AxisValue, _num=Num,
+                    _float=float) -> Optional[tuple]:
+        """(number, body, motion mode written or None) of a plain block, without touching the
+        tracked modal state (plainrun.PlainRun expands lines with it after the front end has moved
+        on); None when the block is not [N] [G0|G1] axis words [F]."""
         number = None
         target: dict = {}
         mode = feed = None
@@ -488,11 +501,9 @@ class Lowering:
             body.append(feed)
         if mode is not None:
             body.append(mode)
-            self.motion = mode.value
-            self.cycle = None
         if target:
             body.append(Motion(target))
-        return number, body
+        return number, body, None if mode is None else mode.value
 
     def lower(self, items: list, line: int) -> tuple[Optional[str], list, list, Optional[str]]:
         """Lower one block's word list. Returns (number, body, structure items, unknown G)."""
@@ -815,17 +826,34 @@ def parse_stream(text: str, file: str = "<stdin>"):
     return ParseResult(program, diags)
 
 
-def _split_lines(text: str, sep: str):
-    """text.split(sep), one piece at a time (no list of every line)."""
-    find = text.find
-    start = 0
-    while True:
-        i = find(sep, start)
+class _Lines:
+    """(line number, text) of each piece of text.split(sep), one at a time (no list of every line),
+    keeping where the current line starts so that a run of plain lines can be stepped over whole."""
+    __slots__ = ("text", "sep", "start", "pos", "lineno")
+
+    def __init__(self, text: str, sep: str):
+        self.text, self.sep = text, sep
+        self.start = self.pos = 0
+        self.lineno = 0
+
+    def __iter__(self):
+        return self
+
+    def __next__(self) -> tuple[int, str]:
+        pos, text = self.pos, self.text
+        if pos > len(text):
+            raise StopIteration
+        i = text.find(self.sep, pos)
         if i < 0:
-            yield text[start:]
-            return
-        yield text[start:i]
-        start = i + 1
+            i = len(text)
+        self.start, self.pos = pos, i + 1
+        self.lineno += 1
+        return self.lineno, text[pos:i]
+
+    def skip_to(self, pos: int, lines: int) -> None:
+        """Continue after `lines` lines that end just before `pos` (the current one among them)."""
+        self.pos = pos
+        self.lineno += lines - 1
 
 
 def _parse_lines(text: str, file: str, program: Program, diags: list, main: list, stream: bool):
@@ -850,7 +878,11 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                                 file, 1))
         text = text.replace("\x00", "")
     sep = "\n" if "\n" in text else "\r"
-    lines = _split_lines(text, sep) if stream else text.split(sep)
+    lines = _Lines(text, sep) if stream else enumerate(text.split(sep), 1)
+    # Streamed and with the native kernel: runs of plain lines become one PlainRun each.
+    plain_scan = plainrun.native.scan if stream and plainrun.native is not None and not low.standard \
+        else None
+    plain_block = low.plain_block
     fast_plain = PLAIN.fullmatch
     fast_words = WORD.findall
     lower = low.lower
@@ -868,11 +900,22 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     hot = low.hot
     _block = Block
     _span = Span
-    for lineno, raw in enumerate(lines, 1):
+    for lineno, raw in lines:
         if stream and main:
             main_seen = True
             yield from main
             main.clear()
+        if plain_scan is not None and cur is main:
+            end, nlines, nblocks, motion = plain_scan(text, lines.start, sep)
+            if nblocks >= PLAIN_RUN_MIN:
+                cur.append(plainrun.PlainRun(file, text, lines.start, end, lineno, sep, nblocks,
+                                             plain_block))
+                lines.skip_to(end, nlines)
+                if motion >= 0:
+                    low.motion = ("rapid", "linear")[motion]
+                    low.cycle = None
+                seen_block = True
+                continue
         # Hot path: a comment-free line of plain axis words (most of CAM output).
         if not ("(" in raw or ";" in raw or ")" in raw):
             code = raw.replace(" ", "")

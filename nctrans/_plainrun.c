@@ -1,0 +1,585 @@
+/* nctrans._plainrun — the native kernel for runs of plain ISO blocks.
+ *
+ * CAM output is tens of thousands of blocks like `N1234 G1 X1.234 Y-5.6 F800.`: address letters and
+ * plain numbers, no comment, no expression. In pure Python every such block costs a regex match,
+ * a handful of IR objects, a record object and a JSON line (~25 us); this kernel does the same work
+ * for a whole run of them straight from the source text (~1 us a block). It is a specialisation of
+ * the Python path, never the definition of behaviour:
+ *
+ *   scan()  accepts a subset of the blocks the ISO front end's plain fast path (fastpath.PLAIN plus
+ *           Lowering.hot) accepts: [N] [G0|G1] axis words [F] in that order-free form, ASCII only;
+ *   run()   executes such a run exactly as the interpreter's _h_fast would and writes the JSON lines
+ *           toolpath_io.to_json_line would write, given the interpreter's state. It stops at the
+ *           first block it cannot do identically (unknown axis, no feed, arc mode, a number whose
+ *           spelling needs repr(), ...) and hands that block back to Python.
+ *
+ * tests/test_plainrun.py holds the two to each other on corpus programs and generated ones.
+ * Numbers are read with PyOS_string_to_double (what float() uses) and written with glibc's exactly
+ * rounded "%.6f", the spelling toolpath_io._spell uses in the same range.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define MAX_LINE 256   /* longer blocks go to Python */
+#define MAX_AXES 9     /* XYZABCUVW */
+
+static const char AXIS_LETTERS[] = "XYZABCUVW";
+
+typedef struct {
+    int kind;
+    const void *data;
+    Py_ssize_t len;
+} Text;
+
+typedef struct {
+    /* where each word's number starts in the line buffer and how long it is; len 0: absent */
+    int axis_at[MAX_AXES], axis_len[MAX_AXES];
+    int naxis_words;
+    int gmode;      /* -1: no G word, 0: G0, 1: G1 */
+    int feed_at, feed_len;
+    int has_number;
+} Block;
+
+/* Copy text[p:q) without spaces into buf (NUL-terminated); drop one trailing '\r'. Returns the
+ * length, or -1 when the line cannot be plain (too long, non-ASCII, a comment character). */
+static int clean_line(const Text *t, Py_ssize_t p, Py_ssize_t q, char *buf)
+{
+    int n = 0;
+    for (Py_ssize_t i = p; i < q; i++) {
+        Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
+        if (c == ' ')
+            continue;
+        if (c >= 128 || c == '(' || c == ')' || c == ';' || n >= MAX_LINE - 1)
+            return -1;
+        buf[n++] = (char)c;
+    }
+    if (n > 0 && buf[n - 1] == '\r')
+        n--;
+    buf[n] = '\0';
+    return n;
+}
+
+static int is_digit(char c) { return c >= '0' && c <= '9'; }
+
+/* Length of a number [-+]?(\d+\.?\d*|\.\d+) at s, 0 when there is none. */
+static int number_len(const char *s)
+{
+    int i = 0;
+    if (s[i] == '-' || s[i] == '+')
+        i++;
+    if (is_digit(s[i])) {
+        while (is_digit(s[i]))
+            i++;
+        if (s[i] == '.') {
+            i++;
+            while (is_digit(s[i]))
+                i++;
+        }
+        return i;
+    }
+    if (s[i] == '.' && is_digit(s[i + 1])) {
+        i++;
+        while (is_digit(s[i]))
+            i++;
+        return i;
+    }
+    return 0;
+}
+
+/* The G word as the rules table reads it (normalise_code after lstrip('+')): 0 for G0, 1 for G1,
+ * -1 for anything else (which the plain path does not take). */
+static int motion_g(const char *s, int len)
+{
+    int i = 0, neg = 0;
+    if (s[0] == '+')
+        i++;
+    else if (s[0] == '-') {
+        neg = 1;
+        i++;
+    }
+    long whole = 0;
+    int digits = 0;
+    for (; i < len && is_digit(s[i]); i++) {
+        if (whole > 10)
+            return -1;
+        whole = whole * 10 + (s[i] - '0');
+        digits++;
+    }
+    if (i < len && s[i] == '.') {
+        for (i++; i < len; i++)
+            if (s[i] != '0')
+                return -1;          /* G1.5 and the like: not a plain motion code */
+    }
+    if (neg && (whole != 0 || digits == 0))
+        return -1;                  /* int("-1") is no G code; int("-") is no number at all */
+    return whole <= 1 ? (int)whole : -1;
+}
+
+/* Parse a cleaned line into words: 1 when the block is plain (what Lowering.hot takes), else 0. */
+static int parse_block(const char *buf, int n, Block *b)
+{
+    memset(b, 0, sizeof *b);
+    b->gmode = -1;
+    int have_target = 0, have_mode = 0, have_feed = 0;
+    int i = 0;
+    if (n == 0 || buf[0] == 'O')
+        return 0;
+    while (i < n) {
+        char letter = buf[i];
+        if (letter < 'A' || letter > 'Z')
+            return 0;
+        int at = i + 1;
+        int len = number_len(buf + at);
+        if (len == 0)
+            return 0;
+        const char *ax = strchr(AXIS_LETTERS, letter);
+        if (ax != NULL) {
+            int k = (int)(ax - AXIS_LETTERS);
+            if (b->axis_len[k] != 0)
+                return 0;
+            b->axis_at[k] = at;
+            b->axis_len[k] = len;
+            b->naxis_words++;
+            have_target = 1;
+        } else if (letter == 'G' && !have_mode) {
+            int g = motion_g(buf + at, len);
+            if (g < 0)
+                return 0;
+            b->gmode = g;
+            have_mode = 1;
+        } else if (letter == 'F' && !have_feed) {
+            b->feed_at = at;
+            b->feed_len = len;
+            have_feed = 1;
+        } else if (letter == 'N' && !b->has_number && !have_target && !have_mode && !have_feed) {
+            b->has_number = 1;
+        } else {
+            return 0;
+        }
+        i = at + len;
+    }
+    return 1;
+}
+
+/* float() of a word's number (copied out: the next letter may be an E, which strtod would read
+ * as an exponent). */
+static int number_value(const char *buf, int at, int len, double *out)
+{
+    char tmp[MAX_LINE + 1];
+    memcpy(tmp, buf + at, (size_t)len);
+    tmp[len] = '\0';
+    *out = PyOS_string_to_double(tmp, NULL, NULL);
+    if (*out == -1.0 && PyErr_Occurred())
+        return -1;
+    return 0;
+}
+
+static int get_text(PyObject *str, Text *t)
+{
+    if (!PyUnicode_Check(str)) {
+        PyErr_SetString(PyExc_TypeError, "text must be str");
+        return -1;
+    }
+    if (PyUnicode_READY(str) < 0)
+        return -1;
+    t->kind = PyUnicode_KIND(str);
+    t->data = PyUnicode_DATA(str);
+    t->len = PyUnicode_GET_LENGTH(str);
+    return 0;
+}
+
+static Py_ssize_t line_end(const Text *t, Py_ssize_t p, Py_UCS4 sep)
+{
+    while (p < t->len && PyUnicode_READ(t->kind, t->data, p) != sep)
+        p++;
+    return p;
+}
+
+/* A line holding nothing but spaces and '\r': no block (the front end skips it). */
+static int blank_line(const Text *t, Py_ssize_t p, Py_ssize_t q)
+{
+    for (Py_ssize_t i = p; i < q; i++) {
+        Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
+        if (c != ' ' && c != '\r')
+            return 0;
+    }
+    return 1;
+}
+
+/* scan(text, pos, sep) -> (end, lines, blocks, motion)
+ * The run of plain lines starting at pos: `end` is where the next line starts (len(text) + 1 when
+ * the run reaches the end of the text), `lines` how many lines it spans, `blocks` how many of them
+ * are blocks (blank lines inside the run are not), `motion` the last G word's mode (-1: none). The
+ * run never starts with a blank line. */
+static PyObject *scan(PyObject *self, PyObject *args)
+{
+    PyObject *str;
+    Py_ssize_t pos;
+    int sepc;
+    if (!PyArg_ParseTuple(args, "UnC", &str, &pos, &sepc))
+        return NULL;
+    Text t;
+    if (get_text(str, &t) < 0)
+        return NULL;
+    char buf[MAX_LINE + 1];
+    Block b;
+    Py_ssize_t p = pos, lines = 0, blocks = 0, blanks = 0;
+    int motion = -1;
+    while (p >= 0 && p <= t.len) {
+        Py_ssize_t q = line_end(&t, p, (Py_UCS4)sepc);
+        if (blank_line(&t, p, q)) {
+            if (blocks == 0)
+                break;
+            blanks++;                  /* counted only if a block follows */
+        } else {
+            int n = clean_line(&t, p, q, buf);
+            if (n <= 0 || !parse_block(buf, n, &b))
+                break;
+            if (b.gmode >= 0)
+                motion = b.gmode;
+            blocks++;
+            lines += blanks + 1;
+            blanks = 0;
+        }
+        p = q + 1;
+        if (blanks == 0)
+            pos = p;
+    }
+    return Py_BuildValue("(nnni)", pos, lines, blocks, motion);
+}
+
+/* ------------------------------------------------------------------ output buffer */
+
+typedef struct {
+    char *data;
+    size_t len, cap;
+} Buf;
+
+static int buf_grow(Buf *b, size_t extra)
+{
+    if (b->len + extra <= b->cap)
+        return 0;
+    size_t cap = b->cap ? b->cap : 1 << 16;
+    while (cap < b->len + extra)
+        cap *= 2;
+    char *d = PyMem_Realloc(b->data, cap);
+    if (d == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    b->data = d;
+    b->cap = cap;
+    return 0;
+}
+
+static int buf_put(Buf *b, const char *s, size_t n)
+{
+    if (buf_grow(b, n) < 0)
+        return -1;
+    memcpy(b->data + b->len, s, n);
+    b->len += n;
+    return 0;
+}
+
+/* toolpath_io._spell for the values it formats with "%.6f": 1e-4 <= |v| < 1e9, and values that
+ * round to zero ("0.0"). Returns the length, or -1 when only repr() would spell v the same way. */
+static int spell(double v, char *out)
+{
+    double a = fabs(v);
+    if (!(a < 1e9))
+        return -1;                      /* also NaN */
+    if (a < 1e-4) {
+        if (a < 4.9e-7) {
+            memcpy(out, "0.0", 4);
+            return 3;
+        }
+        return -1;
+    }
+    int n = snprintf(out, 32, "%.6f", v);
+    if (n <= 0 || n >= 32)
+        return -1;
+    while (out[n - 1] == '0')
+        n--;
+    if (out[n - 1] == '.')
+        out[n++] = '0';
+    out[n] = '\0';
+    return n;
+}
+
+/* '{"X":..,"Y":..}' for the given values; -1 when a value needs repr(). */
+static int spell_point(const double *v, int naxes, const char *axes, char *out)
+{
+    int n = 0;
+    out[n++] = '{';
+    for (int k = 0; k < naxes; k++) {
+        if (k)
+            out[n++] = ',';
+        out[n++] = '"';
+        out[n++] = axes[k];
+        out[n++] = '"';
+        out[n++] = ':';
+        int m = spell(v[k], out + n);
+        if (m < 0)
+            return -1;
+        n += m;
+    }
+    out[n++] = '}';
+    out[n] = '\0';
+    return n;
+}
+
+static int read_doubles(PyObject *seq, double *out, int n, const char *what)
+{
+    if (!PyList_Check(seq) || PyList_GET_SIZE(seq) != n) {
+        PyErr_Format(PyExc_ValueError, "%s: a list of %d floats expected", what, n);
+        return -1;
+    }
+    for (int k = 0; k < n; k++) {
+        out[k] = PyFloat_AsDouble(PyList_GET_ITEM(seq, k));
+        if (out[k] == -1.0 && PyErr_Occurred())
+            return -1;
+    }
+    return 0;
+}
+
+static PyObject *doubles_list(const double *v, int n)
+{
+    PyObject *l = PyList_New(n);
+    if (l == NULL)
+        return NULL;
+    for (int k = 0; k < n; k++) {
+        PyObject *f = PyFloat_FromDouble(v[k]);
+        if (f == NULL) {
+            Py_DECREF(l);
+            return NULL;
+        }
+        PyList_SET_ITEM(l, k, f);
+    }
+    return l;
+}
+
+/* run(text, pos, end, sep, lineno, axes, prog, tot, mach, scale, incremental, motion, feed,
+ *     feed_mode_json, rapid_tail, seq, file_json, max_blocks, write)
+ *   -> (pos, lineno, blocks, chunk, records, prog, mach, motion, feed, feed_seen, last_from)
+ *
+ * Runs the plain blocks in text[pos:end) (a run scan() found) from the interpreter's state:
+ * axes: the program position's axis letters in order ("XYZ"); prog: that position (program
+ * coordinates, mm); tot: the total offset per axis; mach: the machine position per axis;
+ * scale: 25.4 under inch units, else 1; motion: 0 rapid, 1 linear, 2 anything else; feed: the
+ * active feed (mm/min) or None; feed_mode_json: ',"feed_mode":"per_min"' as the record writes it;
+ * rapid_tail: the spindle and tool fields every motion record ends with; seq: the last record's
+ * number; file_json: the file as a JSON string. Returns where it stopped (the first block it cannot
+ * run identically, or `end`), the JSON lines (None unless `write`) and the new state. */
+static PyObject *run(PyObject *self, PyObject *args)
+{
+    PyObject *str, *axes_obj, *prog_obj, *tot_obj, *mach_obj, *feed_obj;
+    Py_ssize_t pos, end, lineno, seq, max_blocks;
+    int sepc, incremental, motion, write;
+    double scale;
+    const char *fm_json, *tail_json, *file_json;
+    Py_ssize_t fm_len, tail_len, file_len;
+    if (!PyArg_ParseTuple(args, "UnnCnUOOOdpiOs#s#ns#np", &str, &pos, &end, &sepc, &lineno,
+                          &axes_obj, &prog_obj, &tot_obj, &mach_obj, &scale, &incremental, &motion,
+                          &feed_obj, &fm_json, &fm_len, &tail_json, &tail_len, &seq, &file_json,
+                          &file_len, &max_blocks, &write))
+        return NULL;
+    Text t;
+    if (get_text(str, &t) < 0)
+        return NULL;
+    Py_ssize_t axes_len;
+    const char *axes = PyUnicode_AsUTF8AndSize(axes_obj, &axes_len);
+    if (axes == NULL)
+        return NULL;
+    if (axes_len > MAX_AXES) {
+        PyErr_SetString(PyExc_ValueError, "too many axes");
+        return NULL;
+    }
+    int naxes = (int)axes_len;
+    int slot[MAX_AXES];                 /* letter index in AXIS_LETTERS -> position in axes, -1 */
+    int linear[MAX_AXES];
+    for (int k = 0; k < MAX_AXES; k++)
+        slot[k] = -1;
+    for (int k = 0; k < naxes; k++) {
+        const char *ax = strchr(AXIS_LETTERS, axes[k]);
+        if (ax == NULL || axes[k] == '\0') {
+            PyErr_Format(PyExc_ValueError, "axis %c is not an ISO axis letter", axes[k]);
+            return NULL;
+        }
+        slot[ax - AXIS_LETTERS] = k;
+        linear[k] = strchr("XYZUVW", axes[k]) != NULL;
+    }
+    double prog[MAX_AXES], tot[MAX_AXES], mach[MAX_AXES], from[MAX_AXES];
+    /* tot None: no offset at all; the interpreter then copies the position (keeps a -0.0) */
+    int has_tot = tot_obj != Py_None;
+    if (read_doubles(prog_obj, prog, naxes, "prog") < 0 || read_doubles(mach_obj, mach, naxes, "mach") < 0
+        || (has_tot && read_doubles(tot_obj, tot, naxes, "tot") < 0))
+        return NULL;
+    int has_feed = feed_obj != Py_None;
+    double feed = 0.0;
+    if (has_feed) {
+        feed = PyFloat_AsDouble(feed_obj);
+        if (feed == -1.0 && PyErr_Occurred())
+            return NULL;
+    }
+    int feed_seen = 0, moved = 0;
+    Py_ssize_t blocks = 0, records = 0;
+    Buf out = {NULL, 0, 0};
+    char line[MAX_LINE + 1];
+    char start_json[MAX_AXES * 48 + 4], end_json[MAX_AXES * 48 + 4], feed_json[40];
+    int start_len = -1, feed_len = -1;
+    double feed_spelled = 0.0;          /* the feed feed_json spells (valid when feed_len >= 0) */
+    Block b;
+
+    while (pos < end && blocks < max_blocks) {
+        Py_ssize_t q = line_end(&t, pos, (Py_UCS4)sepc);
+        if (blank_line(&t, pos, q)) {
+            pos = q + 1;
+            lineno++;
+            continue;
+        }
+        int n = clean_line(&t, pos, q, line);
+        if (n <= 0 || !parse_block(line, n, &b))
+            break;                      /* not a run scan() gave: Python takes over */
+        /* Work out the whole block before changing any state, so a block the kernel cannot do
+         * identically is left entirely to Python. Order as the interpreter: feed, mode, motion. */
+        double new_feed = feed;
+        int new_has_feed = has_feed;
+        if (b.feed_len) {
+            double v;
+            if (number_value(line, b.feed_at, b.feed_len, &v) < 0)
+                goto fail;
+            if (!(v >= 0) || !isfinite(v))
+                break;                  /* negative feed: a diagnostic Python reports */
+            new_feed = v * scale;
+            new_has_feed = 1;
+        }
+        int new_motion = b.gmode >= 0 ? b.gmode : motion;
+        double tgt[MAX_AXES];
+        int bail = 0;
+        if (b.naxis_words) {
+            if (new_motion > 1 || (new_motion == 1 && !(new_has_feed && new_feed != 0.0)))
+                break;                  /* arc/cycle mode, or a feed move without feed */
+            memcpy(tgt, prog, sizeof prog);
+            for (int k = 0; k < MAX_AXES && !bail; k++) {
+                if (b.axis_len[k] == 0)
+                    continue;
+                int s = slot[k];
+                if (s < 0) {
+                    bail = 1;           /* an axis the position does not have yet */
+                    break;
+                }
+                double v;
+                if (number_value(line, b.axis_at[k], b.axis_len[k], &v) < 0)
+                    goto fail;
+                if (linear[s] && scale != 1.0)
+                    v = v * scale;
+                if (incremental)
+                    v += tgt[s];
+                tgt[s] = v;
+            }
+            if (bail)
+                break;
+            double mend[MAX_AXES];
+            for (int k = 0; k < naxes; k++) {
+                mend[k] = has_tot ? tgt[k] + tot[k] : tgt[k];
+                if (!isfinite(mend[k]))
+                    bail = 1;
+            }
+            if (bail)
+                break;
+            if (write) {
+                int el = spell_point(mend, naxes, axes, end_json);
+                if (el < 0)
+                    break;
+                if (start_len < 0) {
+                    start_len = spell_point(mach, naxes, axes, start_json);
+                    if (start_len < 0)
+                        break;
+                }
+                if (new_motion == 1 && (feed_len < 0 || new_feed != feed_spelled)) {
+                    feed_len = spell(new_feed, feed_json);
+                    if (feed_len < 0)
+                        break;
+                    feed_spelled = new_feed;
+                }
+                char head[160];
+                int hl = snprintf(head, sizeof head, "{\"seq\":%zd,\"file\":", seq + 1);
+                char mid[96];
+                int ml = snprintf(mid, sizeof mid, ",\"line\":%zd,\"kind\":\"%s\",\"start\":", lineno,
+                                  new_motion == 0 ? "rapid" : "linear");
+                if (buf_put(&out, head, (size_t)hl) < 0 || buf_put(&out, file_json, (size_t)file_len) < 0
+                    || buf_put(&out, mid, (size_t)ml) < 0 || buf_put(&out, start_json, (size_t)start_len) < 0
+                    || buf_put(&out, ",\"end\":", 7) < 0 || buf_put(&out, end_json, (size_t)el) < 0)
+                    goto fail;
+                if (new_motion == 1) {
+                    if (buf_put(&out, ",\"feed\":", 8) < 0 || buf_put(&out, feed_json, (size_t)feed_len) < 0
+                        || buf_put(&out, fm_json, (size_t)fm_len) < 0)
+                        goto fail;
+                }
+                if (buf_put(&out, tail_json, (size_t)tail_len) < 0 || buf_put(&out, "}\n", 2) < 0)
+                    goto fail;
+                memcpy(start_json, end_json, (size_t)el + 1);
+                start_len = el;
+            }
+            memcpy(from, prog, sizeof prog);
+            memcpy(prog, tgt, sizeof prog);
+            memcpy(mach, mend, sizeof mend);
+            moved = 1;
+            seq++;
+            records++;
+        }
+        if (b.feed_len) {
+            feed = new_feed;
+            has_feed = 1;
+            feed_seen = 1;
+        }
+        motion = new_motion;
+        blocks++;
+        pos = q + 1;
+        lineno++;
+    }
+    PyObject *chunk;
+    if (write && out.len) {
+        chunk = PyUnicode_DecodeASCII(out.data, (Py_ssize_t)out.len, NULL);
+        if (chunk == NULL)
+            goto fail;
+    } else {
+        chunk = Py_NewRef(Py_None);
+    }
+    PyMem_Free(out.data);
+    PyObject *prog_l = doubles_list(prog, naxes), *mach_l = doubles_list(mach, naxes);
+    PyObject *from_l = moved ? doubles_list(from, naxes) : Py_NewRef(Py_None);
+    PyObject *feed_o = has_feed ? PyFloat_FromDouble(feed) : Py_NewRef(Py_None);
+    if (prog_l == NULL || mach_l == NULL || from_l == NULL || feed_o == NULL) {
+        Py_XDECREF(prog_l);
+        Py_XDECREF(mach_l);
+        Py_XDECREF(from_l);
+        Py_XDECREF(feed_o);
+        Py_DECREF(chunk);
+        return NULL;
+    }
+    return Py_BuildValue("(nnnNnNNiNiN)", pos, lineno, blocks, chunk, records, prog_l, mach_l, motion,
+                         feed_o, feed_seen, from_l);
+fail:
+    PyMem_Free(out.data);
+    return NULL;
+}
+
+static PyMethodDef methods[] = {
+    {"scan", scan, METH_VARARGS, "scan(text, pos, sep) -> (end, lines, blocks, motion)"},
+    {"run", run, METH_VARARGS, "run the plain blocks of a scanned run (see the module source)"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "nctrans._plainrun",
+    "Native kernel for runs of plain ISO blocks (see nctrans/plainrun.py).", -1, methods,
+};
+
+PyMODINIT_FUNC PyInit__plainrun(void)
+{
+    return PyModule_Create(&module);
+}

@@ -1,0 +1,194 @@
+"""The native plain-run kernel against the Python path it specialises (nctrans/plainrun.py).
+
+The kernel must be invisible: the same JSON lines, byte for byte, and the same diagnostics as the
+pure-Python front end and interpreter (plainrun.native switched off), on every corpus program and
+on generated programs built to hit its edges (inch, incremental, offsets, arc modes, missing
+feed, tiny and huge numbers, unknown axes, odd G spellings, CRLF, blank lines). Without the
+compiled extension these tests skip, except in CI, where the build must have produced it.
+"""
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from nctrans import pipeline, plainrun, source, toolpath_io
+from nctrans.dialects.iso_m.fastpath import PLAIN, WORD
+from nctrans.dialects.iso_m.frontend import Lowering
+
+from conftest import CORPUS
+
+GEOMETRY = Path(__file__).parent / "data" / "rs274-geometry-machine.toml"
+NATIVE = plainrun.native
+
+
+@pytest.fixture(autouse=True)
+def _need_native():
+    if NATIVE is None:
+        if os.environ.get("CI"):
+            pytest.fail("nctrans._plainrun was not built: the install must compile it in CI", pytrace=False)
+        pytest.skip("nctrans._plainrun not built (no C compiler?)")
+
+
+def run(text: str, kernel: bool, machine=None, name: str = "t.nc", lint: bool = False):
+    """(JSON lines, diagnostics, JSON chunks seen) of the streamed toolpath, with or without kernel."""
+    saved = plainrun.native
+    plainrun.native = NATIVE if kernel else None
+    try:
+        src = source.decode(text.encode("latin-1", errors="replace"), name)
+        ld = pipeline.load_source(src, name, "iso-m", stream=True)
+        m = pipeline.load_machine(machine, "iso-m")
+        buf = io.StringIO()
+        chunks = 0
+        if lint:
+            pipeline.lint(ld, m)
+        else:
+            items = list(pipeline.toolpath_of(ld, m, fast_sink="jsonl" if kernel else None))
+            chunks = sum(1 for r in items if isinstance(r, plainrun.JsonChunk))
+            toolpath_io.write_jsonl(items, buf)
+        diags = [(d.rule, d.severity, d.line, d.column, d.message) for d in ld.diagnostics]
+        return buf.getvalue(), diags, chunks
+    finally:
+        plainrun.native = saved
+
+
+def iso_corpus():
+    return sorted(p for p in (CORPUS / "iso-mill").iterdir() if p.is_file())
+
+
+@pytest.mark.parametrize("machine", [None, str(GEOMETRY)], ids=["zero-tools", "geometry"])
+@pytest.mark.parametrize("path", iso_corpus(), ids=lambda p: p.name)
+def test_corpus_program_same_with_and_without_kernel(path, machine):
+    text = source.decode(path.read_bytes(), path.name).text
+    slow, slow_diags, _ = run(text, kernel=False, machine=machine, name=path.name)
+    fast, fast_diags, _ = run(text, kernel=True, machine=machine, name=path.name)
+    assert fast_diags == slow_diags
+    assert fast == slow
+
+
+def test_kernel_carries_a_cam_program():
+    """Not vacuous: on the big adaptive-clearing program nearly every record comes from the kernel."""
+    path = CORPUS / "iso-mill" / "mheaton-fusion-adaptive-1001.nc"
+    text = source.decode(path.read_bytes(), path.name).text
+    out, _, chunks = run(text, kernel=True, name=path.name)
+    assert chunks > 10
+    records = out.count("\n")
+    src = source.decode(path.read_bytes(), path.name)
+    ld = pipeline.load_source(src, path.name, "iso-m", stream=True)
+    objects = [r for r in pipeline.toolpath_of(ld, None, fast_sink="jsonl")
+               if not isinstance(r, plainrun.JsonChunk)]
+    assert records > 20_000 and len(objects) < records / 10
+
+
+@pytest.mark.parametrize("text", [
+    "%\nO1\nG1F250.\nX1.\nX2.\nG1F100.\nX3.\nX4.\nM30\n%\n",       # F in a block without motion
+    "%\nO1\nG20G91G1F10.\nX1.Y1.\nX.5\nG90X0Y0\nZ-.1\nM30\n%\n",       # inch, incremental
+    "%\nO1\nG0X1.\nG2X2.Y1.R1.F50.\nX3.Y2.\nG1X4.\nX5.\nM30\n%\n",    # arc mode hands back
+    "%\nO1\nG1X1.\nX2.\nF100.X3.\nM30\n%\n",                          # no feed yet: NC202
+    "%\nO1\nG0X1.\nX0.00001\nX0.0000001\nX1000000000.5\nX2.\nM30\n%\n",  # spellings only repr() has
+])
+def test_edge_programs_same_with_and_without_kernel(text):
+    assert run(text, kernel=True)[:2] == run(text, kernel=False)[:2]
+
+
+def test_lint_same_with_and_without_kernel():
+    text = "%\nO1\nG21G90G54\nG0X0Y0Z5.\nG1X1.Z-1.\nX2.\nG1F100.X3.\nF-5.X4.\nM30\n%\n"
+    assert run(text, kernel=True, lint=True)[1] == run(text, kernel=False, lint=True)[1]
+    assert any(d[0] == "NC202" for d in run(text, kernel=True, lint=True)[1])   # G1 without feed
+
+
+# ------------------------------------------------------------------ generated programs
+
+NUMBER = st.one_of(
+    st.integers(-99999, 99999).map(lambda i: f"{i / 1000:.3f}"),
+    st.integers(-999, 999).map(str),                                   # no decimal point
+    st.integers(0, 255).map(lambda j: f"{j / 128:.7f}"),               # ties at the 7th decimal
+    st.sampled_from(["0.00001", "-0.00004", "0.0000004", ".5", "5.", "-.25", "+1.5", "0", "-0.",
+                     "123456789.", "1000000000.5", "9" * 30]),
+)
+AXIS_WORD = st.tuples(st.sampled_from("XYZ" * 6 + "ABUW"), NUMBER).map("".join)
+G_WORD = st.sampled_from(["G0", "G1", "G1", "G00", "G01", "G1.0", "G+1", "G-0", "G.0", "G-1", "G2",
+                          "G3", "G1.5", "G001", "G90", "G91"])
+ODD = st.sampled_from(["F0", "F-5.", "S1000", "I1.", "R2.", "N5", "G1", "X1.", "M8"])
+# mostly CAM-shaped lines ([N] [G] axes [F]) so the kernel runs; now and then a word it must refuse
+PLAIN_LINE = st.tuples(
+    st.sampled_from(["", "", "N10", "N0020"]),
+    st.one_of(st.just(""), st.just(""), G_WORD),
+    st.lists(AXIS_WORD, min_size=0, max_size=3).map("".join),
+    st.sampled_from(["", "", "", "F300.", "F.5", "F1200"]),
+    st.one_of(*[st.just("")] * 8, ODD),
+).map(lambda t: [w for w in t if w])
+SPACED = st.tuples(PLAIN_LINE, st.booleans()).map(lambda t: (" " if t[1] else "").join(t[0]))
+HEADER = st.lists(st.sampled_from(["G20", "G21", "G90", "G91", "G54", "G55", "G43H1", "G43H3", "G49",
+                                   "G17", "G18", "M3S1200", "T2M6", "G94", "G95", "G93", "G0Z5.",
+                                   "G1F100.", "G2X1.Y1.R1.F50.", "G52X10.Y-5.", "G92X0Y0"]),
+                  min_size=0, max_size=4)
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(HEADER.map("".join), st.lists(st.one_of(*[SPACED] * 6, HEADER.map("".join), st.just("")),
+                                     min_size=1, max_size=30),
+       st.sampled_from(["\n", "\r\n"]), st.booleans())
+def test_generated_program_same_with_and_without_kernel(header, lines, newline, geometry):
+    text = newline.join(["%", "O1", header, "G1F250."] + lines + ["M30", "%"]) + newline
+    machine = str(GEOMETRY) if geometry else None
+    slow = run(text, kernel=False, machine=machine)
+    fast = run(text, kernel=True, machine=machine)
+    assert fast[1] == slow[1]
+    assert fast[0] == slow[0]
+
+
+COORD = st.one_of(st.integers(-99999, 99999).map(lambda i: f"{i / 1000:.4f}"), NUMBER)
+CAM_LINE = st.tuples(
+    st.sampled_from(["", "N10 ", "N0020"]),
+    st.sampled_from(["", "", "", "G1", "G0", "G01 ", "G00", "G2", "G1.0"]),
+    st.lists(st.sampled_from("XYZ"), min_size=1, max_size=3, unique=True),
+    st.lists(COORD, min_size=3, max_size=3),
+    st.sampled_from(["", "", "", "", "F300.", "F1200", " F.5"]),
+).map(lambda t: t[0] + t[1] + "".join(f"{a}{v}" for a, v in zip(t[2], t[3])) + t[4])
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(HEADER.map("".join), st.lists(st.one_of(*[CAM_LINE] * 12, HEADER.map("".join)), min_size=5,
+                                     max_size=60), st.booleans())
+def test_generated_cam_program_same_with_and_without_kernel(header, lines, geometry):
+    """CAM-shaped programs, where the kernel carries most blocks and hands some back."""
+    text = "\n".join(["%", "O1", header, "G1F250."] + lines + ["M30", "%"]) + "\n"
+    machine = str(GEOMETRY) if geometry else None
+    slow = run(text, kernel=False, machine=machine)
+    fast = run(text, kernel=True, machine=machine)
+    assert fast[1] == slow[1]
+    assert fast[0] == slow[0]
+
+
+# ------------------------------------------------------------------ the scan
+
+@settings(max_examples=400, deadline=None)
+@given(SPACED, st.sampled_from(["", "\r"]))
+def test_scan_accepts_only_what_the_python_fast_path_lowers(line, cr):
+    """A line the kernel takes is a line the Python fast path takes, with the same motion mode."""
+    text = line + cr + "\n"
+    _end, _lines, blocks, motion = NATIVE.scan(text, 0, "\n")
+    code = (line + cr).replace(" ", "")
+    code = code[:-1] if code.endswith("\r") else code
+    python = None
+    if code and code[0] != "O" and PLAIN.fullmatch(code):
+        python = Lowering("t.nc", []).plain_block(WORD.findall(code))
+    if blocks:
+        assert python is not None, line
+        assert motion == {None: -1, "rapid": 0, "linear": 1}[python[2]]
+    elif python is not None:
+        # the kernel may be more careful than Python, never less: only over-long lines
+        assert len(code) >= 255, line
+
+
+def test_scan_spans_blank_lines_inside_a_run_only():
+    text = "\nG1X1.\n\nX2.\n\n(comment)\nX3.\n"
+    assert NATIVE.scan(text, 0, "\n")[2] == 0                 # a run never starts on a blank line
+    end, lines, blocks, motion = NATIVE.scan(text, 1, "\n")
+    assert (lines, blocks, motion) == (3, 2, 1)
+    assert text[end:].startswith("\n(comment)")              # the trailing blank line is not taken
