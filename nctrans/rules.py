@@ -1,4 +1,4 @@
-"""Dialect code tables (`rules/<dialect>.toml`) loaded and validated with pydantic.
+"""Dialect code tables (`rules/<dialect>.toml`) loaded and validated with pydantic (nctrans.tables).
 
 A table lists every G/M (or keyword) code a dialect knows: its neutral (group, value) meaning from
 `nctrans.ir.vocabulary`, its own modal-group number, whether it is modal, whether it is the power-on
@@ -7,12 +7,12 @@ reverse way; the lint catalogue documents from here. No G-code tables in if-chai
 """
 from __future__ import annotations
 
-import tomllib
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 from typing import Any, Optional
 
-from pydantic import BaseModel, ConfigDict, Field
+from nctrans import tables
 
 RULES_DIR = Path(__file__).resolve().parent.parent / "rules"
 
@@ -28,8 +28,9 @@ def normalise_code(letter: str, number: str | float | int) -> str:
     return f"{letter.upper()}{int(text)}"
 
 
-class CodeRule(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+@dataclass
+class CodeRule:
+    __pydantic_config__ = {"extra": "forbid"}
     code: str                       # canonical spelling, e.g. "G0", "G54.1", "M3", "TRANS"
     group: str                      # neutral group ("motion", "plane", ...) or a statement kind
     value: str = ""                 # neutral value within the group
@@ -38,22 +39,28 @@ class CodeRule(BaseModel):
     dialect_group: Optional[int | str] = None   # the manual's own group number/name
     meaning: str = ""
     ref: str = ""                   # seed line reference
-    args: dict[str, str] = Field(default_factory=dict)   # address letter -> neutral parameter
+    args: dict[str, str] = field(default_factory=dict)   # address letter -> neutral parameter
 
 
-class RulesTable(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+@dataclass
+class RulesTable:
+    __pydantic_config__ = {"extra": "forbid"}
     dialect: str
     description: str = ""
-    options: dict[str, Any] = Field(default_factory=dict)
-    addresses: dict[str, str] = Field(default_factory=dict)   # letter -> what it is
-    codes: list[CodeRule] = Field(default_factory=list)
+    options: dict[str, Any] = field(default_factory=dict)
+    addresses: dict[str, str] = field(default_factory=dict)   # letter -> what it is
+    codes: list[CodeRule] = field(default_factory=list)
 
-    def model_post_init(self, _ctx: Any) -> None:
+    def __post_init__(self) -> None:
         self._by_code = {c.code.upper(): c for c in self.codes}
         self._by_meaning: dict[tuple[str, str], CodeRule] = {}
         for c in self.codes:
             self._by_meaning.setdefault((c.group, c.value), c)
+
+    @classmethod
+    def from_data(cls, data: dict) -> "RulesTable":
+        """The table from validated data (tables.load): the rules become CodeRule objects."""
+        return cls(**{**data, "codes": [CodeRule(**c) for c in data.get("codes", ())]})
 
     def lookup(self, code: str) -> Optional[CodeRule]:
         """The rule for a canonical code spelling (see normalise_code), or None if unknown."""
@@ -70,7 +77,5 @@ class RulesTable(BaseModel):
 
 @lru_cache(maxsize=None)
 def load_table(dialect: str) -> RulesTable:
-    path = RULES_DIR / f"{dialect}.toml"
-    with path.open("rb") as fh:
-        data = tomllib.load(fh)
-    return RulesTable.model_validate(data)
+    """rules/<dialect>.toml, validated by pydantic (once per content: see nctrans.tables)."""
+    return tables.load(RULES_DIR / f"{dialect}.toml", RulesTable, RulesTable.from_data)

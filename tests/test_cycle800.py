@@ -114,7 +114,7 @@ def test_retract_records():
     recs, _ = run('G0 X3 Y4 Z20\nCYCLE800(5,"T",0,57,0,0,0,0,0,0,0,0,0,1,15)')
     assert moves(recs, line=5) == [("rapid", (3.0, 4.0, 35.0))]
     # the machine model's max travel, under a work offset (machine coordinates)
-    m = default_mill().model_copy(deep=True)
+    m = default_mill().copy()
     m.axes["Z"].max = 400.0
     recs, _ = run('G0 X3 Y4 Z20\nCYCLE800(4,"T",0,57,0,0,0,0,0,90,0,0,0,1,0)\nG0 X0 Y0', m)
     assert moves(recs, line=5) == [("rapid", (3.0, 4.0, 400.0))]

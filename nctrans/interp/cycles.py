@@ -38,12 +38,11 @@ cycles drilling in +Z work too; LinuxCNC would reject R below Z (see `cycle_prob
 from __future__ import annotations
 
 import math
-import tomllib
+from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Literal, Optional, Sequence
 
-from pydantic import BaseModel, ConfigDict, Field
-
+from nctrans import tables
 from nctrans.rules import RULES_DIR
 
 DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
@@ -239,51 +238,70 @@ def cycle_problems(kind: str, *, approach: float, bottom: float, peck: float | N
 # ---------------------------------------------------------------------------------------------
 # Sinumerik standard cycles (rules/cycles.toml)
 
-class KindBy(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+@dataclass
+class KindBy:
+    __pydantic_config__ = {"extra": "forbid"}
     param: str
     values: dict[str, str]
 
 
-class SinumerikCycle(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+@dataclass
+class SinumerikCycle:
+    __pydantic_config__ = {"extra": "forbid"}
     name: str
     kind: str
-    meaning: str = ""
     params: list[str]
+    meaning: str = ""
     kind_by: Optional[KindBy] = None
 
 
-class HolePattern(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+@dataclass
+class HolePattern:
+    __pydantic_config__ = {"extra": "forbid"}
     name: str
     shape: Literal["row", "circle"]
-    meaning: str = ""
     params: list[str]
+    meaning: str = ""
 
 
-class SwivelCycle(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+@dataclass
+class SwivelCycle:
+    __pydantic_config__ = {"extra": "forbid"}
     name: str
     kind: Literal["swivel_plane"]
-    meaning: str = ""
     params: list[str]
+    meaning: str = ""
 
 
-class SwivelModes(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+@dataclass
+class SwivelModes:
+    __pydantic_config__ = {"extra": "forbid"}
     modes: dict[str, str]
-    axes: dict[str, Literal["X", "Y", "Z"]] = Field(default_factory=dict)
+    axes: dict[str, Literal["X", "Y", "Z"]] = field(default_factory=dict)
 
 
-class CycleTable(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-    names: dict[str, str] = Field(default_factory=dict)
-    cycle: list[SinumerikCycle] = Field(default_factory=list)
-    pattern: list[HolePattern] = Field(default_factory=list)
-    swivel: list[SwivelCycle] = Field(default_factory=list)
-    swivel_mode: SwivelModes = Field(default_factory=lambda: SwivelModes(modes={"0": "axis"}))
-    swivel_retract: SwivelModes = Field(default_factory=lambda: SwivelModes(modes={"0": "none"}))
+@dataclass
+class CycleTable:
+    """rules/cycles.toml: Siemens standard cycles, hole patterns and CYCLE800 (schema for pydantic)."""
+    __pydantic_config__ = {"extra": "forbid"}
+    names: dict[str, str] = field(default_factory=dict)
+    cycle: list[SinumerikCycle] = field(default_factory=list)
+    pattern: list[HolePattern] = field(default_factory=list)
+    swivel: list[SwivelCycle] = field(default_factory=list)
+    swivel_mode: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "axis"}))
+    swivel_retract: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "none"}))
+
+    @classmethod
+    def from_data(cls, d: dict) -> "CycleTable":
+        """The table from validated data (tables.load)."""
+        def cycle(c: dict) -> SinumerikCycle:
+            kb = c.get("kind_by")
+            return SinumerikCycle(**{**c, "kind_by": None if kb is None else KindBy(**kb)})
+        return cls(names=d["names"], cycle=[cycle(c) for c in d["cycle"]],
+                   pattern=[HolePattern(**p) for p in d["pattern"]],
+                   swivel=[SwivelCycle(**w) for w in d["swivel"]],
+                   swivel_mode=SwivelModes(**d["swivel_mode"]),
+                   swivel_retract=SwivelModes(**d["swivel_retract"]))
 
     def neutral(self, name: str) -> str:
         """The neutral key of a Siemens parameter name, or its lowercase spelling if it has none."""
@@ -292,8 +310,8 @@ class CycleTable(BaseModel):
 
 @lru_cache(maxsize=1)
 def cycle_table() -> CycleTable:
-    with open(RULES_DIR / "cycles.toml", "rb") as fh:
-        return CycleTable.model_validate(tomllib.load(fh))
+    """rules/cycles.toml, validated by pydantic (once per content: see nctrans.tables)."""
+    return tables.load(RULES_DIR / "cycles.toml", CycleTable, CycleTable.from_data)
 
 
 def sinumerik_cycles() -> dict[str, SinumerikCycle]:
@@ -358,17 +376,17 @@ def hole_pattern(name: str, args: Sequence[float | None]) -> list[tuple[float, f
 # ---------------------------------------------------------------------------------------------
 # CYCLE800 swivel plane
 
-class SwivelPlan(BaseModel):
+@dataclass
+class SwivelPlan:
     """What one CYCLE800 call does, decoded from its neutral parameters (see `swivel_plan`)."""
-    model_config = ConfigDict(extra="forbid")
     retract: str = "none"                    # [swivel_retract] value, or "unknown"
     retract_inc: float = 0.0
     mode: str = "axis"                       # [swivel_mode] value, or "unknown"
     additive: bool = False
     deselect: bool = False
-    ref: dict[str, float] = Field(default_factory=dict)       # TRANS / ATRANS before rotation
-    rotations: list[tuple[str, float]] = Field(default_factory=list)   # AROT, in order
-    shift: dict[str, float] = Field(default_factory=dict)     # ATRANS after rotation
+    ref: dict[str, float] = field(default_factory=dict)       # TRANS / ATRANS before rotation
+    rotations: list[tuple[str, float]] = field(default_factory=list)   # AROT, in order
+    shift: dict[str, float] = field(default_factory=dict)     # ATRANS after rotation
 
 
 def swivel_axis_order(mode: int) -> list[Optional[str]]:

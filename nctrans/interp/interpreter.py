@@ -799,7 +799,7 @@ class Interpreter:
         idx = int(round(idx))
         inc = self.st.incremental
         if self.machine is not None and not getattr(self, "_machine_copied", False):
-            self.machine = self.machine.model_copy(deep=True)
+            self.machine = self.machine.copy()
             self._machine_copied = True
         m = self.machine
         if s.kind == "work_offset":
