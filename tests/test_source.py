@@ -138,3 +138,11 @@ def test_line_and_column_of_every_character_survive_normalisation(lines, nl):
             if ch.isprintable() or ch == "\t":
                 assert got[col - 1] == ch
                 assert src.location(src.offset(i, col)) == (i, col)
+
+
+@pytest.mark.parametrize("text", ["a\r\nb", "a\rb", "a\r\r\nb\n\rc\r", "\r\n\r\n", "a\x0cb\x7fc\td", "ä\x85x\ufeffy\x01"])
+def test_newlines_and_stray_controls_normalised_as_the_plain_regexes_would(text):
+    import re
+    want = re.sub("[\x00-\x08\x0b-\x1f\x7f-\x9f\ufeff]", " ", re.sub("\r\n?", "\n", text))
+    got = from_text(text, "t.nc").text
+    assert got == (want if want.endswith("\n") else want + "\n")
