@@ -298,9 +298,36 @@ static int spell(double v, char *out)
         }
         return -1;
     }
-    int n = snprintf(out, 32, "%.6f", v);
-    if (n <= 0 || n >= 32)
-        return -1;
+    int n;
+    double x = v * 1e6;
+    double r = nearbyint(x);
+    if (a < 1e5 && fabs(fabs(x - r) - 0.5) > 1e-3) {
+        /* x is within 1e-5 of v * 10^6 exactly (|x| < 1e11), so unless that is nearly a tie,
+         * rounding x rounds the exact value: the digits "%.6f" would print, without printf */
+        long long q = (long long)r;
+        char digits[24];
+        int neg = q < 0, k = 0;
+        unsigned long long u = neg ? (unsigned long long)(-q) : (unsigned long long)q;
+        do {
+            digits[k++] = (char)('0' + u % 10);
+            u /= 10;
+        } while (u);
+        while (k < 7)
+            digits[k++] = '0';           /* at least one digit before the point */
+        n = 0;
+        if (neg)
+            out[n++] = '-';
+        while (k > 6)
+            out[n++] = digits[--k];
+        out[n++] = '.';
+        while (k > 0)
+            out[n++] = digits[--k];
+        out[n] = '\0';
+    } else {
+        n = snprintf(out, 32, "%.6f", v);
+        if (n <= 0 || n >= 32)
+            return -1;
+    }
     while (out[n - 1] == '0')
         n--;
     if (out[n - 1] == '.')
@@ -568,7 +595,21 @@ fail:
     return NULL;
 }
 
+/* spell(v) -> str | None: the kernel's number spelling, for tests against toolpath_io._spell. */
+static PyObject *spell_py(PyObject *self, PyObject *arg)
+{
+    double v = PyFloat_AsDouble(arg);
+    if (v == -1.0 && PyErr_Occurred())
+        return NULL;
+    char out[40];
+    int n = spell(v, out);
+    if (n < 0)
+        Py_RETURN_NONE;
+    return PyUnicode_DecodeASCII(out, n, NULL);
+}
+
 static PyMethodDef methods[] = {
+    {"spell", spell_py, METH_O, "spell(v) -> the JSON spelling of v, or None where only repr() spells it"},
     {"scan", scan, METH_VARARGS, "scan(text, pos, sep) -> (end, lines, blocks, motion)"},
     {"run", run, METH_VARARGS, "run the plain blocks of a scanned run (see the module source)"},
     {NULL, NULL, 0, NULL},

@@ -192,3 +192,15 @@ def test_scan_spans_blank_lines_inside_a_run_only():
     end, lines, blocks, motion = NATIVE.scan(text, 1, "\n")
     assert (lines, blocks, motion) == (3, 2, 1)
     assert text[end:].startswith("\n(comment)")              # the trailing blank line is not taken
+
+
+@settings(max_examples=3000, deadline=None)
+@given(st.one_of(st.floats(-2e9, 2e9, allow_nan=False), st.floats(-1e-3, 1e-3),
+                 st.integers(-10**9, 10**9).map(lambda i: i / 128),
+                 st.integers(-10**12, 10**12).map(lambda i: (i + 0.5) / 1e6),
+                 st.sampled_from([0.0, -0.0, 1e-4, -1e-4, 4.9e-7, 5e-7, 99999.9999995, 1e9, 0.0078125])))
+def test_kernel_spells_numbers_as_the_jsonl_writer(v):
+    """Every spelling the kernel writes is _spell's; where it declines, the block goes to Python."""
+    got = NATIVE.spell(v)
+    if got is not None:
+        assert got == toolpath_io._spell(v)
