@@ -26,6 +26,9 @@
 #define MAX_LINE 256   /* longer blocks go to Python */
 #define MAX_AXES 9     /* XYZABCUVW */
 
+/* motion modes as the Python side passes them (plainrun.MOTIONS) */
+enum { MOTION_RAPID, MOTION_LINEAR, MOTION_CW, MOTION_CCW, MOTION_OTHER };
+
 static const char AXIS_LETTERS[] = "XYZABCUVW";
 
 typedef struct {
@@ -38,7 +41,9 @@ typedef struct {
     /* where each word's number starts in the line buffer and how long it is; len 0: absent */
     int axis_at[MAX_AXES], axis_len[MAX_AXES];
     int naxis_words;
-    int gmode;      /* -1: no G word, 0: G0, 1: G1 */
+    int gmode;      /* -1: no G word, else a MOTION_* code */
+    int ijk_at[3], ijk_len[3];          /* centre words I J K; len 0: absent */
+    int nijk;
     int feed_at, feed_len;
     int has_number;
 } Block;
@@ -89,8 +94,8 @@ static int number_len(const char *s)
     return 0;
 }
 
-/* The G word as the rules table reads it (normalise_code after lstrip('+')): 0 for G0, 1 for G1,
- * -1 for anything else (which the plain path does not take). */
+/* The G word as the rules table reads it (normalise_code after lstrip('+')): G0..G3 as their
+ * MOTION_* code, -1 for anything else (which the plain path does not take). */
 static int motion_g(const char *s, int len)
 {
     int i = 0, neg = 0;
@@ -115,7 +120,7 @@ static int motion_g(const char *s, int len)
     }
     if (neg && (whole != 0 || digits == 0))
         return -1;                  /* int("-1") is no G code; int("-") is no number at all */
-    return whole <= 1 ? (int)whole : -1;
+    return whole <= 3 ? (int)whole : -1;
 }
 
 /* Parse a cleaned line into words: 1 when the block is plain (what Lowering.hot takes), else 0. */
@@ -123,7 +128,7 @@ static int parse_block(const char *buf, int n, Block *b)
 {
     memset(b, 0, sizeof *b);
     b->gmode = -1;
-    int have_target = 0, have_mode = 0, have_feed = 0;
+    int have_target = 0, have_mode = 0, have_feed = 0, have_center = 0;
     int i = 0;
     if (n == 0 || buf[0] == 'O')
         return 0;
@@ -154,7 +159,16 @@ static int parse_block(const char *buf, int n, Block *b)
             b->feed_at = at;
             b->feed_len = len;
             have_feed = 1;
-        } else if (letter == 'N' && !b->has_number && !have_target && !have_mode && !have_feed) {
+        } else if (letter >= 'I' && letter <= 'K') {
+            int k = letter - 'I';
+            if (b->ijk_len[k] != 0)
+                return 0;
+            b->ijk_at[k] = at;
+            b->ijk_len[k] = len;
+            b->nijk++;
+            have_center = 1;
+        } else if (letter == 'N' && !b->has_number && !have_target && !have_mode && !have_feed
+                   && !have_center) {
             b->has_number = 1;
         } else {
             return 0;
@@ -209,17 +223,36 @@ static int blank_line(const Text *t, Py_ssize_t p, Py_ssize_t q)
     return 1;
 }
 
-/* scan(text, pos, sep) -> (end, lines, blocks, motion)
- * The run of plain lines starting at pos: `end` is where the next line starts (len(text) + 1 when
- * the run reaches the end of the text), `lines` how many lines it spans, `blocks` how many of them
- * are blocks (blank lines inside the run are not), `motion` the last G word's mode (-1: none). The
- * run never starts with a blank line. */
+/* Whether a parsed block is one the plain path lowers, given the static modal state before it
+ * (Lowering.plain_block): centre words only in arc mode, incremental (G91.1), with no canned
+ * cycle pending. Updates
+ * the state as the front end would (a motion G word sets the mode and ends the cycle). */
+static int plain_in_state(const Block *b, int *motion, int *cycle_off, int arc_abs)
+{
+    int eff = b->gmode >= 0 ? b->gmode : *motion;
+    if (b->nijk && (arc_abs || (eff != MOTION_CW && eff != MOTION_CCW)))
+        return 0;
+    if (b->nijk && b->gmode < 0 && !*cycle_off)
+        return 0;
+    if (b->gmode >= 0) {
+        *motion = b->gmode;
+        *cycle_off = 1;
+    }
+    return 1;
+}
+
+/* scan(text, pos, sep, motion, cycle_off, arc_abs) -> (end, lines, blocks, motion)
+ * The run of plain lines starting at pos, given the front end's static motion mode (a MOTION_*
+ * code), whether no canned cycle is active and whether centres are absolute (G90.1): `end` is where the next line starts (len(text) + 1
+ * when the run reaches the end of the text), `lines` how many lines it spans, `blocks` how many of
+ * them are blocks (blank lines inside the run are not), `motion` the last G word's mode (-1:
+ * none). The run never starts with a blank line. */
 static PyObject *scan(PyObject *self, PyObject *args)
 {
     PyObject *str;
     Py_ssize_t pos;
-    int sepc;
-    if (!PyArg_ParseTuple(args, "UnC", &str, &pos, &sepc))
+    int sepc, motion, cycle_off, arc_abs;
+    if (!PyArg_ParseTuple(args, "UnCipp", &str, &pos, &sepc, &motion, &cycle_off, &arc_abs))
         return NULL;
     Text t;
     if (get_text(str, &t) < 0)
@@ -227,7 +260,7 @@ static PyObject *scan(PyObject *self, PyObject *args)
     char buf[MAX_LINE + 1];
     Block b;
     Py_ssize_t p = pos, lines = 0, blocks = 0, blanks = 0;
-    int motion = -1;
+    int last_g = -1;
     while (p >= 0 && p <= t.len) {
         Py_ssize_t q = line_end(&t, p, (Py_UCS4)sepc);
         if (blank_line(&t, p, q)) {
@@ -236,10 +269,10 @@ static PyObject *scan(PyObject *self, PyObject *args)
             blanks++;                  /* counted only if a block follows */
         } else {
             int n = clean_line(&t, p, q, buf);
-            if (n <= 0 || !parse_block(buf, n, &b))
+            if (n <= 0 || !parse_block(buf, n, &b) || !plain_in_state(&b, &motion, &cycle_off, arc_abs))
                 break;
             if (b.gmode >= 0)
-                motion = b.gmode;
+                last_g = b.gmode;
             blocks++;
             lines += blanks + 1;
             blanks = 0;
@@ -248,7 +281,7 @@ static PyObject *scan(PyObject *self, PyObject *args)
         if (blanks == 0)
             pos = p;
     }
-    return Py_BuildValue("(nnni)", pos, lines, blocks, motion);
+    return Py_BuildValue("(nnni)", pos, lines, blocks, last_g);
 }
 
 /* ------------------------------------------------------------------ output buffer */
@@ -388,30 +421,47 @@ static PyObject *doubles_list(const double *v, int n)
     return l;
 }
 
+/* Python's math.hypot for two finite doubles is correctly rounded where glibc's hypot may be off by
+ * an ulp; the kernel only uses it to decide an arc is clearly on the circle (see run), far from
+ * any threshold, so the last bit never decides anything. */
+static double hyp(double a, double b) { return hypot(a, b); }
+
+/* Append s[0:n] to the output buffer, or jump to fail. */
+#define PUT(s, n)                                                                                  \
+    do {                                                                                           \
+        if (buf_put(&out, (s), (size_t)(n)) < 0)                                                   \
+            goto fail;                                                                             \
+    } while (0)
+
 /* run(text, pos, end, sep, lineno, axes, prog, tot, mach, scale, incremental, motion, feed,
- *     feed_mode_json, rapid_tail, seq, file_json, max_blocks, write)
- *   -> (pos, lineno, blocks, chunk, records, prog, mach, motion, feed, feed_seen, last_from)
+ *     feed_mode_json, rapid_tail, seq, file_json, max_blocks, write, plane, arc_absolute, inch_tol)
+ *   -> (pos, lineno, blocks, chunk, records, prog, mach, motion, feed, feed_seen, last_from,
+ *       last_arc, last_g)
  *
  * Runs the plain blocks in text[pos:end) (a run scan() found) from the interpreter's state:
  * axes: the program position's axis letters in order ("XYZ"); prog: that position (program
- * coordinates, mm); tot: the total offset per axis; mach: the machine position per axis;
- * scale: 25.4 under inch units, else 1; motion: 0 rapid, 1 linear, 2 anything else; feed: the
+ * coordinates, mm); tot: the total offset per axis, or None when there is none; mach: the machine
+ * position per axis; scale: 25.4 under inch units, else 1; motion: a MOTION_* code; feed: the
  * active feed (mm/min) or None; feed_mode_json: ',"feed_mode":"per_min"' as the record writes it;
  * rapid_tail: the spindle and tool fields every motion record ends with; seq: the last record's
- * number; file_json: the file as a JSON string. Returns where it stopped (the first block it cannot
- * run identically, or `end`), the JSON lines (None unless `write`) and the new state. */
+ * number; file_json: the file as a JSON string; plane: "XY", "ZX" or "YZ"; arc_absolute: I J K
+ * are absolute (G90.1); center_tol: the arc centre tolerance (arcs.CENTER_TOL_*). Returns where
+ * it stopped (the first block it cannot run identically, or `end`), the JSON lines (None unless
+ * `write`) and the new state; last_arc is (c1, c2, cw) when the last move was an arc; last_g the
+ * MOTION_* code of the last G word in the blocks run (-1: none). */
 static PyObject *run(PyObject *self, PyObject *args)
 {
     PyObject *str, *axes_obj, *prog_obj, *tot_obj, *mach_obj, *feed_obj;
     Py_ssize_t pos, end, lineno, seq, max_blocks;
-    int sepc, incremental, motion, write;
-    double scale;
-    const char *fm_json, *tail_json, *file_json;
-    Py_ssize_t fm_len, tail_len, file_len;
-    if (!PyArg_ParseTuple(args, "UnnCnUOOOdpiOs#s#ns#np", &str, &pos, &end, &sepc, &lineno,
+    int sepc, incremental, motion, write, arc_absolute;
+    double scale, center_tol;
+    const char *fm_json, *tail_json, *file_json, *plane;
+    Py_ssize_t fm_len, tail_len, file_len, plane_len;
+    if (!PyArg_ParseTuple(args, "UnnCnUOOOdpiOs#s#ns#nps#pd", &str, &pos, &end, &sepc, &lineno,
                           &axes_obj, &prog_obj, &tot_obj, &mach_obj, &scale, &incremental, &motion,
                           &feed_obj, &fm_json, &fm_len, &tail_json, &tail_len, &seq, &file_json,
-                          &file_len, &max_blocks, &write))
+                          &file_len, &max_blocks, &write, &plane, &plane_len, &arc_absolute,
+                          &center_tol))
         return NULL;
     Text t;
     if (get_text(str, &t) < 0)
@@ -438,6 +488,21 @@ static PyObject *run(PyObject *self, PyObject *args)
         slot[ax - AXIS_LETTERS] = k;
         linear[k] = strchr("XYZUVW", axes[k]) != NULL;
     }
+    /* the plane's axes (first, second, normal) as positions in `axes`, and which centre word
+     * (I J K index) belongs to each of the first two; -1 when the position lacks the axis */
+    int pa[3] = {-1, -1, -1}, pc[2] = {-1, -1};
+    if (plane_len == 2) {
+        const char *normal = strcmp(plane, "XY") == 0 ? "Z" : strcmp(plane, "ZX") == 0 ? "Y" : "X";
+        const char names[3] = {plane[0], plane[1], normal[0]};
+        for (int j = 0; j < 3; j++) {
+            const char *ax = strchr(AXIS_LETTERS, names[j]);
+            pa[j] = ax ? slot[ax - AXIS_LETTERS] : -1;
+        }
+        pc[0] = plane[0] - 'X';         /* X->I, Y->J, Z->K */
+        pc[1] = plane[1] - 'X';
+    }
+    int arcs_ok = pa[0] >= 0 && pa[1] >= 0 && pa[2] >= 0 && pc[0] >= 0 && pc[0] < 3 && pc[1] >= 0
+                  && pc[1] < 3;
     double prog[MAX_AXES], tot[MAX_AXES], mach[MAX_AXES], from[MAX_AXES];
     /* tot None: no offset at all; the interpreter then copies the position (keeps a -0.0) */
     int has_tot = tot_obj != Py_None;
@@ -451,11 +516,13 @@ static PyObject *run(PyObject *self, PyObject *args)
         if (feed == -1.0 && PyErr_Occurred())
             return NULL;
     }
-    int feed_seen = 0, moved = 0;
+    int feed_seen = 0, moved = 0, last_was_arc = 0, last_cw = 0, last_g = -1;
+    double last_c1 = 0.0, last_c2 = 0.0;
     Py_ssize_t blocks = 0, records = 0;
     Buf out = {NULL, 0, 0};
     char line[MAX_LINE + 1];
-    char start_json[MAX_AXES * 48 + 4], end_json[MAX_AXES * 48 + 4], feed_json[40];
+    char start_json[MAX_AXES * 48 + 4], end_json[MAX_AXES * 48 + 4], center_json[3 * 48 + 4];
+    char feed_json[40];
     int start_len = -1, feed_len = -1;
     double feed_spelled = 0.0;          /* the feed feed_json spells (valid when feed_len >= 0) */
     Block b;
@@ -484,11 +551,17 @@ static PyObject *run(PyObject *self, PyObject *args)
             new_has_feed = 1;
         }
         int new_motion = b.gmode >= 0 ? b.gmode : motion;
-        double tgt[MAX_AXES];
+        int arc = new_motion == MOTION_CW || new_motion == MOTION_CCW;
+        if (b.nijk && !arc)
+            break;
+        double tgt[MAX_AXES], mend[MAX_AXES], c1 = 0.0, c2 = 0.0, mc[3];
         int bail = 0;
-        if (b.naxis_words) {
-            if (new_motion > 1 || (new_motion == 1 && !(new_has_feed && new_feed != 0.0)))
-                break;                  /* arc/cycle mode, or a feed move without feed */
+        int moves = b.naxis_words || (arc && b.nijk);
+        if (moves) {
+            if (new_motion == MOTION_OTHER || (new_motion != MOTION_RAPID && !(new_has_feed && new_feed != 0.0)))
+                break;                  /* another mode, or a feed move without feed */
+            if (arc && (!b.nijk || !arcs_ok))
+                break;                  /* radius format, or an arc without centre: Python */
             memcpy(tgt, prog, sizeof prog);
             for (int k = 0; k < MAX_AXES && !bail; k++) {
                 if (b.axis_len[k] == 0)
@@ -509,7 +582,32 @@ static PyObject *run(PyObject *self, PyObject *args)
             }
             if (bail)
                 break;
-            double mend[MAX_AXES];
+            if (arc) {
+                /* _arc with centre words: centre from I J K (scaled, relative to the start unless
+                 * G90.1), the end must lie on the circle through the start */
+                double s1 = prog[pa[0]], s2 = prog[pa[1]], e1 = tgt[pa[0]], e2 = tgt[pa[1]];
+                c1 = s1;
+                c2 = s2;
+                for (int j = 0; j < 2; j++) {
+                    int w = pc[j];
+                    if (b.ijk_len[w] == 0)
+                        continue;
+                    double v;
+                    if (number_value(line, b.ijk_at[w], b.ijk_len[w], &v) < 0)
+                        goto fail;
+                    v *= scale;
+                    if (j == 0)
+                        c1 = arc_absolute ? v : s1 + v;
+                    else
+                        c2 = arc_absolute ? v : s2 + v;
+                }
+                double r1 = hyp(s1 - c1, s2 - c2), r2 = hyp(e1 - c1, e2 - c2);
+                double err = fabs(r1 - r2);
+                /* well inside arcs.check_center's acceptance (err <= tol, or relative < 0.1 %
+                 * and err <= 100 tol): anything near its edges goes to Python */
+                if (!(r1 > 1e-9) || !(err < 0.5 * center_tol) || !isfinite(c1) || !isfinite(c2))
+                    break;
+            }
             for (int k = 0; k < naxes; k++) {
                 mend[k] = has_tot ? tgt[k] + tot[k] : tgt[k];
                 if (!isfinite(mend[k]))
@@ -517,6 +615,11 @@ static PyObject *run(PyObject *self, PyObject *args)
             }
             if (bail)
                 break;
+            if (arc) {
+                double cp[3] = {c1, c2, tgt[pa[2]]};
+                for (int j = 0; j < 3; j++)
+                    mc[j] = has_tot ? cp[j] + tot[pa[j]] : cp[j];
+            }
             if (write) {
                 int el = spell_point(mend, naxes, axes, end_json);
                 if (el < 0)
@@ -526,28 +629,44 @@ static PyObject *run(PyObject *self, PyObject *args)
                     if (start_len < 0)
                         break;
                 }
-                if (new_motion == 1 && (feed_len < 0 || new_feed != feed_spelled)) {
+                int cl = 0;
+                if (arc) {
+                    const char names[3] = {axes[pa[0]], axes[pa[1]], axes[pa[2]]};
+                    cl = spell_point(mc, 3, names, center_json);
+                    if (cl < 0)
+                        break;
+                }
+                if (new_motion != MOTION_RAPID && (feed_len < 0 || new_feed != feed_spelled)) {
                     feed_len = spell(new_feed, feed_json);
                     if (feed_len < 0)
                         break;
                     feed_spelled = new_feed;
                 }
-                char head[160];
+                static const char *KIND[] = {"rapid", "linear", "arc", "arc"};
+                char head[200];
                 int hl = snprintf(head, sizeof head, "{\"seq\":%zd,\"file\":", seq + 1);
-                char mid[96];
-                int ml = snprintf(mid, sizeof mid, ",\"line\":%zd,\"kind\":\"%s\",\"start\":", lineno,
-                                  new_motion == 0 ? "rapid" : "linear");
-                if (buf_put(&out, head, (size_t)hl) < 0 || buf_put(&out, file_json, (size_t)file_len) < 0
-                    || buf_put(&out, mid, (size_t)ml) < 0 || buf_put(&out, start_json, (size_t)start_len) < 0
-                    || buf_put(&out, ",\"end\":", 7) < 0 || buf_put(&out, end_json, (size_t)el) < 0)
-                    goto fail;
-                if (new_motion == 1) {
-                    if (buf_put(&out, ",\"feed\":", 8) < 0 || buf_put(&out, feed_json, (size_t)feed_len) < 0
-                        || buf_put(&out, fm_json, (size_t)fm_len) < 0)
-                        goto fail;
+                PUT(head, hl);
+                PUT(file_json, file_len);
+                hl = snprintf(head, sizeof head, ",\"line\":%zd,\"kind\":\"%s\",\"start\":", lineno,
+                              KIND[new_motion]);
+                PUT(head, hl);
+                PUT(start_json, start_len);
+                PUT(",\"end\":", 7);
+                PUT(end_json, el);
+                if (arc) {
+                    PUT(",\"center\":", 10);
+                    PUT(center_json, cl);
+                    hl = snprintf(head, sizeof head, ",\"direction\":\"%s\",\"plane\":\"%s\",\"turns\":0",
+                                  new_motion == MOTION_CW ? "cw" : "ccw", plane);
+                    PUT(head, hl);
                 }
-                if (buf_put(&out, tail_json, (size_t)tail_len) < 0 || buf_put(&out, "}\n", 2) < 0)
-                    goto fail;
+                if (new_motion != MOTION_RAPID) {
+                    PUT(",\"feed\":", 8);
+                    PUT(feed_json, feed_len);
+                    PUT(fm_json, fm_len);
+                }
+                PUT(tail_json, tail_len);
+                PUT("}\n", 2);
                 memcpy(start_json, end_json, (size_t)el + 1);
                 start_len = el;
             }
@@ -555,6 +674,10 @@ static PyObject *run(PyObject *self, PyObject *args)
             memcpy(prog, tgt, sizeof prog);
             memcpy(mach, mend, sizeof mend);
             moved = 1;
+            last_was_arc = arc;
+            last_c1 = c1;
+            last_c2 = c2;
+            last_cw = new_motion == MOTION_CW;
             seq++;
             records++;
         }
@@ -564,6 +687,8 @@ static PyObject *run(PyObject *self, PyObject *args)
             feed_seen = 1;
         }
         motion = new_motion;
+        if (b.gmode >= 0)
+            last_g = b.gmode;
         blocks++;
         pos = q + 1;
         lineno++;
@@ -577,19 +702,23 @@ static PyObject *run(PyObject *self, PyObject *args)
         chunk = Py_NewRef(Py_None);
     }
     PyMem_Free(out.data);
+    out.data = NULL;
     PyObject *prog_l = doubles_list(prog, naxes), *mach_l = doubles_list(mach, naxes);
     PyObject *from_l = moved ? doubles_list(from, naxes) : Py_NewRef(Py_None);
     PyObject *feed_o = has_feed ? PyFloat_FromDouble(feed) : Py_NewRef(Py_None);
-    if (prog_l == NULL || mach_l == NULL || from_l == NULL || feed_o == NULL) {
+    PyObject *arc_o = last_was_arc ? Py_BuildValue("(ddO)", last_c1, last_c2, last_cw ? Py_True : Py_False)
+                                   : Py_NewRef(Py_None);
+    if (prog_l == NULL || mach_l == NULL || from_l == NULL || feed_o == NULL || arc_o == NULL) {
         Py_XDECREF(prog_l);
         Py_XDECREF(mach_l);
         Py_XDECREF(from_l);
         Py_XDECREF(feed_o);
+        Py_XDECREF(arc_o);
         Py_DECREF(chunk);
         return NULL;
     }
-    return Py_BuildValue("(nnnNnNNiNiN)", pos, lineno, blocks, chunk, records, prog_l, mach_l, motion,
-                         feed_o, feed_seen, from_l);
+    return Py_BuildValue("(nnnNnNNiNiNNi)", pos, lineno, blocks, chunk, records, prog_l, mach_l,
+                         motion, feed_o, feed_seen, from_l, arc_o, last_g);
 fail:
     PyMem_Free(out.data);
     return NULL;
@@ -610,7 +739,8 @@ static PyObject *spell_py(PyObject *self, PyObject *arg)
 
 static PyMethodDef methods[] = {
     {"spell", spell_py, METH_O, "spell(v) -> the JSON spelling of v, or None where only repr() spells it"},
-    {"scan", scan, METH_VARARGS, "scan(text, pos, sep) -> (end, lines, blocks, motion)"},
+    {"scan", scan, METH_VARARGS,
+     "scan(text, pos, sep, motion, cycle_off, arc_abs) -> (end, lines, blocks, motion)"},
     {"run", run, METH_VARARGS, "run the plain blocks of a scanned run (see the module source)"},
     {NULL, NULL, 0, NULL},
 };

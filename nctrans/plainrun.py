@@ -1,6 +1,7 @@
 """Runs of plain blocks: the fast lane for CAM output through the streamed ISO toolpath.
 
-A CAM program is tens of thousands of blocks like `N1234 G1 X1.234 Y-5.6 F800.`. In the streamed
+A CAM program is tens of thousands of blocks like `N1234 G1 X1.234 Y-5.6 F800.` and arcs by
+centre (`G3 X.. Y.. I.. J..`). In the streamed
 parse the ISO front end marks a run of such lines as one `PlainRun` (a lazy form of the Blocks it
 would otherwise build) instead of lowering each line. The interpreter then either
 
@@ -30,6 +31,19 @@ if os.environ.get("NCTRANS_NATIVE", "1") == "0":
     native = None
 
 
+# Motion modes a plain block may select, in the order of the kernel's MOTION_* codes; any other
+# mode is MOTION_OTHER (len(MOTIONS)).
+MOTIONS = ("rapid", "linear", "arc_cw", "arc_ccw")
+
+
+def motion_code(mode: Optional[str]) -> int:
+    """The kernel's code for a motion mode name (4 for anything that is not a plain motion)."""
+    try:
+        return MOTIONS.index(mode)
+    except ValueError:
+        return len(MOTIONS)
+
+
 class JsonChunk:
     """Toolpath records the kernel already wrote as JSON lines (text) and how many there are.
     Only a consumer that asked for them (interpret(..., json_chunks=True)) ever sees one."""
@@ -42,12 +56,15 @@ class JsonChunk:
 
 class PlainRun:
     """Lines text[start:end) of a streamed ISO program: `blocks` plain blocks (blank lines between
-    them do not count), the first on line `line`. `lower` turns one line's word list into the
-    Block body the Python fast path would build (Lowering.plain_block)."""
-    __slots__ = ("file", "text", "start", "end", "line", "sep", "blocks", "lower")
+    them do not count), the first on line `line`. `lower(words, motion, cycle)` turns one line's
+    word list into the Block body the Python fast path would build (Lowering.plain_block), given
+    the front end's static motion mode, canned cycle and centre mode (G90.1), which were `motion`,
+    `cycle`, `arc_abs` at `start`."""
+    __slots__ = ("file", "text", "start", "end", "line", "sep", "blocks", "lower", "motion", "cycle",
+                 "arc_abs")
 
     def __init__(self, file: str, text: str, start: int, end: int, line: int, sep: str, blocks: int,
-                 lower: Callable):
+                 lower: Callable, motion: Optional[str], cycle: Optional[str], arc_abs: bool):
         self.file = file
         self.text = text
         self.start = start
@@ -56,6 +73,9 @@ class PlainRun:
         self.sep = sep
         self.blocks = blocks
         self.lower = lower
+        self.motion = motion
+        self.cycle = cycle
+        self.arc_abs = arc_abs
 
     def take(self, count: int) -> tuple[list, Optional["PlainRun"]]:
         """The first `count` blocks as IR Blocks, and the rest of the run (None when none is left)."""
@@ -63,6 +83,7 @@ class PlainRun:
         from nctrans.ir.nodes import Block, Span
         text, sep, end, file, lower = self.text, self.sep, self.end, self.file, self.lower
         pos, line = self.start, self.line
+        motion, cycle = self.motion, self.cycle
         out: list = []
         while pos < end and len(out) < count:
             nl = text.find(sep, pos)
@@ -73,11 +94,14 @@ class PlainRun:
             if code[-1:] == "\r":
                 code = code[:-1]
             if code:                                  # a blank line inside the run: no block
-                number, body, _ = lower(WORD.findall(code))
+                number, body, mode = lower(WORD.findall(code), motion, cycle, self.arc_abs)
+                if mode is not None:
+                    motion, cycle = mode, None
                 out.append(Block(Span(file, line, 1, line, len(raw) + 1), body, number))
             pos, line = nl + 1, line + 1
         left = self.blocks - len(out)
-        rest = PlainRun(file, text, pos, end, line, sep, left, lower) if left > 0 else None
+        rest = (PlainRun(file, text, pos, end, line, sep, left, lower, motion, cycle, self.arc_abs)
+                if left > 0 else None)
         return out, rest
 
     def expand(self) -> list:

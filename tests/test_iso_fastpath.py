@@ -70,7 +70,7 @@ hot_word = st.one_of(
 
 
 @settings(max_examples=400, deadline=None)
-@given(st.lists(hot_word, min_size=1, max_size=6), st.sampled_from([None, "arc_cw", "drill"]))
+@given(st.lists(hot_word, min_size=1, max_size=6), st.sampled_from([None, "arc_cw", "drill", "arc_abs"]))
 def test_hot_lowering_equals_general_lowering(words, state):
     words = [tuple(w) for w in words]
     a, b = Lowering("t.nc", []), Lowering("t.nc", [])
@@ -79,6 +79,8 @@ def test_hot_lowering_equals_general_lowering(words, state):
             low.motion = "arc_cw"
         elif state == "drill":
             low.cycle = "drill"
+        elif state == "arc_abs":
+            low.motion, low.arc_abs = "arc_ccw", True
     hot = a.hot(words)
     if hot is None:
         return

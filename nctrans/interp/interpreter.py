@@ -1704,7 +1704,7 @@ class Interpreter:
         pos, mpos = self.pos, self.mpos
         axes = "".join(pos)
         tot = self.off.total
-        motion = {"rapid": 0, "linear": 1}.get(st.motion, 2)
+        motion = plainrun.motion_code(st.motion)
         tail = ""
         if st.spindle_speed is not None:
             tail += ',"spindle":' + _spell(st.spindle_speed)
@@ -1712,20 +1712,21 @@ class Interpreter:
             tail += f',"tool":{int(st.tool)}'
         write = self.fast_sink == "jsonl"
         (stop, line, blocks, chunk, records, prog, mach, new_motion, feed, feed_seen,
-         last_from) = self.native.run(
+         last_from, last_arc, last_g) = self.native.run(
             run.text, run.start, run.end, run.sep, run.line, axes, list(pos.values()),
             [tot.get(a, 0.0) for a in axes] if tot else None, list(mpos.values()), st.scale,
             st.incremental, motion, st.feed, f',"feed_mode":"{st.feed_mode}"', tail, self._seq,
-            _json_str(run.file), budget, write)
+            _json_str(run.file), budget, write, st.plane, st.arc_absolute,
+            arcs.CENTER_TOL_INCH if st.scale != 1.0 else arcs.CENTER_TOL_MM)
         if blocks:
             self.pos = dict(zip(axes, prog))
             self.mpos = dict(zip(axes, mach))
             if last_from is not None:
                 self.last_from = dict(zip(axes, last_from))
-                self.last_arc = None
+                self.last_arc = None if last_arc is None else ((last_arc[0], last_arc[1]), last_arc[2])
                 self.moved = True
             if new_motion != motion:
-                st.set("motion", ("rapid", "linear")[new_motion])
+                st.set("motion", plainrun.MOTIONS[new_motion])
             if feed_seen:
                 st.feed = feed
                 self.feed_reported = False
@@ -1736,8 +1737,11 @@ class Interpreter:
                     self._seq += records
         rest = None
         if blocks < run.blocks:
+            # the front end's static mode where the rest starts: the last G word the kernel ran
+            motion_at, cycle_at = ((plainrun.MOTIONS[last_g], None) if last_g >= 0
+                                   else (run.motion, run.cycle))
             rest = PlainRun(run.file, run.text, stop, run.end, line, run.sep, run.blocks - blocks,
-                            run.lower)
+                            run.lower, motion_at, cycle_at, run.arc_abs)
         return blocks, rest
 
     def _release(self, out: list) -> Iterator[ToolpathRecord]:
@@ -1892,3 +1896,4 @@ def _spell(v) -> str:
 def _json_str(s: str) -> str:
     from nctrans.toolpath_io import _str
     return _str(s)
+

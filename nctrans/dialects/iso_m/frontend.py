@@ -34,6 +34,8 @@ AXES = "XYZABCUVW"
 AXIS_SET = frozenset(AXES)
 # Plain lines in a row before the streamed parse hands them over as one PlainRun.
 PLAIN_RUN_MIN = 2
+# Motion modes a plain block may select (their order is the kernel's MOTION_* codes).
+PLAIN_MOTIONS = plainrun.MOTIONS
 CENTER_LETTERS = frozenset("IJK")
 
 # rs274ngc order of execution (the interpreter runs Block.body as listed).
@@ -466,43 +468,55 @@ class Lowering:
         would do it (tests/test_iso_fastpath.py compares them); None sends the block to lower()."""
         if self.standard:
             return None
-        done = self.plain_block(words)
+        done = self.plain_block(words, self.motion, self.cycle, self.arc_abs)
         if done is not None and done[2] is not None:
             self.motion = done[2]
             self.cycle = None
         return done
 
-    def plain_block(self, words: list, _axes=AXIS_SET, _av=AxisValue, _num=Num,
-                    _float=float) -> Optional[tuple]:
-        """(number, body, motion mode written or None) of a plain block, without touching the
-        tracked modal state (plainrun.PlainRun expands lines with it after the front end has moved
-        on); None when the block is not [N] [G0|G1] axis words [F]."""
+    def plain_block(self, words: list, motion: Optional[str], cycle: Optional[str], arc_abs: bool,
+                    _axes=AXIS_SET, _av=AxisValue, _num=Num, _float=float) -> Optional[tuple]:
+        """(number, body, motion mode written or None) of a plain block given the static modal
+        state before it, without touching the tracked state (plainrun.PlainRun expands lines with
+        it after the front end has moved on); None when the block is not [N] [G0-G3] axis words
+        [I J K] [F] with centre words only in arc mode, incremental (G91.1), no cycle pending."""
         number = None
         target: dict = {}
+        center: dict = {}
         mode = feed = None
         for letter, text in words:
             if letter in _axes:
                 if letter in target:
                     return None
                 target[letter] = _av(_num(_float(text), text))
+            elif letter in CENTER_LETTERS:
+                if letter in center:
+                    return None
+                center[letter] = _av(_num(_float(text), text))
             elif letter == "G" and mode is None:
                 rule = self.code("G", text)
-                if rule is None or rule.group != "motion" or rule.value not in ("rapid", "linear"):
+                if rule is None or rule.group != "motion" or rule.value not in PLAIN_MOTIONS:
                     return None
                 mode = ModeChange("motion", rule.value, "G" + text)
             elif letter == "F" and feed is None:
                 feed = Feed(Num(float(text), text))
-            elif letter == "N" and number is None and not target and mode is None and feed is None:
+            elif (letter == "N" and number is None and not target and not center and mode is None
+                  and feed is None):
                 number = text
             else:
+                return None
+        if center:
+            if (mode.value if mode is not None else motion) not in ("arc_cw", "arc_ccw"):
+                return None
+            if (mode is None and cycle is not None) or arc_abs:
                 return None
         body = []
         if feed is not None:
             body.append(feed)
         if mode is not None:
             body.append(mode)
-        if target:
-            body.append(Motion(target))
+        if target or center:
+            body.append(Motion(target, center or None))
         return number, body, None if mode is None else mode.value
 
     def lower(self, items: list, line: int) -> tuple[Optional[str], list, list, Optional[str]]:
@@ -906,13 +920,15 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
             yield from main
             main.clear()
         if plain_scan is not None and cur is main:
-            end, nlines, nblocks, motion = plain_scan(text, lines.start, sep)
+            end, nlines, nblocks, motion = plain_scan(text, lines.start, sep,
+                                                      plainrun.motion_code(low.motion),
+                                                      low.cycle is None, low.arc_abs)
             if nblocks >= PLAIN_RUN_MIN:
                 cur.append(plainrun.PlainRun(file, text, lines.start, end, lineno, sep, nblocks,
-                                             plain_block))
+                                             plain_block, low.motion, low.cycle, low.arc_abs))
                 lines.skip_to(end, nlines)
                 if motion >= 0:
-                    low.motion = ("rapid", "linear")[motion]
+                    low.motion = PLAIN_MOTIONS[motion]
                     low.cycle = None
                 seen_block = True
                 continue
