@@ -101,6 +101,33 @@ def test_edge_programs_same_with_and_without_kernel(text):
     assert run(text, kernel=True)[:2] == run(text, kernel=False)[:2]
 
 
+def test_kernel_memory_does_not_grow_with_program_length():
+    """The kernel writes a bounded chunk per call: the streamed jsonl run stays flat."""
+    import tracemalloc
+
+    def program(n):
+        lines = [f"N{i * 5}G1X{i % 97 * 0.37:.4f}Y{i % 89 * 0.41:.4f}Z-{i % 7 * 0.1:.3f}F500."
+                 for i in range(n)]
+        return "%\nO1\nG90G21G54\nG0X0Y0Z5.\n" + "\n".join(lines) + "\nM30\n%\n"
+
+    class Null:
+        def write(self, s):
+            return len(s)
+
+    def peak(text):
+        src = source.decode(text.encode(), "big.nc")
+        tracemalloc.start()
+        try:
+            ld = pipeline.load_source(src, "big.nc", "iso-m", stream=True)
+            n = toolpath_io.write_jsonl(pipeline.toolpath_of(ld, None, fast_sink="jsonl"), Null())
+            return n, tracemalloc.get_traced_memory()[1] / 2**20
+        finally:
+            tracemalloc.stop()
+    peak(program(2_000))
+    (n_small, small), (n_large, large) = peak(program(10_000)), peak(program(100_000))
+    assert n_large == 100_002 and large < small + 1.0, (small, large)     # G0, 100k G1, M30
+
+
 def test_lint_same_with_and_without_kernel():
     text = "%\nO1\nG21G90G54\nG0X0Y0Z5.\nG1X1.Z-1.\nX2.\nG1F100.X3.\nF-5.X4.\nM30\n%\n"
     assert run(text, kernel=True, lint=True)[1] == run(text, kernel=False, lint=True)[1]

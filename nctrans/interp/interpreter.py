@@ -60,6 +60,7 @@ BLOCK, JUMP, JFALSE, EXEC, CASE, PLAIN = range(6)
 MAX_CALL_DEPTH = 16
 STREAM_BATCH = 256          # blocks of a streamed main body compiled at a time
 PLAIN_EXPAND = 64           # blocks of a PlainRun expanded at a time when the kernel cannot run it
+KERNEL_BLOCKS = 4096        # blocks per kernel call: its JSON text (~1 MB) is all it holds
 MOVE_KINDS = frozenset(("rapid", "linear", "arc"))
 NORMAL = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 ROT_AXIS = NORMAL
@@ -1678,9 +1679,12 @@ class Interpreter:
         done = 0
         tried = self._kernel_ready()
         if tried:
-            done, run = self._plain_kernel(run, budget)
+            limit = min(budget, KERNEL_BLOCKS)
+            done, run = self._plain_kernel(run, limit)
             if run is None:
                 return done, []
+            if done == limit < budget:          # only the call's size stopped it: go on
+                return done, [(PLAIN, run, None, n.Span(run.file, run.line, 1, run.line, 1))]
         blocks, rest = run.take(1 if tried else PLAIN_EXPAND)
         entries = [(BLOCK, None, b, b.span) for b in blocks]
         if rest is not None:
