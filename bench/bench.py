@@ -2,7 +2,8 @@
 
 For each program: lines/s in-process (parse + interpret, and parse + interpret + JSONL serialisation
 to a null sink, with the whole IR; then the streamed path the CLI takes: pipeline.load(stream=True)
-+ toolpath_io.write_jsonl), the CLI end to end (subprocess wall time, output to /dev/null), LinuxCNC
++ toolpath_io.write_jsonl with the native plain-run kernel, and the same without it, "py strm"),
+the CLI end to end (subprocess wall time, output to /dev/null), LinuxCNC
 rs274 on the same file in the same run and the CLI/rs274 time ratio. Then peak memory (tracemalloc)
 for one program and for the same program repeated 10x: the full parse holds the IR (it grows with
 the text) and the interpreter's peak is measured above it; the streamed parse + run + serialisation
@@ -78,12 +79,19 @@ def toolpath_in_process(text: str, name: str) -> int:
     return n
 
 
-def stream_in_process(text: str, name: str) -> int:
-    """What `nctrans toolpath --from iso-m` runs: streamed parse + interpret + jsonl writer."""
-    from nctrans import pipeline, source, toolpath_io
-    ld = pipeline.load_source(source.decode(text.encode("utf-8"), name), name, "iso-m", stream=True)
-    return toolpath_io.write_jsonl(pipeline.toolpath_of(ld, pipeline.load_machine(None, "iso-m")),
-                                   NullSink())
+def stream_in_process(text: str, name: str, kernel: bool = True) -> int:
+    """What `nctrans toolpath --from iso-m` runs: streamed parse + interpret + jsonl writer, with
+    the native plain-run kernel (or, kernel=False, the pure-Python path it specialises)."""
+    from nctrans import pipeline, plainrun, source, toolpath_io
+    saved = plainrun.native
+    if not kernel:
+        plainrun.native = None
+    try:
+        ld = pipeline.load_source(source.decode(text.encode("utf-8"), name), name, "iso-m", stream=True)
+        return toolpath_io.write_jsonl(pipeline.toolpath_of(ld, pipeline.load_machine(None, "iso-m"),
+                                                            fast_sink="jsonl"), NullSink())
+    finally:
+        plainrun.native = saved
 
 
 def stream_peak(text: str, name: str) -> float:
@@ -94,7 +102,7 @@ def stream_peak(text: str, name: str) -> float:
     gc.collect()
     tracemalloc.start()
     ld = pipeline.load_source(src, name, "iso-m", stream=True)
-    toolpath_io.write_jsonl(pipeline.toolpath_of(ld, machine), NullSink())
+    toolpath_io.write_jsonl(pipeline.toolpath_of(ld, machine, fast_sink="jsonl"), NullSink())
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     return peak / 2**20
@@ -160,7 +168,7 @@ def fmt(v, spec=",.0f"):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=2, help="runs per measurement; the best is shown")
+    ap.add_argument("--repeat", type=int, default=5, help="runs per measurement; the best is shown")
     ap.add_argument("--peak", nargs=2, metavar=("PROGRAM", "TIMES"), help=argparse.SUPPRESS)
     ap.add_argument("programs", nargs="*", help="programs (default: the three largest iso-mill ones)")
     args = ap.parse_args(argv)
@@ -182,6 +190,7 @@ def main(argv=None) -> int:
     print(f"python {sys.version.split()[0]}, rs274 {'found' if Path(RS274).exists() else 'missing'}, "
           f"best of {args.repeat}; lines/s = source lines / seconds")
     head = (f"{'program':34} {'lines':>6} {'records':>8} {'lint l/s':>10} {'toolpath l/s':>12} {'stream l/s':>10} "
+            f"{'py strm l/s':>11} "
             f"{'CLI lint s':>10} {'CLI tp s':>9} {'CLI tp l/s':>10} {'rs274 s':>8} {'CLI/rs274':>9}")
     print(head)
     print("-" * len(head))
@@ -191,12 +200,13 @@ def main(argv=None) -> int:
         for path in paths:
             text = read_text(path)
             lines = text.count("\n") or 1
-            records = lint_rate = tp_rate = st_rate = None
+            records = lint_rate = tp_rate = st_rate = py_rate = None
             try:
                 records = toolpath_in_process(text, path.name)
                 lint_rate = lines / best_time(lambda: lint_in_process(text, path.name), args.repeat)
                 tp_rate = lines / best_time(lambda: toolpath_in_process(text, path.name), args.repeat)
                 st_rate = lines / best_time(lambda: stream_in_process(text, path.name), args.repeat)
+                py_rate = lines / best_time(lambda: stream_in_process(text, path.name, False), args.repeat)
             except Exception as e:                      # a missing stage: report, keep benchmarking
                 notes.append(f"{path.name}: in-process: {type(e).__name__}: {e}")
             cli_lint, rc_l = wall(NCTRANS + ["lint", str(path), "--from", "iso-m"], args.repeat)
@@ -211,7 +221,7 @@ def main(argv=None) -> int:
             rs = rs274_time(path, args.repeat, tmp)
             ratio = cli_tp / rs if cli_tp and rs else None
             print(f"{path.name[:34]:34} {lines:>6} {fmt(records):>8} {fmt(lint_rate):>10} {fmt(tp_rate):>12} "
-                  f"{fmt(st_rate):>10} "
+                  f"{fmt(st_rate):>10} {fmt(py_rate):>11} "
                   f"{fmt(cli_lint, '.3f'):>10} {fmt(cli_tp, '.3f'):>9} "
                   f"{fmt(lines / cli_tp if cli_tp else None):>10} {fmt(rs, '.3f'):>8} {fmt(ratio, '.2f'):>9}")
         print()
