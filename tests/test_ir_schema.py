@@ -63,3 +63,18 @@ def test_documents_validate_against_schema():
     bad["body"][0]["span"]["line"] = "ten"
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(bad, json_schema())
+
+
+def test_nodes_compare_and_print_as_dataclasses_do():
+    """nodes.node shares one __repr__/__eq__ among the node classes (start-up time); the
+    behaviour must stay dataclass's: field-wise equality within a class, Name(field=...) repr."""
+    from nctrans.ir import nodes as n
+    a = n.Motion({"X": n.AxisValue(n.Num(1.0, "1."))})
+    assert a == n.Motion({"X": n.AxisValue(n.Num(1.0, "1."))})
+    assert a != n.Motion({"X": n.AxisValue(n.Num(2.0, "2."))})
+    assert n.Feed(n.Num(1.0, "1")) != n.SpindleSpeed(n.Num(1.0, "1"))      # other class: unequal
+    assert repr(n.Num(1.0, "1.")) == "Num(value=1.0, text='1.')"
+    assert repr(a).startswith("Motion(target={'X': AxisValue(value=Num(value=1.0, text='1.'), mode=None)}")
+    with pytest.raises(TypeError):
+        hash(a)                                                           # mutable: unhashable
+    assert hash(n.Span("f", 1)) == hash(n.Span("f", 1))
