@@ -66,6 +66,7 @@ def test_documents_validate_against_schema():
 
 
 def test_nodes_compare_and_print_as_dataclasses_do():
+    import pytest
     """nodes.node shares one __repr__/__eq__ among the node classes (start-up time); the
     behaviour must stay dataclass's: field-wise equality within a class, Name(field=...) repr."""
     from nctrans.ir import nodes as n
