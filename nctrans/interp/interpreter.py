@@ -248,7 +248,7 @@ class Interpreter:
                 if node.label:
                     unit.labels.setdefault(label_key(node.label), []).append(pc)
             elif t is PlainRun:
-                code.append((PLAIN, node, None, n.Span(node.file, node.line, 1, node.line, 1)))
+                code.append(_plain_entry(node))
             elif t is n.If:
                 j = len(code)
                 code.append(None)
@@ -1684,11 +1684,11 @@ class Interpreter:
             if run is None:
                 return done, []
             if done == limit < budget:          # only the call's size stopped it: go on
-                return done, [(PLAIN, run, None, n.Span(run.file, run.line, 1, run.line, 1))]
+                return done, [_plain_entry(run)]
         blocks, rest = run.take(1 if tried else PLAIN_EXPAND)
         entries = [(BLOCK, None, b, b.span) for b in blocks]
         if rest is not None:
-            entries.append((PLAIN, rest, None, n.Span(rest.file, rest.line, 1, rest.line, 1)))
+            entries.append(_plain_entry(rest))
         return done, entries
 
     def _kernel_ready(self) -> bool:
@@ -1890,6 +1890,11 @@ def interpret(program: n.Program, machine=None, *, diagnostics: list, resolver=N
 
 
 _KERNEL_AXES = frozenset("XYZABCUVW")
+
+
+def _plain_entry(run: PlainRun) -> tuple:
+    """The code entry of a PlainRun; its span (first line) places an NC205 step-budget warning."""
+    return (PLAIN, run, None, n.Span(run.file, run.line, 1, run.line, 1))
 
 
 def _spell(v) -> str:
