@@ -241,3 +241,25 @@ def test_kernel_spells_numbers_as_the_jsonl_writer(v):
     got = NATIVE.spell(v)
     if got is not None:
         assert got == toolpath_io._spell(v)
+
+
+@pytest.mark.parametrize("budget", [1, 7, 50, 4100, 4400])
+def test_step_budget_stops_at_the_same_block_with_and_without_kernel(budget):
+    from nctrans.interp import interpret
+    text = "%\nO1\nG0X0Y0Z5.\nG1F100.\n" + "\n".join(f"X{i}.Y{i % 7}." for i in range(4500)) + "\nM30\n%\n"
+
+    def go(kernel):
+        saved = plainrun.native
+        plainrun.native = NATIVE if kernel else None
+        try:
+            ld = pipeline.load_source(source.decode(text.encode(), "t.nc"), "t.nc", "iso-m", stream=True)
+            diags: list = []
+            buf = io.StringIO()
+            toolpath_io.write_jsonl(interpret(ld.program, None, diagnostics=diags, max_steps=budget,
+                                              fast_sink="jsonl" if kernel else None), buf)
+            return buf.getvalue(), [(d.rule, d.line, d.message) for d in diags]
+        finally:
+            plainrun.native = saved
+    fast, slow = go(True), go(False)
+    assert fast == slow
+    assert any(d[0] == "NC205" for d in fast[1])
