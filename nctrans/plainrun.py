@@ -46,7 +46,7 @@ def motion_code(mode: Optional[str]) -> int:
 
 class JsonChunk:
     """Toolpath records the kernel already wrote as JSON lines (text) and how many there are.
-    Only a consumer that asked for them (interpret(..., json_chunks=True)) ever sees one."""
+    Only a consumer that asked for them (interpret(..., fast_sink="jsonl")) ever sees one."""
     __slots__ = ("text", "count")
 
     def __init__(self, text: str, count: int):
@@ -56,7 +56,7 @@ class JsonChunk:
 
 class PlainRun:
     """Lines text[start:end) of a streamed ISO program: `blocks` plain blocks (blank lines between
-    them do not count), the first on line `line`. `lower(words, motion, cycle)` turns one line's
+    them do not count), the first on line `line`. `lower(words, motion, cycle, arc_abs)` turns a line's
     word list into the Block body the Python fast path would build (Lowering.plain_block), given
     the front end's static motion mode, canned cycle and centre mode (G90.1), which were `motion`,
     `cycle`, `arc_abs` at `start`."""
