@@ -40,12 +40,8 @@ class NullSink:
 
 
 def read_text(path: Path) -> str:
-    data = path.read_bytes()
-    try:
-        from nctrans import source
-        return source.decode(data, path.name).text
-    except ImportError:
-        return data.decode("utf-8", errors="replace")
+    from nctrans import source
+    return source.decode(path.read_bytes(), path.name).text
 
 
 def parse(text: str, name: str):

@@ -71,12 +71,8 @@ def reference(rs274, rs274_cache):
 
 
 def _read(program: Path) -> str:
-    data = program.read_bytes()
-    try:
-        from nctrans import source
-        return source.decode(data, program.name).text
-    except ImportError:
-        return data.decode("utf-8", errors="replace")
+    from nctrans import source
+    return source.decode(program.read_bytes(), program.name).text
 
 
 def nctrans_motions(program: Path, setup: str) -> tuple[list[h.Motion], list]:

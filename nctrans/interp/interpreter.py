@@ -42,6 +42,7 @@ from nctrans.ir import nodes as n
 from nctrans import plainrun
 from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
+from nctrans.toolpath_io import _spell, _str as _json_str    # the kernel writes as the writer does
 
 try:  # the colleague's modules; without them the feature is skipped
     from nctrans.interp.cycles import expand_cycle
@@ -1895,14 +1896,4 @@ _KERNEL_AXES = frozenset("XYZABCUVW")
 def _plain_entry(run: PlainRun) -> tuple:
     """The code entry of a PlainRun; its span (first line) places an NC205 step-budget warning."""
     return (PLAIN, run, None, n.Span(run.file, run.line, 1, run.line, 1))
-
-
-def _spell(v) -> str:
-    from nctrans.toolpath_io import _spell as spell
-    return spell(v)
-
-
-def _json_str(s: str) -> str:
-    from nctrans.toolpath_io import _str
-    return _str(s)
 
