@@ -8,12 +8,13 @@ from __future__ import annotations
 import re
 import tomllib
 from functools import lru_cache
-from pathlib import Path
 from typing import Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, field_validator
 
-CATALOGUE_PATH = Path(__file__).resolve().parent.parent / "rules" / "lint-rules.toml"
+from nctrans import resources
+
+CATALOGUE_PATH = resources.path("rules", "lint-rules.toml")
 _CODE = re.compile(r"^NC\d{3}$")
 
 FAMILIES = {
@@ -65,7 +66,7 @@ class Catalogue(BaseModel):
 
 
 @lru_cache(maxsize=None)
-def load(path: Path = CATALOGUE_PATH) -> Catalogue:
+def load(path=CATALOGUE_PATH) -> Catalogue:
     with path.open("rb") as fh:
         return Catalogue.model_validate(tomllib.load(fh))
 

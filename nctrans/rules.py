@@ -9,12 +9,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
 from typing import Any, Optional
 
-from nctrans import tables
+from nctrans import resources, tables
 
-RULES_DIR = Path(__file__).resolve().parent.parent / "rules"
+RULES_DIR = resources.root("rules")
 
 
 def normalise_code(letter: str, number: str | float | int) -> str:

@@ -36,8 +36,9 @@ def cache_dir() -> Path:
     return Path(base) / "nctrans"
 
 
-def load(path: Path, schema: type, build: Callable[[Any], T]) -> T:
-    """build(validated data) for the TOML file at `path` validated against the dataclass `schema`."""
+def load(path, schema: type, build: Callable[[Any], T]) -> T:
+    """build(validated data) for the TOML file at `path` (a Path or importlib.resources Traversable)
+    validated against the dataclass `schema`."""
     try:
         raw = path.read_bytes()
     except OSError as e:
@@ -47,7 +48,7 @@ def load(path: Path, schema: type, build: Callable[[Any], T]) -> T:
     # more than reading the cached table)
     key = (f"{zlib.crc32(raw):08x}{len(raw):x}-{zlib.crc32(module):08x}{len(module):x}-"
            f"{CACHE_VERSION}{marshal.version}{sys.version_info[0]}{sys.version_info[1]}")
-    cached = cache_dir() / f"{path.stem}-{key}.marshal"
+    cached = cache_dir() / f"{Path(path.name).stem}-{key}.marshal"
     try:
         data = marshal.loads(cached.read_bytes())
     except (OSError, ValueError, EOFError, TypeError):

@@ -14,12 +14,12 @@ Items, in source order:
 """
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any, Optional
 
+from nctrans import resources
 from nctrans.ir.nodes import Binary, Func, Num, Unary, Var
 
-GRAMMAR_PATH = Path(__file__).resolve().parents[3] / "grammars" / "iso-m.lark"
+GRAMMAR_PATH = resources.path("grammars", "iso-m.lark")
 
 _RELOPS = {"EQ": "==", "NE": "!=", "GT": ">", "GE": ">=", "LT": "<", "LE": "<="}
 
@@ -137,7 +137,7 @@ def parser():
     global _parser
     if _parser is None:
         from lark import Lark
-        _parser = Lark(GRAMMAR_PATH.read_text(), parser="lalr", lexer="contextual",
+        _parser = Lark(GRAMMAR_PATH.read_text(encoding="utf-8"), parser="lalr", lexer="contextual",
                        transformer=_make_transformer(), cache=True)
     return _parser
 

@@ -19,13 +19,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
 from typing import Optional
 
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedInput, UnexpectedToken, UnexpectedCharacters, UnexpectedEOF
 from lark.lexer import Lexer
 
+from nctrans import resources
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import ParseResult
 from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
@@ -33,7 +33,7 @@ from nctrans.ir import nodes as ir
 from nctrans.ir.vocabulary import MODAL_GROUPS
 from nctrans.rules import load_table, normalise_code
 
-GRAMMAR = Path(__file__).resolve().parents[3] / "grammars" / "sinumerik.lark"
+GRAMMAR = resources.path("grammars", "sinumerik.lark")
 DIALECT = "sinumerik"
 
 

@@ -1,0 +1,97 @@
+"""The package as users install it: a regular wheel in a fresh virtual environment, outside the checkout.
+
+`pip install .`, pipx and pre-commit all build a wheel and install it; an editable install (what
+`make test` uses) hides every file the wheel forgets, because the checkout is still beside the
+package. So this test builds the wheel, installs it into a new venv in a temporary directory and
+runs the CLI from another directory on corpus files copied there.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from conftest import CORPUS
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA_DIRS = ("rules", "grammars", "backplot")
+
+
+def _run(cmd, cwd, env=None, timeout=300):
+    return subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """(venv bin directory, wheel path, clean environment) with nctrans installed from its wheel."""
+    base = tmp_path_factory.mktemp("wheel")
+    dist = base / "dist"
+    build = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(dist), str(ROOT)], cwd=base)
+    assert build.returncode == 0, build.stderr
+    (wheel,) = dist.glob("nctrans-*.whl")
+    venv = base / "venv"
+    made = _run([sys.executable, "-m", "venv", str(venv)], cwd=base)
+    assert made.returncode == 0, made.stderr
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV", "PYTHONHOME")}
+    env["NCTRANS_CACHE_DIR"] = str(base / "cache")
+    inst = _run([str(venv / "bin" / "python"), "-m", "pip", "install", "-q", str(wheel)], cwd=base, env=env)
+    assert inst.returncode == 0, inst.stderr
+    return venv / "bin", wheel, env
+
+
+def test_wheel_carries_every_data_file_and_the_kernel(installed):
+    _, wheel, _ = installed
+    names = set(zipfile.ZipFile(wheel).namelist())
+    for kind in DATA_DIRS:
+        files = [p for p in (ROOT / kind).rglob("*") if p.is_file() and "__pycache__" not in p.parts]
+        assert files, f"{kind}/ is empty in the checkout"
+        for p in files:
+            assert f"nctrans/_data/{p.relative_to(ROOT).as_posix()}" in names, f"{p} missing from the wheel"
+    if list((ROOT / "nctrans").glob("_plainrun*.so")):       # this machine compiles the kernel
+        assert any(n.startswith("nctrans/_plainrun") and n.endswith(".so") for n in names)
+
+
+def test_installed_cli_runs_outside_the_checkout(installed, tmp_path):
+    bin_dir, _, env = installed
+    work = tmp_path / "shop"
+    work.mkdir()
+    iso = work / "part.nc"
+    shutil.copy(CORPUS / "iso-mill" / "kiely-haas-step-part.nc", iso)
+    siemens = work / "slot.mpf"
+    shutil.copy(CORPUS / "sinumerik" / "dubovikov-slot.mpf", siemens)
+    nctrans = str(bin_dir / "nctrans")
+
+    where = _run([str(bin_dir / "python"), "-c", "import nctrans, nctrans.resources as r;"
+                  "print(nctrans.__file__); print(r.root('rules')); print(r.root('backplot'))"],
+                 cwd=work, env=env)
+    assert where.returncode == 0, where.stderr
+    for line in where.stdout.split():
+        assert not line.startswith(str(ROOT)), f"the installed CLI reads the checkout: {line}"
+
+    lint = _run([nctrans, "lint", "--format", "json", str(iso), str(siemens)], cwd=work, env=env)
+    assert lint.returncode in (0, 1), lint.stderr
+    doc = json.loads(lint.stdout)
+    assert doc["files"] == 2
+    assert not any(d["rule"].startswith("NC0") for d in doc["diagnostics"]), doc["diagnostics"]
+
+    for native in ("1", "0"):           # with the kernel and on the pure-Python fallback
+        tp = _run([nctrans, "toolpath", "part.nc"], cwd=work, env={**env, "NCTRANS_NATIVE": native})
+        assert tp.returncode == 0, tp.stderr
+        records = [json.loads(line) for line in tp.stdout.splitlines()]
+        assert sum(r["kind"] == "linear" for r in records) > 10
+
+    conv = _run([nctrans, "convert", "part.nc", "--to", "sinumerik", "-o", "part.mpf"], cwd=work, env=env)
+    assert conv.returncode == 0, conv.stderr
+    back = _run([nctrans, "equiv", "part.nc", "part.mpf"], cwd=work, env=env)
+    assert back.returncode == 0, back.stdout + back.stderr
+
+    listing = _run([nctrans, "rules"], cwd=work, env=env)
+    assert listing.returncode == 0 and "NC002" in listing.stdout
+    one = _run([nctrans, "rules", "NC002"], cwd=work, env=env)
+    assert one.returncode == 0 and one.stdout.startswith("NC002")
