@@ -12,6 +12,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import zipfile
 from pathlib import Path
 
@@ -28,9 +29,18 @@ def _run(cmd, cwd, env=None, timeout=300):
 
 
 @pytest.fixture(scope="module")
-def installed(tmp_path_factory):
+def outside():
+    """A temporary directory outside the checkout (make test's --basetemp is inside it)."""
+    d = Path(tempfile.mkdtemp(prefix="nctrans-wheel-"))
+    assert not d.resolve().is_relative_to(ROOT)
+    yield d
+    shutil.rmtree(d, ignore_errors=True)
+
+
+@pytest.fixture(scope="module")
+def installed(outside):
     """(venv bin directory, wheel path, clean environment) with nctrans installed from its wheel."""
-    base = tmp_path_factory.mktemp("wheel")
+    base = outside
     dist = base / "dist"
     build = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(dist), str(ROOT)], cwd=base)
     assert build.returncode == 0, build.stderr
@@ -57,9 +67,9 @@ def test_wheel_carries_every_data_file_and_the_kernel(installed):
         assert any(n.startswith("nctrans/_plainrun") and n.endswith(".so") for n in names)
 
 
-def test_installed_cli_runs_outside_the_checkout(installed, tmp_path):
+def test_installed_cli_runs_outside_the_checkout(installed, outside):
     bin_dir, _, env = installed
-    work = tmp_path / "shop"
+    work = outside / "shop"
     work.mkdir()
     iso = work / "part.nc"
     shutil.copy(CORPUS / "iso-mill" / "kiely-haas-step-part.nc", iso)
@@ -72,7 +82,7 @@ def test_installed_cli_runs_outside_the_checkout(installed, tmp_path):
                  cwd=work, env=env)
     assert where.returncode == 0, where.stderr
     for line in where.stdout.split():
-        assert not line.startswith(str(ROOT)), f"the installed CLI reads the checkout: {line}"
+        assert Path(line).is_relative_to(bin_dir.parent), f"the installed CLI reads {line}, not the wheel"
 
     lint = _run([nctrans, "lint", "--format", "json", str(iso), str(siemens)], cwd=work, env=env)
     assert lint.returncode in (0, 1), lint.stderr
