@@ -95,9 +95,9 @@ def _check_dialect(name: Optional[str]) -> None:
 # --------------------------------------------------------------------------- convert
 
 def _target_extension(dialect: str) -> str:
-    from nctrans import detect as _detect
-    exts = _detect.EXTENSIONS.get(dialect) or (".nc",)
-    return exts[0]
+    """The file ending `convert` writes for `dialect`: the first of its endings."""
+    exts = pipeline.get_dialect(dialect).extensions
+    return exts[0] if exts else ".nc"
 
 
 def _same_file(a: Path, b: Path) -> bool:

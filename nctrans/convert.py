@@ -59,6 +59,15 @@ def _library_refusal(program: Program, entry: str, target: str) -> Diagnostic:
                       f"(with --flatten) instead", sub.span.file, sub.span.line, sub.span.col)
 
 
+def lower_for(program: Program, target: Dialect, diags: list[Diagnostic]) -> Program:
+    """Run the IR -> IR passes the target lists (Dialect.lowering_passes), in order; each returns
+    the new program and its NC401 diagnostics."""
+    for lowering in target.lowering_passes:
+        program, found = lowering(program)
+        diags.extend(found)
+    return program
+
+
 def strict(diags: list[Diagnostic]) -> list[Diagnostic]:
     """--strict: every lowering (NC401) becomes an error."""
     out = []
@@ -82,6 +91,7 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
     if flatten and flatten_with is not None:
         program = flatten_with(diags)
         flattened = True
+    program = lower_for(program, target, diags)
     result = target.emit(program)
     refusals = [d for d in result.diagnostics if _is_refusal(d)]
     if refusals and library is not None:
@@ -90,7 +100,7 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
     elif refusals and not flattened and flatten_with is not None and not strict_mode:
         lowered = [_as_lowering(d, target.name) for d in refusals]
         flat_diags: list[Diagnostic] = []
-        flat = flatten_with(flat_diags)
+        flat = lower_for(flatten_with(flat_diags), target, flat_diags)
         again = target.emit(flat)
         diags.extend(lowered)
         diags.extend(flat_diags)

@@ -52,14 +52,9 @@ class Loaded:
 
 def get_dialect(name: str) -> base.Dialect:
     """The registered dialect `name`; PipelineError for an unknown or not-yet-available one."""
-    if name not in base.names():
-        raise PipelineError(f"unknown dialect {name!r} (known: {', '.join(base.names())})")
-    try:
-        d = base.get(name)
-    except (ImportError, AttributeError):
-        d = None
+    d = base.get(name)
     if d is None:
-        raise PipelineError(f"dialect {name!r} is not available in this build yet")
+        raise PipelineError(f"unknown dialect {name!r} (known: {', '.join(base.names())})")
     return d
 
 
@@ -83,23 +78,10 @@ _DETECT_HEAD = 64 * 1024
 _CHECK_HEAD = 4 * 1024
 
 
-# Dialects with a lazy parse for programs that run straight through: module, function.
-_STREAMING = {"iso-m": ("nctrans.dialects.iso_m.frontend", "parse_stream")}
-
-
-def _parse_stream(dialect: str, text: str, label: str):
-    """The dialect's streamed parse, or None (no lazy mode, or the text needs the whole IR)."""
-    where = _STREAMING.get(dialect)
-    if where is None:
-        return None
-    import importlib
-    return getattr(importlib.import_module(where[0]), where[1])(text, label)
-
-
 def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Optional[str] = None,
                 stream: bool = False) -> Loaded:
     """Parse already-read text: choose the dialect (given or detected), parse, collect diagnostics.
-    With `stream` the parse may be lazy (see _STREAMING): the program must then be run exactly
+    With `stream` the parse may be lazy (Dialect.streams): the program must then be run exactly
     once, through toolpath_of or lint, which complete the diagnostics."""
     label = src.file
     diags = list(src.diagnostics)
@@ -114,8 +96,8 @@ def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Opt
             raise PipelineError(f"{label}: cannot tell the dialect ({guess.describe()}): use --from DIALECT")
         dialect = guess.dialect
     d = get_dialect(dialect)
-    if stream:
-        result = _parse_stream(dialect, src.text, label)
+    if stream and d.streams:
+        result = d.parse_stream(src.text, label)
         if result is not None:
             return Loaded(path, label, src, dialect, result.program, diags, guess,
                           streamed=result.diagnostics)
@@ -167,7 +149,8 @@ def load_program(path_or_dash: str, dialect: Optional[str] = None
 def load_machine(path: Optional[str], dialect: Optional[str] = None) -> Machine:
     """The machine from MACHINE.toml, or the built-in default (a lathe for turning dialects)."""
     if path is None:
-        return default_lathe() if dialect == "iso-t" else default_mill()
+        d = base.get(dialect) if dialect else None
+        return default_lathe() if d is not None and d.machine_kind == "lathe" else default_mill()
     try:
         return _load_machine(path)
     except MachineError as e:
@@ -186,10 +169,7 @@ def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> O
     """The interpreter's subprogram resolver, searching the source's directory (the working
     directory for stdin). Called files are parsed in the caller's dialect; their own diagnostics
     are reported when they are linted themselves, not again through every caller."""
-    try:
-        from nctrans.interp.resolver import Resolver
-    except ImportError:
-        return None
+    from nctrans.interp.resolver import Resolver
 
     def parse_file(path: Path) -> Optional[Program]:
         try:
@@ -206,7 +186,14 @@ def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> O
         except PipelineError:
             return None
 
-    return Resolver([source_dir or os.getcwd(), *search_paths()], parse_file)
+    d = base.get(dialect) if dialect else None
+    candidates = d.subprogram_files if d is not None else _any_dialect_files
+    return Resolver([source_dir or os.getcwd(), *search_paths()], parse_file, candidates)
+
+
+def _any_dialect_files(name: str) -> list[str]:
+    """Subprogram file names of every registered dialect (the caller's dialect is unknown)."""
+    return list(dict.fromkeys(f for d in base.dialects() for f in d.subprogram_files(name)))
 
 
 # Directories searched for called subprograms and definition files after the source's own directory
@@ -219,19 +206,17 @@ def search_paths() -> list[str]:
     return [*SEARCH_PATHS, *env]
 
 
-# Dialects whose programs read variables declared in definition files beside them (Sinumerik
-# GUD modules _N_*GUD*_DEF, spec 1.8): dialect -> file endings of those files (lower case).
-_DEFINITION_FILES = {"sinumerik": (".def",)}
 # (path, mtime_ns, dialect) -> parsed definition file; a directory lint parses each once
 _DEFINITION_CACHE: dict[tuple, Optional[Program]] = {}
 
 
 def definition_programs(source_dir: Optional[str], dialect: Optional[str],
                         search_paths: Iterable[str] = ()) -> list[Program]:
-    """The parsed definition files (*.DEF for Sinumerik) of the source directory and the search
+    """The parsed definition files (Dialect.definition_files) of the source directory and the search
     paths, in file-name order, for the interpreter to preload their declarations. Unreadable or
     unparsable files are skipped: they are reported when they are linted themselves."""
-    endings = _DEFINITION_FILES.get(dialect or "")
+    d = base.get(dialect) if dialect else None
+    endings = d.definition_files if d is not None else ()
     if not endings:
         return []
     dirs: list[Path] = []
@@ -330,11 +315,10 @@ def lint(ld: Loaded, machine: Optional[Machine] = None) -> list[Diagnostic]:
 # --------------------------------------------------------------------------- paths
 
 def all_extensions() -> set[str]:
+    """File endings (lower case) of every registered dialect: what a directory walk picks up."""
     exts: set[str] = set()
     for name in base.names():
-        exts.update(_detect._extensions(name))
-    for group in _detect.EXTENSIONS.values():
-        exts.update(group)
+        exts.update(_detect.extensions(name))
     return exts
 
 

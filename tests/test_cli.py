@@ -97,16 +97,26 @@ def _fake_emit(program: n.Program) -> EmitResult:
     return EmitResult("\n".join(lines) + "\n", diags)
 
 
-FAKE = Dialect("fake", (".fk",), _fake_parse, _fake_emit, lambda t: 1.0 if t.startswith("G") else 0.0)
+class Fake(Dialect, register=False):
+    name = "fake"
+    extensions = (".nc", ".fk")     # convert writes the first
+
+    def parse(self, text, file="<stdin>"):
+        return _fake_parse(text, file)
+
+    def emit(self, program):
+        return _fake_emit(program)
+
+    def sniff(self, text):
+        return 1.0 if text.startswith("G") else 0.0
 
 
 @pytest.fixture
 def fake(monkeypatch, tmp_path):
     """Register the fake dialect (alone, so detection picks it) and work in a temporary directory."""
-    monkeypatch.setattr(base, "_MODULES", {"fake": "tests.fake"})
-    monkeypatch.setattr(base, "_loaded", {"fake": FAKE})
     monkeypatch.chdir(tmp_path)
-    return tmp_path
+    with base.registered_only(Fake()):
+        yield tmp_path
 
 
 def run(capsys, *argv):
@@ -237,7 +247,7 @@ def test_lint_unreadable_and_missing_files_exit_2_but_report_the_rest(fake, caps
 def test_internal_error_is_a_message_not_a_traceback(fake, capsys, monkeypatch):
     def boom(text, file):
         raise RuntimeError("parser bug")
-    monkeypatch.setattr(FAKE, "parse", boom)
+    monkeypatch.setattr(base.get("fake"), "parse", boom)
     Path("a.fk").write_text("G0 X1\n")
     rc, out, err = run(capsys, "lint", "a.fk")
     assert rc == 2 and "internal error on a.fk: RuntimeError: parser bug" in err
@@ -342,7 +352,7 @@ def test_detect_and_ambiguity(fake, capsys, monkeypatch):
     Path("a.fk").write_text("G0 X1\n")
     rc, out, _ = run(capsys, "detect", "a.fk")
     assert rc == 0 and out.startswith("a.fk: fake (confidence 1.00)")
-    monkeypatch.setattr(FAKE, "sniff", lambda t: 0.0)
+    monkeypatch.setattr(base.get("fake"), "sniff", lambda t: 0.0)
     Path("a.txt").write_text("hello\n")
     rc, out, _ = run(capsys, "detect", "a.txt")
     assert rc == 2 and "ambiguous" in out
@@ -472,7 +482,7 @@ def test_detect_every_corpus_program_with_and_without_its_name():
 
 def test_detect_ignores_words_inside_iso_comments(monkeypatch):
     from nctrans import detect as det
-    monkeypatch.setattr(det, "_sniff", lambda name, text: None)     # the marker table alone
+    monkeypatch.setattr(det, "_sniff", lambda dialect, text: 0.0)     # the marker table alone
     detect = det.detect
     iso = "%\nO1000\n(T1 D=0.5 CR=0. - ZMIN=0. - MIRROR ENDIF)\n(X=10 R1=5 GOTOF)\nG0 X0 Y0\nM30\n%\n"
     g = detect(iso, None)

@@ -8,6 +8,7 @@ import pytest
 from hypothesis import given, settings, strategies as hs
 
 from interp_helpers import B, av, mode, move, moves, num, run
+from nctrans.dialects import base
 from nctrans.interp import interpret
 from nctrans.interp.resolver import Resolver, candidate_names
 from nctrans.ir import nodes as n
@@ -404,13 +405,16 @@ def test_resolver_finds_files_beside_the_caller(tmp_path):
     def parse(path):
         parsed.append(path)
         return n.Program(str(path), "test", [n.Block(n.Span(str(path), 1), [n.Motion({"X": av(9)})])])
-    res = Resolver([tmp_path], parse)        # the caller t.nc is elsewhere: the search path finds it
+    iso = base.get("iso-m")
+    res = Resolver([tmp_path], parse, iso.subprogram_files)   # the caller t.nc is elsewhere: the search path finds it
     b = B()
     b(n.SubCall("1234"))(n.SubCall("O1234"))
     recs, diags = run(b.program(), resolver=res)
     assert not diags and len(recs) == 2 and recs[0].file.endswith("O1234.nc")
     assert len(parsed) == 1
-    assert candidate_names("../etc/passwd") == [] and "L10.SPF" in candidate_names("L10")
+    assert candidate_names("../etc/passwd") == [] and iso.subprogram_files("../etc/passwd") == []
+    assert "L10.SPF" in base.get("sinumerik").subprogram_files("L10")
+    assert "SUB1.SPF" in base.get("sinumerik").subprogram_files("%_N_SUB1_SPF")
 
 
 # ------------------------------------------------------------------ events and streaming

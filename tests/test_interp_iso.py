@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from nctrans.dialects import base
 from nctrans.interp import interpret
 from nctrans.interp.resolver import Resolver
 from nctrans.machine import Machine, Tool
@@ -113,7 +114,8 @@ def test_subprogram_in_another_file(tmp_path):
     main = tmp_path / "main.nc"
     main.write_text("G21 G90\nG0 X0\nM98 P9020 L3\nG0 Y5\nM30\n")
     from nctrans.dialects.iso_m.frontend import parse_program
-    res = Resolver([], lambda p: parse_program(p.read_text(), str(p)).program)
+    res = Resolver([], lambda p: parse_program(p.read_text(), str(p)).program,
+                   base.get("iso-m").subprogram_files)
     recs, diags = run(main.read_text(), resolver=res, file=str(main))
     assert not diags
     assert ends(recs) == [0.0, 1.0, 2.0, 3.0, 3.0]

@@ -1,4 +1,5 @@
-"""Finding subprograms that live in other files (ISO `O1000` -> 1000.nc, Sinumerik `L10` -> L10.SPF).
+"""Finding subprograms that live in other files (each dialect says how a name maps to file names:
+Dialect.subprogram_files).
 
 A Resolver is the `resolver` argument of `interpret`: resolver(name, from_file) -> Program | None.
 It looks in the calling file's directory first, then in the configured search paths, and never
@@ -13,32 +14,26 @@ from typing import Callable, Iterable, Optional
 
 from nctrans.ir.nodes import Program
 
-EXTENSIONS = ("", ".nc", ".NC", ".mpf", ".MPF", ".spf", ".SPF", ".tap", ".TAP", ".ngc", ".cnc",
-              ".iso", ".eia", ".txt")
 _SAFE = re.compile(r"^[A-Za-z0-9_.$%-]+$")
 
 
-def candidate_names(name: str) -> list[str]:
-    """File names (without directory) that may hold the program `name`, most likely first."""
+def _default_stems(name: str) -> list[str]:
+    return [name, name.upper()]
+
+
+def candidate_names(name: str, stems: Callable[[str], list[str]] = _default_stems,
+                    endings: Iterable[str] = ()) -> list[str]:
+    """File names (without directory) that may hold the program `name`, most likely first: each of
+    `stems(name)` (the dialect's spellings of the name) as written, then with each of `endings`
+    (a stem that already has an ending is tried as written only). [] for a name that could leave
+    the directory (path separators, `..`)."""
     s = name.strip().strip('"').strip("'")
     if not s or not _SAFE.match(s) or ".." in s:
         return []
-    stems: list[str] = []
-    m = re.match(r"^[Oo]?0*(\d+)$", s)
-    if m:
-        num = m.group(1)
-        stems += [f"O{num.zfill(4)}", f"O{num}", num.zfill(4), num, f"o{num.zfill(4)}", f"o{num}"]
-    else:
-        stems += [s, s.upper()]
-        if s.upper().startswith("%_N_"):          # Sinumerik archive names %_N_NAME_SPF
-            core = s.upper()[4:]
-            for ext in ("_SPF", "_MPF"):
-                if core.endswith(ext):
-                    stems.append(core[:-4])
     seen: set[str] = set()
     out = []
-    for st in stems:
-        for ext in EXTENSIONS:
+    for st in stems(s):
+        for ext in ("", *endings):
             if "." in st and ext:
                 continue
             f = st + ext
@@ -51,12 +46,15 @@ def candidate_names(name: str) -> list[str]:
 class Resolver:
     """Map a subprogram name to a parsed Program from the caller's directory or the search paths.
 
-    parse_fn(path) -> Program | None reads and parses one file (the caller chooses the dialect).
+    parse_fn(path) -> Program | None reads and parses one file (the caller chooses the dialect);
+    candidates(name) -> file names to try (the caller's dialect's Dialect.subprogram_files).
     """
 
-    def __init__(self, search_paths: Iterable[str | Path] = (), parse_fn: Optional[Callable] = None):
+    def __init__(self, search_paths: Iterable[str | Path] = (), parse_fn: Optional[Callable] = None,
+                 candidates: Callable[[str], list[str]] = candidate_names):
         self.search_paths = [Path(p).resolve() for p in search_paths]
         self.parse_fn = parse_fn
+        self.candidates = candidates
         self._cache: dict[Path, Optional[Program]] = {}
 
     def find_file(self, name: str, from_file: Optional[str] = None) -> Optional[Path]:
@@ -67,7 +65,7 @@ class Resolver:
         for d in dirs:
             if not d.is_dir():
                 continue
-            for cand in candidate_names(name):
+            for cand in self.candidates(name):
                 p = d / cand
                 if p.is_file() and p.resolve().parent == d:
                     return p.resolve()

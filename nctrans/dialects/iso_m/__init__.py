@@ -1,14 +1,43 @@
-"""ISO / Fanuc-style milling (`iso-m`): front end, emitter and detection.
+"""ISO / Fanuc-style milling (`iso-m`), and `IsoFamily`, the base of every ISO-style dialect.
 
 Modules: prelex (comments, cleaning), fastpath + words (the word list of a block; lark grammar of
 record in grammars/iso-m.lark), frontend (lowering to the IR), emitter (IR -> ISO text).
 Imports stay light: lark is loaded only when a block needs the full grammar.
+
+ISO turning and Fagor extend the family: `class IsoTurning(IsoFamily)` sets its name, endings and
+table and overrides what differs (see nctrans.dialects.base).
 """
 from __future__ import annotations
 
 import re
 
-from nctrans.dialects.base import Dialect, EmitResult, ParseResult
+from nctrans.dialects.base import Dialect, EmitResult, Marker, ParseResult
+
+_I = re.IGNORECASE
+
+# Content markers of ISO-style programs (Fanuc macro B and LinuxCNC rs274ngc), per line of code with
+# its comments removed (nctrans.detect).
+ISO_MARKERS = (
+    Marker(3.0, 1, re.compile(r"^[ \t]*O\d{1,8}\b", _I)),
+    # LinuxCNC rs274ngc (an ISO dialect): o-word control flow and named parameters
+    Marker(4.0, 3, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?O(?:\d+|<\w+>)[ \t]*(?:SUB|ENDSUB|IF|ELSEIF|ELSE|ENDIF|"
+                              r"WHILE|ENDWHILE|DO|REPEAT|ENDREPEAT|CALL|RETURN|BREAK|CONTINUE)\b", _I)),
+    Marker(3.0, 3, re.compile(r"#<\w+>")),
+    Marker(1.0, 3, re.compile(r"^[ \t]*%[ \t]*$")),
+    Marker(3.0, 3, re.compile(r"#\d+[ \t]*=")),
+    Marker(2.0, 3, re.compile(r"#\[")),
+    Marker(3.0, 2, re.compile(r"\b(?:WHILE|IF)[ \t]*\[", _I)),
+    Marker(2.0, 2, re.compile(r"\bEND[ \t]*\d\b", _I)),
+    Marker(2.0, 2, re.compile(r"\bGOTO[ \t]*\d", _I)),
+    Marker(2.0, 2, re.compile(r"\b(?:M98[ \t]*P|G65[ \t]*P|M99\b)", _I)),
+    Marker(1.0, 2, re.compile(r"\bG43\b.*\bH\d", _I)),
+    Marker(1.0, 2, re.compile(r"\bG(?:7[346]|8[1-9])\b.*\bR[-+.\d]", _I)),
+    Marker(1.0, 2, re.compile(r"\bG0?[23]\b[^=]*\bR[-+.\d]", _I)),
+    Marker(1.0, 2, re.compile(r"\bG28\b", _I)),
+    # blocks of plain words only (N, G, M, axes, F, S, T...): other dialects allow them too, ISO
+    # programs are made of little else, so a small capped lean towards ISO.
+    Marker(0.25, 6, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?(?:[GMXYZIJKFSTHDPQRABC][ \t]*[-+]?\d*\.?\d+[ \t]*)+$", _I)),
+)
 
 
 def parse(text: str, file: str = "<stdin>") -> ParseResult:
@@ -40,6 +69,41 @@ def sniff(text: str) -> float:
     return round(max(0.0, min(1.0, 0.3 + 0.7 * score)), 3)
 
 
-DIALECT = Dialect(name="iso-m", extensions=(".nc", ".tap", ".cnc", ".iso", ".eia", ".ngc"),
-                  parse=parse, emit=emit, sniff=sniff,
-                  description="ISO / Fanuc-style milling with custom macro B")
+_PROGRAM_NUMBER = re.compile(r"^[Oo]?0*(\d+)$")
+
+
+class IsoFamily(Dialect):
+    """ISO-style (Fanuc-like) dialects: word-address blocks, `( )` comments, macro B variables,
+    O-numbered subprograms. Not registered itself (it has no name); subclasses set name, endings
+    and table and override what differs."""
+    markers = ISO_MARKERS
+    comment_evidence = {"paren_comment": (1.0, 3)}
+    subprogram_endings = (".nc", ".NC", ".tap", ".TAP", ".ngc", ".cnc", ".iso", ".eia", ".txt")
+
+    def sniff(self, text: str) -> float:
+        return sniff(text)
+
+    def subprogram_stems(self, name: str) -> list[str]:
+        """O1000 / 1000 -> O1000, 1000 (and the zero-padded and lower-case spellings)."""
+        m = _PROGRAM_NUMBER.match(name)
+        if m:
+            num = m.group(1)
+            return [f"O{num.zfill(4)}", f"O{num}", num.zfill(4), num, f"o{num.zfill(4)}", f"o{num}"]
+        return super().subprogram_stems(name)
+
+
+class IsoMilling(IsoFamily):
+    name = "iso-m"
+    description = "ISO / Fanuc-style milling with custom macro B"
+    extensions = (".nc", ".tap", ".cnc", ".iso", ".eia", ".ngc")
+    streams = True
+
+    def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
+        return parse(text, file)
+
+    def parse_stream(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        from .frontend import parse_stream
+        return parse_stream(text, file)
+
+    def emit(self, program) -> EmitResult:
+        return emit(program)

@@ -1,9 +1,11 @@
-"""Siemens Sinumerik 840D dialect: front end (frontend.py), emitter (emitter.py), sniffing."""
+"""Siemens Sinumerik 840D dialect: front end (frontend.py), emitter (emitter.py), detection."""
 from __future__ import annotations
 
 import re
 
-from nctrans.dialects.base import Dialect
+from nctrans.dialects.base import Dialect, EmitResult, Marker, ParseResult
+
+_I = re.IGNORECASE
 
 _MARKS = [re.compile(p, re.IGNORECASE | re.MULTILINE) for p in (
     r"^%_N_\w+_(?:MPF|SPF)\b", r"^\s*(?:N\d+\s+)?(?:DEF|PROC)\s+\w+", r"\bGOTO[FBC]\b",
@@ -28,6 +30,49 @@ def _emit(program):
     return emit(program)
 
 
-DIALECT = Dialect(name="sinumerik", extensions=(".mpf", ".spf", ".MPF", ".SPF"), parse=_parse,
-                  emit=_emit, sniff=sniff,
-                  description="Siemens Sinumerik 840D/840Di/810D (SW 6)")
+# Content markers, per line of code with its comments removed (nctrans.detect).
+MARKERS = (
+    Marker(5.0, 1, re.compile(r"^%_N_\w+_(?:MPF|SPF)\b", _I)),
+    Marker(3.0, 3, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?DEF[ \t]+(?:INT|REAL|BOOL|CHAR|STRING|AXIS|FRAME)\b", _I)),
+    Marker(4.0, 2, re.compile(r"^[ \t]*DEFINE[ \t]+\w+[ \t]+AS\b", _I)),
+    Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?PROC[ \t]+\w+", _I)),
+    Marker(2.0, 3, re.compile(r"\bR\d+[ \t]*=", _I)),
+    Marker(3.0, 3, re.compile(r"\bGOTO[FBC]\b", _I)),
+    Marker(3.0, 3, re.compile(r"\bMSG[ \t]*\([ \t]*\"", _I)),
+    Marker(3.0, 3, re.compile(r"\bCYCLE\d+[ \t]*\(", _I)),
+    Marker(2.0, 3, re.compile(r"\b[XYZABCIJKFS]\d?[ \t]*=[ \t]*[-+(A-Z$0-9]", _I)),
+    Marker(2.0, 3, re.compile(r"\$[A-Z]{1,3}_\w+", _I)),
+    Marker(2.0, 3, re.compile(
+        r"\b(?:A?TRANS|A?ROT|A?SCALE|A?MIRROR|ENDIF|ENDWHILE|ENDFOR|ENDLOOP|STOPRE|TRAFOOF|TRAORI|SUPA|"
+        r"CFC|DIAMON|BRISK|SOFT|G64[12]|CIP|CR[ \t]*=|AC[ \t]*\(|IC[ \t]*\(|M17|RET)\b", _I)),
+    Marker(3.0, 2, re.compile(r"\bT[ \t]*=[ \t]*\"", _I)),
+    Marker(1.5, 1, re.compile(r"\bG7[01]\b", _I)),          # inch/metric (ISO mills: G20/G21)
+    # array element assignment by name (GUD/LUD arrays: INI[53]=0); ISO writes #[..] instead
+    Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?[A-Z_]{2,}\w*[ \t]*\[[^\]]*\][ \t]*=", _I)),
+)
+
+class Sinumerik(Dialect):
+    name = "sinumerik"
+    description = "Siemens Sinumerik 840D/840Di/810D (SW 6)"
+    extensions = (".mpf", ".spf", ".MPF", ".SPF")
+    markers = MARKERS
+    comment_evidence = {"semicolon_line": (1.0, 3), "semicolon_tail": (0.5, 2)}
+    definition_files = (".def",)       # GUD modules _N_*GUD*_DEF (spec 1.8)
+    subprogram_endings = (".spf", ".SPF", ".mpf", ".MPF", ".txt")
+
+    def sniff(self, text: str) -> float:
+        return sniff(text)
+
+    def subprogram_stems(self, name: str) -> list[str]:
+        """L10 -> L10, and an archive name %_N_NAME_SPF -> NAME as well."""
+        stems = super().subprogram_stems(name)
+        upper = name.upper()
+        if upper.startswith("%_N_") and upper.endswith(("_SPF", "_MPF")):
+            stems.append(upper[4:-4])
+        return stems
+
+    def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
+        return _parse(text, file)
+
+    def emit(self, program) -> EmitResult:
+        return _emit(program)

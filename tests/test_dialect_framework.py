@@ -1,0 +1,88 @@
+"""The dialect framework: registration by subclassing, family bases, and the consumers (detection,
+pipeline, resolver) reading what a dialect declares instead of lists of their own."""
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from nctrans import detect, pipeline
+from nctrans.dialects import base
+from nctrans.dialects.base import Dialect, Marker, ParseResult
+from nctrans.dialects.iso_m import IsoFamily, IsoMilling
+from nctrans.ir import nodes as n
+
+
+def test_every_dialect_package_registers_its_class():
+    assert base.names() == ["iso-m", "sinumerik"]
+    assert isinstance(base.get("iso-m"), IsoMilling) and base.get("nope") is None
+    with pytest.raises(KeyError, match="unknown dialect 'nope'"):
+        base.get_or_raise("nope")
+
+
+def test_a_family_base_without_a_name_is_not_registered_and_a_subclass_is():
+    class Family(Dialect, register=False):
+        pass
+
+    before = dict(base._REGISTRY)
+    try:
+        class Sub(Family):          # no name of its own: abstract, not registered
+            extensions = (".x",)
+        assert base._REGISTRY == before
+
+        class Turning(IsoFamily):   # the way ISO turning extends the ISO family
+            name = "test-turning"
+            extensions = (".tt",)
+            machine_kind = "lathe"
+        t = base.get("test-turning")
+        assert isinstance(t, Turning) and t.markers == IsoMilling.markers
+        assert t.table_name == "test-turning"
+        assert "O0012.nc" in t.subprogram_files("12") and "O0012.tt" in t.subprogram_files("12")
+        assert pipeline.load_machine(None, "test-turning").kind == "lathe"
+        assert pipeline.load_machine(None, "iso-m").kind == "mill"
+    finally:
+        base._REGISTRY.clear()
+        base._REGISTRY.update(before)
+    assert base.get("test-turning") is None
+
+
+class Marked(Dialect, register=False):
+    """A dialect known only by one marker and one comment shape."""
+    name = "marked"
+    extensions = (".mk",)
+    markers = (Marker(4.0, 1, re.compile(r"^ZAP\b")),)
+    comment_evidence = {"semicolon_line": (1.0, 2)}
+
+    def parse(self, text, file="<stdin>"):
+        return ParseResult(n.Program(file, self.name, []))
+
+
+def test_detection_weighs_the_markers_and_comment_shapes_a_dialect_declares():
+    with base.registered_only(Marked(), base.get("iso-m")):
+        g = detect.detect("ZAP 1\n;a\n;b\n;c\n", None)
+        assert g.dialect == "marked"
+        assert g.content["marked"] == pytest.approx(4.0 + 2.0)     # one ZAP line (cap 1), 2 of 3 ';' lines
+        assert g.first_marker["marked"] == (1, 1, "ZAP")
+        assert detect.extensions("marked") == (".mk",)
+        assert pipeline.all_extensions() == {".mk", *detect.extensions("iso-m")}
+        # the pipeline knows only registered dialects
+        with pytest.raises(pipeline.PipelineError, match="unknown dialect 'sinumerik'"):
+            pipeline.get_dialect("sinumerik")
+
+
+def test_resolver_tries_the_callers_dialect_file_names(tmp_path):
+    (tmp_path / "L10.SPF").write_text("G0 X1\nM17\n")
+    (tmp_path / "O0077.nc").write_text("O77\nG0 X1\nM99\n")
+    sin = pipeline.make_resolver(str(tmp_path), "sinumerik")
+    iso = pipeline.make_resolver(str(tmp_path), "iso-m")
+    anyd = pipeline.make_resolver(str(tmp_path), None)
+    assert sin.find_file("L10").name == "L10.SPF" and iso.find_file("L10") is None
+    assert iso.find_file("77").name == "O0077.nc" and sin.find_file("77") is None
+    assert anyd.find_file("L10").name == "L10.SPF" and anyd.find_file("77").name == "O0077.nc"
+    assert iso.find_file("../L10.SPF") is None
+
+
+def test_definition_files_and_streaming_are_declared_by_the_dialect():
+    assert base.get("sinumerik").definition_files == (".def",) and not base.get("iso-m").definition_files
+    assert base.get("iso-m").streams and not base.get("sinumerik").streams
+    assert base.get("sinumerik").parse_stream("G0 X1\n") is None
