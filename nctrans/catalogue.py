@@ -28,6 +28,12 @@ FAMILIES = {
 
 
 class Rule(BaseModel):
+    """One rule. `bad` and `good` are real programs in `dialect`: tests/test_rule_examples.py runs
+    each through `nctrans <example_command> FILE --from DIALECT <example_args>` and requires the bad
+    one to report this rule and the good one not to. Examples that need more than one file declare
+    it: `example_files` (name -> text, written beside the example, e.g. a called subprogram),
+    `example_machine` (MACHINE.toml text, passed with --machine), `example_encoding` (how the bad
+    example's bytes are encoded, e.g. utf-16)."""
     model_config = ConfigDict(extra="forbid")
     code: str
     name: str
@@ -37,6 +43,15 @@ class Rule(BaseModel):
     bad: str
     good: str
     fix: Optional[str] = None
+    dialect: str = "iso-m"
+    example_command: Literal["lint", "convert", "check"] = "lint"
+    example_args: list[str] = []
+    example_files: dict[str, str] = {}
+    example_machine: Optional[str] = None
+    example_encoding: str = "utf-8"
+    # A rule kept for its stable code that no dialect reports yet: why. Its test then requires
+    # that the bad example does NOT fire, so the day it does, the entry must be completed.
+    reserved: Optional[str] = None
 
     @field_validator("code")
     @classmethod
@@ -90,17 +105,33 @@ def format_catalogue(cat: Catalogue) -> str:
 def format_rule(r: Rule) -> str:
     """One rule's documentation: summary, why, a failing and a passing example, the fix."""
     return "\n".join([
-        f"{r.code} {r.name} ({r.severity})",
+        f"{r.code} {r.name} ({r.severity})" + (" - reserved: no dialect reports it yet" if r.reserved else ""),
         "",
         r.summary,
         "",
         f"Why: {r.why}",
         "",
         "Bad:",
-        f"    {r.bad}" if r.bad else "    (an empty file)",
+        _indent(r.bad) if r.bad.strip() else "    (an empty file)",
         "",
         "Good:",
-        f"    {r.good}",
+        _indent(r.good),
+        "",
+        f"(examples run as: {_example_context(r)})",
         "",
         f"Fix: {r.fix}" if r.fix else "Fix: no automatic fix; edit the program as in the good example.",
     ])
+
+
+def _indent(program: str) -> str:
+    return "\n".join("    " + line for line in program.strip("\n").splitlines())
+
+
+def _example_context(r: Rule) -> str:
+    """How the examples are run, e.g. `nctrans lint --from sinumerik`."""
+    words = ["nctrans", r.example_command, "--from", r.dialect, *r.example_args]
+    if r.example_machine:
+        words += ["--machine", "MACHINE.toml"]
+    if r.example_encoding != "utf-8":
+        words.append(f"(file encoded as {r.example_encoding})")
+    return " ".join(words)
