@@ -319,7 +319,7 @@ def cmd_toolpath(args) -> int:
 # --------------------------------------------------------------------------- equiv
 
 def cmd_equiv(args) -> int:
-    from nctrans import equiv as _equiv
+    from nctrans import equivalence as _equiv
     if args.tol is None:
         args.tol = _equiv.DEFAULT_TOL
     if not args.tol > 0:
@@ -364,7 +364,7 @@ def cmd_detect(args) -> int:
             _print_text_diags(src.diagnostics, sys.stderr)
             status = max(status, EXIT_DIAGNOSTICS)
             continue
-        from nctrans import detect as _detect
+        from nctrans import detection as _detect
         g = _detect.detect(src.text, None if f == _source.STDIN else f)
         if g.ambiguous:
             print(f"{label}: ambiguous ({g.describe()}): use --from DIALECT")

@@ -96,6 +96,11 @@ class Machine:
         t = self.tool(index)
         return t.radius if t else 0.0
 
+    @classmethod
+    def from_toml(cls, path: "str | Path") -> "Machine":
+        """The machine described by a MACHINE.toml (CONTRACT.md); MachineError names what is wrong."""
+        return load(path)
+
     def work_offset(self, name: str) -> dict[str, float]:
         """Offset of work coordinate system `name` (ISO name, e.g. "G54", "G54.1P3"); zeros if unset."""
         return self.offsets.get(name.upper(), {})

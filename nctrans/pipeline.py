@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, Optional
 
-from nctrans import detect as _detect
+from nctrans import detection as _detect
 from nctrans import source as _source
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects import base

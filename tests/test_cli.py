@@ -469,7 +469,7 @@ def test_e2e_convert_iso_to_sinumerik_is_equivalent(tmp_path):
 # --------------------------------------------------------------------------- detection (in process)
 
 def test_detect_every_corpus_program_with_and_without_its_name():
-    from nctrans.detect import detect
+    from nctrans.detection import detect
     from nctrans.source import read_source
     files = [p for p in CORPUS.rglob("*") if p.is_file() and p.suffix != ".tsv"]
     assert len(files) > 50
@@ -493,7 +493,7 @@ def test_detect_ignores_words_inside_iso_comments(monkeypatch):
 
 
 def test_detect_says_ambiguous_without_evidence():
-    from nctrans.detect import detect
+    from nctrans.detection import detect
     for text in ("", "hello\n", "  \n"):
         g = detect(text, None)
         assert g.ambiguous and g.dialect is None

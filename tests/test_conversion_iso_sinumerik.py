@@ -28,7 +28,7 @@ import pytest
 
 import rs274 as h
 from conftest import CORPUS
-from nctrans import equiv, pipeline
+from nctrans import equivalence as equiv, pipeline
 from nctrans import source as _source
 from nctrans.dialects.base import get
 from nctrans.interp import interpret

@@ -2,7 +2,7 @@
 refusal only when even plain motion cannot carry it; --strict refuses every lowering."""
 from pathlib import Path
 
-from nctrans import equiv
+from nctrans import equivalence as equiv
 from nctrans.convert import convert
 from nctrans.dialects.base import get
 from nctrans.interp import interpret

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from nctrans import equiv
+from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.dialects.sinumerik.frontend import parse
 from nctrans.interp import interpret

@@ -3,7 +3,7 @@ import math
 
 from hypothesis import assume, given, settings, strategies as st
 
-from nctrans.equiv import _dist_point_segment, arc_points, compare
+from nctrans.equivalence import _dist_point_segment, arc_points, compare
 from nctrans.toolpath import ToolpathRecord
 
 

@@ -7,7 +7,7 @@ and radii, and for every Sinumerik conformance program (corpus/sinumerik/*.mpf, 
   tools, spindle, coolant, dwells, stops, program end; no control flow, calls, cycles, frames,
   expressions, compensation or subprograms (walked node by node);
 - nctrans's toolpath of the flattened program equals the source's record by record (machine mm,
-  1e-6), comes from the same source lines, and `nctrans.equiv` finds no difference;
+  1e-6), comes from the same source lines, and `nctrans.equivalence` finds no difference;
 - its iso-m emission runs in LinuxCNC's rs274 to PROGRAM_END with the same moves as nctrans's
   toolpath of the source (harness tests/rs274.py; the machine's work offsets are loaded into rs274
   with G10 L2 lines ahead of the program and the tool table is written from the machine model);
@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 
 import rs274 as h
-from nctrans import equiv
+from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.ir import nodes as n

@@ -15,7 +15,7 @@ import pytest
 
 import rs274 as h
 from conftest import CORPUS
-from nctrans import equiv
+from nctrans import equivalence as equiv
 from nctrans import source as _source
 from nctrans.convert import convert
 from nctrans.dialects.base import get

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from nctrans import equiv
+from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from test_iso_roundtrip import iso_program

@@ -460,3 +460,15 @@ class Program:
     subprograms: dict[str, Subprogram] = field(default_factory=dict)
     meta: dict[str, object] = field(default_factory=dict)
     name: Optional[str] = None
+
+
+def _program_repr(self: Program) -> str:
+    """A program prints as a one-line summary (a whole IR repr runs to megabytes on CAM files)."""
+    body = self.body
+    size = f"{len(body)} top-level nodes" if type(body) is list else "streamed body"
+    subs = list(self.subprograms)
+    named = f" ({', '.join(subs[:5])}{', ...' if len(subs) > 5 else ''})" if subs else ""
+    return f"<Program {self.file} [{self.dialect}]: {size}, {len(subs)} subprograms{named}>"
+
+
+Program.__repr__ = _program_repr    # type: ignore[method-assign]

@@ -1,0 +1,404 @@
+"""The Python API: what the command line does, callable from code.
+
+Modelled on sqlglot's `transpile`/`parse_one`: a handful of functions over the same stages the CLI
+runs (`nctrans.pipeline`), so a CAM post-processor test, a DNC gateway or a notebook gets exactly the
+answers `nctrans convert/lint/toolpath/equiv` print.
+
+Conventions, the same for every function:
+- Program text is a `str`; a file is a `pathlib.Path` (or any `os.PathLike`). A `str` is never
+  taken for a file name, so a one-line program cannot be mistaken for a path.
+- Problems in the user's program are `Diagnostic` records in the result, never exceptions.
+  `error_level=ErrorLevel.RAISE` turns error diagnostics into an `NCProgramError` carrying them.
+- Misuse of the API (an unknown dialect, an unreadable file, a bad machine file, a wrong argument
+  type) raises a subclass of `NCError`.
+"""
+from __future__ import annotations
+
+import contextlib
+import enum
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Iterable, Iterator, Optional, Sequence, Union
+
+from nctrans import pipeline
+from nctrans import source as _source
+from nctrans.diagnostics import Diagnostic
+from nctrans.ir.nodes import Program
+from nctrans.machine import Machine, MachineError
+from nctrans.toolpath import ToolpathRecord
+
+from nctrans import detection as _detection
+from nctrans.detection import Guess
+
+if TYPE_CHECKING:     # equivalence (and the jsonl writer it uses) loads only when equiv() runs
+    from nctrans.equivalence import Difference
+
+__all__ = [
+    "Conversion", "Equivalence", "ErrorLevel", "NCError", "NCInputError", "NCProgramError",
+    "Toolpath", "UnknownDialectError", "detect", "dialects", "equiv", "lint", "parse",
+    "toolpath", "transpile",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Source = Union[str, "os.PathLike[str]", Program]
+MachineLike = Union[Machine, str, "os.PathLike[str]", None]
+
+STRING_LABEL = "<string>"
+DEFAULT_TOL = 0.001     # mm, as `nctrans equiv --tol` (nctrans.equivalence.DEFAULT_TOL)
+
+
+# --------------------------------------------------------------------------- errors
+
+class NCError(Exception):
+    """Root of every exception the API raises on misuse (never for problems in a program)."""
+
+
+class UnknownDialectError(NCError, ValueError):
+    """A dialect name that is not registered (see `dialects()`), or text whose dialect cannot be
+    told apart (give `read=`/`dialect=`)."""
+
+
+class NCInputError(NCError):
+    """An input that cannot be used at all: an unreadable file, a bad machine file, a bad argument."""
+
+
+class NCProgramError(NCError):
+    """Raised only with `error_level=ErrorLevel.RAISE`: the program has error diagnostics."""
+
+    def __init__(self, diagnostics: Sequence[Diagnostic]):
+        self.diagnostics = list(diagnostics)
+        errors = [d for d in self.diagnostics if d.severity == "error"]
+        first = errors[0].format_text() if errors else "no error"
+        more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+        super().__init__(f"{first}{more}")
+
+
+class ErrorLevel(enum.Enum):
+    """What to do with error diagnostics of the user's program (as sqlglot's ErrorLevel)."""
+    IGNORE = "ignore"     # return them in the result (the default)
+    RAISE = "raise"       # raise NCProgramError carrying all diagnostics
+
+
+def _raise_on_errors(diags: Sequence[Diagnostic], level: ErrorLevel) -> None:
+    if level is ErrorLevel.RAISE and any(d.severity == "error" for d in diags):
+        raise NCProgramError(diags)
+
+
+@contextlib.contextmanager
+def _api_errors() -> Iterator[None]:
+    """Pipeline failures (unknown dialect, unreadable file, ambiguous detection) as NCError."""
+    try:
+        yield
+    except pipeline.PipelineError as e:
+        msg = str(e)
+        if "dialect" in msg:
+            raise UnknownDialectError(msg) from None
+        raise NCInputError(msg) from None
+
+
+@contextlib.contextmanager
+def _search_path(dirs: Iterable[PathLike]) -> Iterator[None]:
+    """Directories searched for called subprograms and definition files during one call."""
+    extra = [os.fspath(d) for d in dirs]
+    for d in extra:
+        if not os.path.isdir(d):
+            raise NCInputError(f"search path {d}: not a directory")
+    saved = list(pipeline.SEARCH_PATHS)
+    pipeline.SEARCH_PATHS[:] = extra
+    try:
+        yield
+    finally:
+        pipeline.SEARCH_PATHS[:] = saved
+
+
+def _check_dialect(name: Optional[str]) -> None:
+    if name is not None:
+        with _api_errors():
+            pipeline.get_dialect(name)
+
+
+def _machine(machine: MachineLike, dialect: Optional[str]) -> Machine:
+    if isinstance(machine, Machine):
+        return machine
+    if machine is None:
+        return pipeline.load_machine(None, dialect)
+    if isinstance(machine, (str, os.PathLike)):
+        try:
+            return Machine.from_toml(os.fspath(machine))
+        except MachineError as e:
+            raise NCInputError(str(e)) from None
+    raise NCInputError(f"machine must be a Machine, a path to MACHINE.toml or None, not {type(machine).__name__}")
+
+
+def _load(source: Union[str, "os.PathLike[str]"], dialect: Optional[str], *, stream: bool = False,
+          file: str = STRING_LABEL) -> pipeline.Loaded:
+    """Read and parse text (a str) or a file (a PathLike)."""
+    _check_dialect(dialect)
+    with _api_errors():
+        if isinstance(source, str):
+            return pipeline.load_source(_source.from_text(source, file), _source.STDIN, dialect, stream)
+        if isinstance(source, os.PathLike):
+            path = os.fspath(source)
+            if os.path.isdir(path):
+                raise NCInputError(f"{path}: is a directory (lint takes directories)")
+            return pipeline.load(path, dialect, stream)
+    raise NCInputError(f"source must be program text (str) or a path (os.PathLike), not {type(source).__name__}")
+
+
+# --------------------------------------------------------------------------- discovery
+
+def dialects() -> list[str]:
+    """The names of every registered dialect, as the CLI's --from/--to take them."""
+    from nctrans.dialects import base
+    return list(base.names())
+
+
+def detect(text: str, filename: Optional[PathLike] = None) -> Guess:
+    """Guess the dialect of program text (`filename` adds the evidence of its ending).
+    `.dialect` is None when the guess is ambiguous; `.confidence` is 0..1."""
+    if not isinstance(text, str):
+        raise NCInputError(f"detect takes program text (str), not {type(text).__name__}")
+    return _detection.detect(_source.from_text(text).text, None if filename is None else os.fspath(filename))
+
+
+# --------------------------------------------------------------------------- parse
+
+def parse(text: Union[str, "os.PathLike[str]"], dialect: Optional[str] = None, *,
+          file: str = STRING_LABEL, error_level: ErrorLevel = ErrorLevel.IGNORE) -> Program:
+    """The IR of a program (`nctrans.ir.schema.dumps(program)` gives its JSON form).
+
+    Parse diagnostics are not raised unless `error_level=ErrorLevel.RAISE`; `lint()` reports them
+    together with what running the program finds."""
+    ld = _load(text, dialect, file=file)
+    _raise_on_errors(ld.diagnostics, error_level)
+    if ld.program is None:
+        raise NCProgramError(ld.diagnostics)
+    return ld.program
+
+
+# --------------------------------------------------------------------------- transpile
+
+@dataclass
+class Conversion:
+    """The outcome of `transpile`: the target text (None when refused), every diagnostic, and the
+    constructs that were lowered on the way (NC401 diagnostics, each naming one at its line)."""
+    text: Optional[str]
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    read: str = ""
+    write: str = ""
+
+    @property
+    def lowered(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if d.rule == "NC401"]
+
+    @property
+    def ok(self) -> bool:
+        return self.text is not None
+
+    def __repr__(self) -> str:
+        state = f"{len(self.text.splitlines())} lines" if self.text is not None else "refused"
+        return (f"<Conversion {self.read} -> {self.write}: {state}, {len(self.diagnostics)} diagnostics, "
+                f"{len(self.lowered)} lowered>")
+
+
+def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, write: str = "iso-m", *,
+              flatten: bool = False, strict: bool = False, machine: MachineLike = None,
+              search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
+              error_level: ErrorLevel = ErrorLevel.IGNORE) -> Conversion:
+    """Convert a program from dialect `read` (detected when None) to dialect `write`.
+
+    Constructs the target cannot express are lowered (NC401 infos, listed in `.lowered`) or the
+    conversion is refused (`.text` is None, NC402 errors say why). `flatten` writes plain motion
+    only; `strict` refuses every lowering; `machine` (used by flattening) is a Machine or a path to
+    MACHINE.toml; `search_path` lists directories for called subprograms."""
+    _check_dialect(write)
+    with _search_path(search_path):
+        ld = _load(text, read, file=file)
+        with _api_errors():
+            target = pipeline.get_dialect(write)
+        diags = ld.diagnostics
+        out: Optional[str] = None
+        if ld.program is not None and not any(d.severity == "error" for d in diags):
+            from nctrans.convert import convert
+            program = ld.program
+            flat_machine = _machine(machine, ld.dialect)
+
+            def flatten_with(into: list[Diagnostic]) -> Program:
+                from nctrans.lower.flatten import flatten as _flatten
+                result: Program = _flatten(program, flat_machine, diagnostics=into,
+                                           resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
+                return result
+
+            result = convert(program, target, flatten=flatten, strict_mode=strict, flatten_with=flatten_with)
+            diags.extend(result.diagnostics)
+            out = result.text
+        elif strict:
+            from nctrans.convert import strict as _strict
+            diags[:] = _strict(diags)
+        if any(d.severity == "error" for d in diags):
+            out = None
+    _raise_on_errors(diags, error_level)
+    return Conversion(out, diags, ld.dialect or "", write)
+
+
+# --------------------------------------------------------------------------- toolpath
+
+class Toolpath(Iterator[ToolpathRecord]):
+    """The streamed toolpath of one program: iterate it once for its `ToolpathRecord`s (memory
+    stays flat in program length); `.diagnostics` holds what parsing and running reported, complete
+    once the iteration has ended."""
+
+    def __init__(self, records: Iterator[ToolpathRecord], diagnostics: list[Diagnostic],
+                 label: str, dialect: Optional[str], parsed: bool = True):
+        self._records = records
+        self.diagnostics = diagnostics
+        self.parsed = parsed        # False when the program did not parse (no records follow)
+        self.label = label
+        self.dialect = dialect
+        self.count = 0
+        self.done = False
+
+    def __iter__(self) -> "Toolpath":
+        return self
+
+    def __next__(self) -> ToolpathRecord:
+        try:
+            rec = next(self._records)
+        except StopIteration:
+            self.done = True
+            raise
+        self.count += 1
+        return rec
+
+    def summary(self, machine: MachineLike = None) -> str:
+        """Run the rest of the toolpath and return what `nctrans toolpath --summary` prints."""
+        from nctrans import toolpath_io
+        summ = toolpath_io.Summary(_machine(machine, self.dialect))
+        for r in self:
+            summ.add(r)
+        text: str = summ.format(len(self.diagnostics))
+        return text
+
+    def __repr__(self) -> str:
+        state = "complete" if self.done else "running" if self.count else "not started"
+        return (f"<Toolpath {self.label} ({self.dialect}): {self.count} records, {state}, "
+                f"{len(self.diagnostics)} diagnostics>")
+
+
+def toolpath(source: Source, dialect: Optional[str] = None, machine: MachineLike = None, *,
+             search_path: Iterable[PathLike] = (), file: str = STRING_LABEL) -> Toolpath:
+    """The canonical motions of a program (text, a path or a parsed `Program`), streamed.
+
+    Records are in machine coordinates, mm and degrees, as `nctrans toolpath --format jsonl`
+    writes them. The program runs while the result is iterated."""
+    dirs = list(search_path)
+
+    def run(records: Iterator[ToolpathRecord]) -> Iterator[ToolpathRecord]:
+        with _search_path(dirs):
+            yield from records
+
+    if isinstance(source, Program):
+        _check_dialect(dialect)
+        m = _machine(machine, dialect or source.dialect)
+        diags: list[Diagnostic] = []
+        with _search_path(dirs):
+            records = pipeline.run_toolpath(source, m, diags, dialect=dialect or source.dialect)
+        return Toolpath(run(records), diags, source.file, dialect or source.dialect)
+    with _search_path(dirs):
+        ld = _load(source, dialect, stream=True, file=file)
+    m = _machine(machine, ld.dialect)
+    return Toolpath(run(pipeline.toolpath_of(ld, m)), ld.diagnostics, ld.label, ld.dialect,
+                    parsed=ld.program is not None)
+
+
+# --------------------------------------------------------------------------- lint
+
+def rule_filter(select: Iterable[str] = (), ignore: Iterable[str] = ()):  # type: ignore[no-untyped-def]
+    """A predicate keeping diagnostics whose rule code starts with one of `select` (all when empty)
+    and with none of `ignore`; entries may be comma-separated lists of prefixes (`"NC1,NC20"`)."""
+    sel = [p.strip().upper() for group in select for p in group.split(",") if p.strip()]
+    ign = [p.strip().upper() for group in ignore for p in group.split(",") if p.strip()]
+
+    def keep(d: Diagnostic) -> bool:
+        code = d.rule.upper()
+        if sel and not any(code.startswith(p) for p in sel):
+            return False
+        return not any(code.startswith(p) for p in ign)
+    return keep
+
+
+def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], dialect: Optional[str] = None,
+         machine: MachineLike = None, *, select: Iterable[str] = (), ignore: Iterable[str] = (),
+         search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
+         error_level: ErrorLevel = ErrorLevel.IGNORE) -> list[Diagnostic]:
+    """Diagnostics of program text, a file, a directory (recursed for NC file endings, as
+    `nctrans lint DIR`) or several paths, filtered by rule-code prefixes `select`/`ignore`."""
+    if isinstance(source, str) or isinstance(source, os.PathLike):
+        sources: list[Union[str, os.PathLike[str]]] = [source]
+    else:
+        sources = list(source)
+    keep = rule_filter(list(select), list(ignore))
+    out: list[Diagnostic] = []
+    with _search_path(search_path):
+        for s in sources:
+            if isinstance(s, os.PathLike) and os.path.isdir(s):
+                files: list[Union[str, os.PathLike[str]]] = [Path(f) for f in pipeline.iter_inputs([os.fspath(s)])]
+            else:
+                files = [s]
+            for f in files:
+                ld = _load(f, dialect, stream=True, file=file)
+                m = _machine(machine, ld.dialect)
+                out.extend(d for d in pipeline.lint(ld, m) if keep(d))
+    _raise_on_errors(out, error_level)
+    return out
+
+
+# --------------------------------------------------------------------------- equiv
+
+@dataclass
+class Equivalence:
+    """Whether two programs drive the same toolpath within `tol` mm. Truthy when they do;
+    otherwise `difference` says what differs first and where (file:line in each program)."""
+    equivalent: bool
+    tol: float
+    difference: Optional["Difference"] = None
+    records: tuple[int, int] = (0, 0)
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    def __bool__(self) -> bool:
+        return self.equivalent
+
+    @property
+    def message(self) -> str:
+        if self.difference is not None:
+            text: str = self.difference.format()
+            return text
+        if not self.equivalent:
+            return "an input did not parse"
+        return f"equivalent within {self.tol:g} mm ({self.records[0]} and {self.records[1]} toolpath records)"
+
+    def __repr__(self) -> str:
+        return f"<Equivalence {'yes' if self.equivalent else 'no'}: {self.message}>"
+
+
+def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[str] = None,
+          read_b: Optional[str] = None, machine: MachineLike = None,
+          search_path: Iterable[PathLike] = ()) -> Equivalence:
+    """Compare the toolpaths of two programs (text, paths or parsed Programs) within `tol` mm,
+    as `nctrans equiv` does."""
+    from nctrans import equivalence as _equivalence
+    if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not math.isfinite(tol) or tol <= 0:
+        raise NCInputError(f"tol must be a positive finite number of mm, not {tol!r}")
+    dirs = list(search_path)
+    ta = toolpath(a, read_a, machine, search_path=dirs, file="<a>")
+    tb = toolpath(b, read_b, machine, search_path=dirs, file="<b>")
+    ra, rb = list(ta), list(tb)
+    diags = ta.diagnostics + tb.diagnostics
+    if not (ta.parsed and tb.parsed):
+        return Equivalence(False, tol, None, (len(ra), len(rb)), diags)
+    diff = _equivalence.compare(ra, rb, tol)
+    return Equivalence(diff is None, tol, diff, (len(ra), len(rb)), diags)
+
+
