@@ -481,7 +481,7 @@ def test_detect_every_corpus_program_with_and_without_its_name():
 
 
 def test_detect_ignores_words_inside_iso_comments(monkeypatch):
-    from nctrans import detect as det
+    from nctrans import detection as det
     monkeypatch.setattr(det, "_sniff", lambda dialect, text: 0.0)     # the marker table alone
     detect = det.detect
     iso = "%\nO1000\n(T1 D=0.5 CR=0. - ZMIN=0. - MIRROR ENDIF)\n(X=10 R1=5 GOTOF)\nG0 X0 Y0\nM30\n%\n"

@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from nctrans import detect, pipeline
+from nctrans import detection as detect, pipeline
 from nctrans.dialects import base
 from nctrans.dialects.base import Dialect, Marker, ParseResult
 from nctrans.dialects.iso_m import IsoFamily, IsoMilling

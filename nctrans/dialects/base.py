@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+import sys
 import re
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -148,7 +149,8 @@ def _discover() -> None:
     if _discovered:
         return
     _discovered = True
-    import nctrans.dialects as pkg
+    # the package module itself: the attribute `nctrans.dialects` is the public API function
+    pkg = sys.modules[__package__]
     for info in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda i: i.name):
         if info.ispkg:
             importlib.import_module(f"{pkg.__name__}.{info.name}")
