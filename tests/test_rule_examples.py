@@ -12,14 +12,14 @@ from pathlib import Path
 
 import pytest
 
-from nctrans import catalogue, cli, detect
+from nctrans import catalogue, cli, pipeline
 
 CATALOGUE = catalogue.load()
 RULE_IN_OUTPUT = re.compile(r"\[(NC\d{3})\]")
 
 
 def _example_file(tmp: Path, rule: catalogue.Rule, text: str, encoding: str) -> Path:
-    ending = (getattr(detect, "EXTENSIONS", {}).get(rule.dialect) or (".nc",))[0]
+    ending = (pipeline.get_dialect(rule.dialect).extensions or (".nc",))[0] if rule.dialect else ".nc"
     for name, content in rule.example_files.items():
         (tmp / name).write_text(content, encoding="utf-8")
     path = tmp / f"example{ending}"
