@@ -56,8 +56,8 @@ class JsonChunk:
 
 class PlainRun:
     """Lines text[start:end) of a streamed ISO program: `blocks` plain blocks (blank lines between
-    them do not count), the first on line `line`. `lower(words, motion, cycle, arc_abs)` turns a line's
-    word list into the Block body the Python fast path would build (Lowering.plain_block), given
+    them do not count), the first on line `line`. `lower(code, motion, cycle, arc_abs)` turns a line's
+    code (blanks removed) into the Block body the Python fast path would build (Lowering.plain_line), given
     the front end's static motion mode, canned cycle and centre mode (G90.1), which were `motion`,
     `cycle`, `arc_abs` at `start`."""
     __slots__ = ("file", "text", "start", "end", "line", "sep", "blocks", "lower", "motion", "cycle",
@@ -79,7 +79,6 @@ class PlainRun:
 
     def take(self, count: int) -> tuple[list, Optional["PlainRun"]]:
         """The first `count` blocks as IR Blocks, and the rest of the run (None when none is left)."""
-        from nctrans.dialects.iso_m.fastpath import WORD
         from nctrans.ir.nodes import Block, Span
         text, sep, end, file, lower = self.text, self.sep, self.end, self.file, self.lower
         pos, line = self.start, self.line
@@ -94,7 +93,7 @@ class PlainRun:
             if code[-1:] == "\r":
                 code = code[:-1]
             if code:                                  # a blank line inside the run: no block
-                number, body, mode = lower(WORD.findall(code), motion, cycle, self.arc_abs)
+                number, body, mode = lower(code, motion, cycle, self.arc_abs)
                 if mode is not None:
                     motion, cycle = mode, None
                 out.append(Block(Span(file, line, 1, line, len(raw) + 1), body, number))

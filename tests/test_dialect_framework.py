@@ -86,3 +86,45 @@ def test_definition_files_and_streaming_are_declared_by_the_dialect():
     assert base.get("sinumerik").definition_files == (".def",) and not base.get("iso-m").definition_files
     assert base.get("iso-m").streams and not base.get("sinumerik").streams
     assert base.get("sinumerik").parse_stream("G0 X1\n") is None
+
+
+def test_an_iso_family_member_reuses_the_front_end_and_emitter_with_its_own_names():
+    """The way iso-t / fagor extend the family: subclasses of Lowering and IsoEmitter carrying the
+    member's name (and table), one handler overridden."""
+    from nctrans.dialects.iso_m.emitter import IsoEmitter
+    from nctrans.dialects.iso_m.frontend import B_NONMODAL, Lowering
+
+    class MemberLowering(Lowering):
+        dialect = "test-member"
+
+        def _m_end(self, b, rule, text):      # a member that keeps program ends verbatim
+            b.out.append((B_NONMODAL, self._pass(text, "end kept")))
+
+    class MemberEmitter(IsoEmitter):
+        dialect = "test-member"
+        target_text = "the member"
+
+    class Member(IsoFamily, register=False):
+        name = "test-member"
+        extensions = (".mem",)
+
+        def lowering(self):
+            return MemberLowering
+
+        def emitter(self):
+            return MemberEmitter
+
+    m = Member()
+    text = "%\nO0012\nG0 X1 Y2\nG1 X3 F100\nM30\n%\n"
+    parsed = m.parse(text, "p.mem")
+    assert parsed.program.dialect == "test-member" and not parsed.diagnostics
+    last = parsed.program.body[-1].body[0]
+    assert isinstance(last, n.Passthrough) and last.dialect == "test-member" and last.text == "M30"
+    assert base.get("iso-m").parse(text, "p.nc").program.body[-1].body[0].__class__ is n.ProgramEnd
+    streamed = m.parse_stream("G0 X1\nG1 X2 F10\n", "s.mem")
+    assert streamed.program.dialect == "test-member"
+    blocks = [b for item in streamed.program.body
+              for b in (item.expand() if hasattr(item, "expand") else [item])]
+    assert [type(s).__name__ for b in blocks for s in b.body][-1] == "Motion"
+    out = m.emit(parsed.program)
+    assert "M30" in out.text and out.text.startswith("%")    # its own passthrough is written back

@@ -74,11 +74,36 @@ _PROGRAM_NUMBER = re.compile(r"^[Oo]?0*(\d+)$")
 
 class IsoFamily(Dialect):
     """ISO-style (Fanuc-like) dialects: word-address blocks, `( )` comments, macro B variables,
-    O-numbered subprograms. Not registered itself (it has no name); subclasses set name, endings
-    and table and override what differs."""
+    O-numbered subprograms. Not registered itself (it has no name). A member sets name, endings and
+    `table`, and returns its own front-end and emitter classes from `lowering()` / `emitter()`:
+    subclasses of frontend.Lowering and emitter.IsoEmitter with the same table and the handlers
+    that differ overridden."""
     markers = ISO_MARKERS
     comment_evidence = {"paren_comment": (1.0, 3)}
     subprogram_endings = (".nc", ".NC", ".tap", ".TAP", ".ngc", ".cnc", ".iso", ".eia", ".txt")
+    streams = True
+
+    def lowering(self):
+        """The front end's Lowering class (imported here so that registering stays light)."""
+        from .frontend import Lowering
+        return Lowering
+
+    def emitter(self):
+        """The emitter class (an IsoEmitter)."""
+        from .emitter import IsoEmitter
+        return IsoEmitter
+
+    def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
+        from .frontend import parse_program
+        return parse_program(text, file, self.lowering())
+
+    def parse_stream(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        from .frontend import parse_stream
+        return parse_stream(text, file, self.lowering())
+
+    def emit(self, program) -> EmitResult:
+        from .emitter import emit_program
+        return emit_program(program, self.emitter())
 
     def sniff(self, text: str) -> float:
         return sniff(text)
@@ -96,14 +121,3 @@ class IsoMilling(IsoFamily):
     name = "iso-m"
     description = "ISO / Fanuc-style milling with custom macro B"
     extensions = (".nc", ".tap", ".cnc", ".iso", ".eia", ".ngc")
-    streams = True
-
-    def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
-        return parse(text, file)
-
-    def parse_stream(self, text: str, file: str = "<stdin>") -> ParseResult | None:
-        from .frontend import parse_stream
-        return parse_stream(text, file)
-
-    def emit(self, program) -> EmitResult:
-        return emit(program)

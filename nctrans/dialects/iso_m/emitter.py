@@ -67,7 +67,7 @@ def format_number(v: float, point: bool = False) -> str:
     return text
 
 
-def format_expr(e: Any, ctx: Optional["_Emitter"] = None) -> str:
+def format_expr(e: Any, ctx: Optional["IsoEmitter"] = None) -> str:
     """An IR expression in macro B syntax (brackets only where precedence needs them)."""
     return _expr(e, ctx)[0]
 
@@ -158,10 +158,17 @@ class _Lines(list):
     """Words a statement writes on lines of their own (one list of words per line)."""
 
 
-class _Emitter:
+class IsoEmitter:
+    """IR -> text for a dialect of the ISO family. dialect: the name of programs (and passthrough
+    text) that are already this dialect's own; table: the rules table G/M codes are spelled from.
+    ISO-family dialects subclass it with their names and override what they spell differently."""
+    dialect = "iso-m"
+    table_name = "iso-m"
+    target_text = "ISO milling"          # NC402 wording: "<target_text> cannot express ..."
+
     def __init__(self, program: n.Program):
         self.program = program
-        self.table = load_table("iso-m")
+        self.table = load_table(self.table_name)
         self.diags: list[Diagnostic] = []
         self.out: list[str] = []
         self.span = None
@@ -202,7 +209,7 @@ class _Emitter:
     def refuse(self, what: str) -> None:
         line = self.span.line if self.span is not None else 1
         self.diags.append(at_span("NC402", "error",
-                                  f"ISO milling cannot express {what} (source line {line})", self._where()))
+                                  f"{self.target_text} cannot express {what} (source line {line})", self._where()))
 
     def forget(self) -> None:
         """A place reached from elsewhere (jump target, structure, call): positions and the
@@ -282,13 +289,13 @@ class _Emitter:
             self._collect_numbers(sub.body)
         self._plan()
         meta = p.meta or {}
-        percent = meta.get("percent", True) if p.dialect == "iso-m" else True
+        percent = meta.get("percent", True) if p.dialect == self.dialect else True
         if percent:
             self.out.append("%")
         if meta.get("archive_header"):
             self.out.append(str(meta["archive_header"]))
         head = self._program_word(p.name, meta.get("program_number"))
-        if self.sub_numbers and (head is None or p.dialect != "iso-m"):
+        if self.sub_numbers and (head is None or p.dialect != self.dialect):
             # an O block after a headless main program would be read as the main program's number
             head = f"O{pl.stable_number('MAIN ' + (p.name or ''), set(self.sub_numbers.values()))}"
             self.lowered(f"main program numbered {head} (its subprograms follow as O blocks)")
@@ -331,7 +338,7 @@ class _Emitter:
         for key, sub in p.subprograms.items():
             self.plans[key] = pl.unit_plan(sub, sub.body, self.fresh_label)
             self.targets[key] = pl.jump_targets(sub.body)
-        if p.dialect == "iso-m":
+        if p.dialect == self.dialect:
             return
         taken = {pl.iso_number(k) for k in p.subprograms if pl.iso_number(k) is not None}
         for key in p.subprograms:
@@ -895,7 +902,7 @@ class _Emitter:
     def w_SubCall(self, s: n.SubCall):
         self.forget()
         callee = None
-        if self.program.dialect != "iso-m" and s.name and pl.iso_number(s.name) is None:
+        if self.program.dialect != self.dialect and s.name and pl.iso_number(s.name) is None:
             callee = self._callee(s.name)
             if callee is None:
                 raise NotExpressible(f"a call of {s.name!r}: it is not in this program, so it has no "
@@ -1042,7 +1049,7 @@ class _Emitter:
 
     def w_Passthrough(self, s: n.Passthrough):
         self.forget()
-        if s.dialect not in ("", "iso-m"):
+        if s.dialect not in ("", self.dialect):
             raise NotExpressible(f"{s.dialect} text {s.text!r}")
         return [("", s.text)]
 
@@ -1086,8 +1093,8 @@ def _ms_text(seconds: float) -> Optional[str]:
     return None
 
 
-def emit_program(program: n.Program):
+def emit_program(program: n.Program, emitter: type[IsoEmitter] = IsoEmitter):
     from nctrans.dialects.base import EmitResult
-    em = _Emitter(program)
+    em = emitter(program)
     text = em.run()
     return EmitResult(text, em.diags)

@@ -4,8 +4,10 @@ Per line: pre-lexer (prelex.py: comments, cleaning) -> word list (fastpath.py fo
 the lark grammar of record otherwise; words.py) -> lowering (this module) -> IR nodes, then the
 structure pass nests WHILE/DO..END bodies and files O-subprograms under Program.subprograms.
 
-The lowering looks every G/M code up in rules/iso-m.toml and dispatches on its (group, value)
-through small handler tables; the context-dependent addresses (R P Q K L I J K) get their meaning
+The lowering looks every G/M code up in its dialect's rules table (rules/iso-m.toml for ISO
+milling) and dispatches on its (group, value) through small handler tables, so every dialect of the
+ISO family (nctrans.dialects.iso_m.IsoFamily) shares it: a subclass of `Lowering` with its own
+`dialect` and `table` names, and handlers overridden where the family members differ; the context-dependent addresses (R P Q K L I J K) get their meaning
 from the static modal state tracked in source order (canned-cycle mode, motion mode), as a Fanuc
 block classifier does (spec §2.5 step 3). Statements are ordered as rs274ngc executes them.
 """
@@ -123,10 +125,17 @@ class _Blk:
 
 
 class Lowering:
-    """Word lists -> IR nodes for one file, tracking the static modal state in source order."""
+    """Word lists -> IR nodes for one file, tracking the static modal state in source order.
+
+    dialect: the name the IR is tagged with (Program.dialect, Passthrough.dialect); table: the
+    rules table it reads (rules/<table>.toml). An ISO-family dialect subclasses this with its own
+    names and overrides the handler methods that differ (the tables below map to bound methods)."""
+    dialect = DIALECT
+    table_name = DIALECT
+    code_kind = "an ISO milling code"       # NC403 wording for an unknown G code
 
     def __init__(self, file: str, diags: list[Diagnostic]):
-        self.table = load_table(DIALECT)
+        self.table = load_table(self.table_name)
         opts = self.table.options
         self.file = file
         self.diags = diags
@@ -191,7 +200,7 @@ class Lowering:
         self.diags.append(Diagnostic(rule, severity, message, self.file, line, col))
 
     def _pass(self, text: str, reason: str) -> Passthrough:
-        return Passthrough(text, reason, DIALECT)
+        return Passthrough(text, reason, self.dialect)
 
     def num(self, letter: str, v: Any):
         """A word value as an expression; applies standard decimal notation when the profile asks."""
@@ -519,6 +528,11 @@ class Lowering:
             body.append(Motion(target, center or None))
         return number, body, None if mode is None else mode.value
 
+    def plain_line(self, code: str, motion: Optional[str], cycle: Optional[str], arc_abs: bool
+                   ) -> Optional[tuple]:
+        """plain_block of one line of code (blanks removed): how plainrun.PlainRun expands its lines."""
+        return self.plain_block(WORD.findall(code), motion, cycle, arc_abs)
+
     def lower(self, items: list, line: int) -> tuple[Optional[str], list, list, Optional[str]]:
         """Lower one block's word list. Returns (number, body, structure items, unknown G)."""
         number = None
@@ -753,24 +767,25 @@ def _unbalanced(code: str) -> Optional[int]:
     return opens[0] if opens else None
 
 
-def parse_program(text: str, file: str = "<stdin>"):
-    """Parse ISO text. The cyclic garbage collector is paused while the IR is built: the parse
-    allocates ~10 objects per block and none of them form cycles, so collections are pure cost."""
+def parse_program(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lowering):
+    """Parse ISO text (with the `lowering` of the family member: see Lowering). The cyclic garbage
+    collector is paused while the IR is built: the parse allocates ~10 objects per block and none
+    of them form cycles, so collections are pure cost."""
     gc_was_enabled = gc.isenabled()
     gc.disable()
     try:
-        return _parse_program(text, file)
+        return _parse_program(text, file, lowering)
     finally:
         if gc_was_enabled:
             gc.enable()
 
 
-def _parse_program(text: str, file: str):
+def _parse_program(text: str, file: str, lowering: type[Lowering]):
     from nctrans.dialects.base import ParseResult
 
     diags: list[Diagnostic] = []
-    program = Program(file, DIALECT, [], {}, {}, None)
-    for _ in _parse_lines(text, file, program, diags, program.body, False):
+    program = Program(file, lowering.dialect, [], {}, {}, None)
+    for _ in _parse_lines(text, file, program, diags, program.body, False, lowering):
         pass
     return ParseResult(program, diags)
 
@@ -823,7 +838,7 @@ class StreamedBody:
             pass
 
 
-def parse_stream(text: str, file: str = "<stdin>"):
+def parse_stream(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lowering):
     """Lazy parse for programs whose main body runs straight through (the common CAM output): a
     ParseResult whose Program.body is a StreamedBody and whose diagnostics list fills as the body
     is iterated (complete once it is drained). None when the text has control flow, a macro
@@ -832,11 +847,11 @@ def parse_stream(text: str, file: str = "<stdin>"):
     from nctrans.dialects.base import ParseResult
 
     diags: list[Diagnostic] = []
-    program = Program(file, DIALECT, [], {}, {}, None)
-    opts = load_table(DIALECT).options
+    program = Program(file, lowering.dialect, [], {}, {}, None)
+    opts = load_table(lowering.table_name).options
     if _control_flow_at(text, opts.get("eob_semicolon", "comment") != "eob") is not None:
         return None
-    program.body = StreamedBody(_parse_lines(text, file, program, diags, [], True))
+    program.body = StreamedBody(_parse_lines(text, file, program, diags, [], True, lowering))
     return ParseResult(program, diags)
 
 
@@ -870,10 +885,11 @@ class _Lines:
         self.lineno += lines - 1
 
 
-def _parse_lines(text: str, file: str, program: Program, diags: list, main: list, stream: bool):
+def _parse_lines(text: str, file: str, program: Program, diags: list, main: list, stream: bool,
+                 lowering: type[Lowering] = Lowering):
     """The parse proper. Fills program.meta/name/subprograms and `main`; with `stream` the blocks
     of the main body are yielded (and dropped from `main`) line by line instead."""
-    low = Lowering(file, diags)
+    low = lowering(file, diags)
     opts = low.table.options
     semicolon_comment = opts.get("eob_semicolon", "comment") != "eob"
     meta: dict = program.meta
@@ -896,7 +912,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     # Streamed and with the native kernel: runs of plain lines become one PlainRun each.
     plain_scan = plainrun.native.scan if stream and plainrun.native is not None and not low.standard \
         else None
-    plain_block = low.plain_block
+    plain_line = low.plain_line
     fast_plain = PLAIN.fullmatch
     fast_words = WORD.findall
     lower = low.lower
@@ -925,7 +941,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                                                       low.cycle is None, low.arc_abs)
             if nblocks >= PLAIN_RUN_MIN:
                 cur.append(plainrun.PlainRun(file, text, lines.start, end, lineno, sep, nblocks,
-                                             plain_block, low.motion, low.cycle, low.arc_abs))
+                                             plain_line, low.motion, low.cycle, low.arc_abs))
                 lines.skip_to(end, nlines)
                 if motion >= 0:
                     low.motion = PLAIN_MOTIONS[motion]
@@ -987,7 +1003,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                     continue
                 low.warn_once("directive", "NC403", "warning",
                               "controller/simulator directive kept verbatim", lineno)
-                cur.append(Block(span, [Passthrough(raw.strip(), "directive", DIALECT)]))
+                cur.append(Block(span, [Passthrough(raw.strip(), "directive", low.dialect)]))
                 seen_block = True
                 continue
             if c0 in "O:" and not code.startswith("OR"):
@@ -1135,11 +1151,11 @@ def _passthrough_block(raw: str, span: Span, skip, unknown: Optional[str], low: 
     text = raw[m.end():].strip()
     if unknown is not None:
         low.warn_once(unknown, "NC403", "warning",
-                      f"{unknown} is not an ISO milling code nctrans knows; the block is kept verbatim", line)
+                      f"{unknown} is not {low.code_kind} nctrans knows; the block is kept verbatim", line)
         reason = f"unknown code {unknown}"
     else:
         reason = "syntax error"
-    return Block(span, [Passthrough(text, reason, DIALECT)] if text else [], number, None, skip)
+    return Block(span, [Passthrough(text, reason, low.dialect)] if text else [], number, None, skip)
 
 
 def _split_skips(code: str) -> list:
