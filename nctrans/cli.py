@@ -313,7 +313,7 @@ def cmd_toolpath(args) -> int:
         writer(records, out)
         out.flush()
         _print_text_diags(ld.diagnostics, sys.stderr)
-    return EXIT_DIAGNOSTICS if _at_or_above(ld.diagnostics, "error") else EXIT_OK
+    return EXIT_DIAGNOSTICS if _at_or_above(ld.diagnostics, args.fail_on) else EXIT_OK
 
 
 # --------------------------------------------------------------------------- equiv
@@ -436,6 +436,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("jsonl", "csv"), default="jsonl")
     p.add_argument("--summary", action="store_true",
                    help="print a short summary (counts, lengths, bounding box, tools, cycle time) instead")
+    p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error",
+                   help="exit 1 when a diagnostic at or above this severity was reported")
     _add_search_path(p)
     p.set_defaults(func=cmd_toolpath)
 

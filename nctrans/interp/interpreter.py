@@ -38,7 +38,9 @@ from nctrans.interp.evaluate import (UNKNOWN, EvalError, Evaluator, FrameValue, 
                                      constant)
 from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.state import LINEAR_AXES, ModalState
+from nctrans.interp import unmodelled
 from nctrans.ir import nodes as n
+from nctrans.ir.vocabulary import UNMODELLED_MODES
 from nctrans import plainrun
 from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
@@ -187,6 +189,9 @@ class Interpreter:
         self.cycle_params: dict[str, float] = {}
         self.cycle_initial: Optional[float] = None
         self.modal_cycle = None         # CycleCall with modal=True
+        self.pole: Optional[tuple[float, float]] = None   # polar pole in the plane (program coords)
+        self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
+        self._unmodelled_at = None                          # the span of the block that set it
         self.stack: list[Frame] = []
         self.span: Optional[n.Span] = None
         self._register_system()
@@ -299,6 +304,9 @@ class Interpreter:
         for s in block.body:
             c = comp.get(type(s))
             if c is not None:
+                if type(s) is n.Passthrough and unmodelled.takes_motion(s):
+                    out.insert(0, c(s))      # it owns the block's axis words: before the motion
+                    continue
                 out.append(c(s))
             t = type(s)
             if (t is n.ModeChange and s.group == "motion" and s.value in ("rapid", "linear")) or \
@@ -362,6 +370,8 @@ class Interpreter:
             n.Assign: self._c_assign, n.VarDecl: lambda s: (self._h_decl, s),
             n.Goto: self._c_goto, n.Alarm: lambda s: (self._h_alarm, s),
             n.DataSetting: lambda s: (self._h_data, s),
+            n.PolarPole: lambda s: (self._h_pole, s),
+            n.Passthrough: self._c_passthrough,
         }
 
     # ================================================================ helpers
@@ -576,7 +586,9 @@ class Interpreter:
             if st.cycle != "off":
                 self._cycle_off()
             st.set(g, v)
+            self.unmodelled_motion = None
         elif g == "cycle":
+            self.unmodelled_motion = None
             if v == "off":
                 self._cycle_off()
             else:
@@ -610,6 +622,9 @@ class Interpreter:
             st.set(g, v)
         else:
             st.set(g, v)
+        left_out = UNMODELLED_MODES.get((g, v))
+        if left_out is not None:
+            self.diag("NC220", "warning", f"{s.code or g + '=' + v} is not modelled ({left_out})")
 
     def _cycle_off(self) -> None:
         self.st.set("cycle", "off")
@@ -868,7 +883,8 @@ class Interpreter:
         words = d[0]
         st = self.st
         if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
-                or self.comp_exit or st.comp_side != "off" or not self.frame.identity):
+                or self.comp_exit or st.comp_side != "off" or not self.frame.identity
+                or self.unmodelled_motion is not None):
             return self._slow(d)
         motion = st.motion
         if motion == "rapid":
@@ -916,6 +932,12 @@ class Interpreter:
     def _h_motion(self, d):
         words, center, radius, turns, machine, polar, via, aperture = d
         st = self.st
+        if self.unmodelled_motion is not None:
+            if self._unmodelled_at is self.span:
+                return                  # the code's own block: reported with the code
+            self.diag("NC220", "warning", f"motion under {self.unmodelled_motion} is not modelled: "
+                      "this block's axis words move nothing in the analysed toolpath")
+            return
         self.moved = True
         vals = self._eval_words(words)
         if polar:
@@ -965,13 +987,15 @@ class Interpreter:
             self.diag("NC202", "error", "feed move with no feed rate programmed")
 
     def _polar(self, vals, polar):
-        """Polar words (radius, angle in the active plane about program zero)."""
+        """Polar words (radius, angle in the active plane about the pole: program zero until
+        G110/G111/G112 sets one). A word left out keeps its value from the current point."""
         a1, a2, _ = PLANE_AXES[self.st.plane]
         r = self._value(polar["radius"], "polar radius") if "radius" in polar else None
         ang = self._value(polar["angle"], "polar angle") if "angle" in polar else None
         if r is None and ang is None:
             return vals
-        p1, p2 = self.pos.get(a1, 0.0), self.pos.get(a2, 0.0)
+        c1, c2 = self.pole or (0.0, 0.0)
+        p1, p2 = self.pos.get(a1, 0.0) - c1, self.pos.get(a2, 0.0) - c2
         if r is None:
             r = math.hypot(p1, p2)
         else:
@@ -979,8 +1003,55 @@ class Interpreter:
         if ang is None:
             ang = math.degrees(math.atan2(p2, p1))
         rest = [w for w in vals if w[0] not in (a1, a2)]
-        return rest + [(a1, r * math.cos(math.radians(ang)), "abs"),
-                       (a2, r * math.sin(math.radians(ang)), "abs")]
+        return rest + [(a1, c1 + r * math.cos(math.radians(ang)), "abs"),
+                       (a2, c2 + r * math.sin(math.radians(ang)), "abs")]
+
+    def _c_passthrough(self, s: n.Passthrough):
+        if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")):
+            return (self._h_known, None)
+        return (self._h_unmodelled, (s, unmodelled.takes_motion(s)))
+
+    @staticmethod
+    def _h_known(_):
+        """A construct known to have no effect on the programmed path."""
+
+    def _h_unmodelled(self, d):
+        s, code = d
+        what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
+        if code is not None:
+            self.unmodelled_motion = code
+            self._unmodelled_at = self.span
+            self.diag("NC220", "warning", f"{what} is not modelled: its axis words, and those of "
+                      "the blocks after it until the next motion code, move nothing in the analysed "
+                      "toolpath")
+        else:
+            self.diag("NC220", "warning", f"{what} is not modelled: the analysed toolpath leaves "
+                      "it out")
+
+    def _h_pole(self, s: n.PolarPole) -> None:
+        """G110/G111/G112: the pole relative to the last programmed point, the workpiece zero or
+        the last pole, whatever G90/G91 (spec 9.2); given by plane axis words or by polar words
+        about that point. Nothing moves."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        if s.relative_to == "last_point":
+            ref = (self.pos.get(a1, 0.0), self.pos.get(a2, 0.0))
+        elif s.relative_to == "pole":
+            ref = self.pole or (0.0, 0.0)
+        else:
+            ref = (0.0, 0.0)
+        if s.polar:
+            polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
+            r = self._value(polar["radius"], "pole radius") if "radius" in polar else None
+            ang = self._value(polar["angle"], "pole angle") if "angle" in polar else None
+            r = (r or 0.0) * self.st.scale
+            ang = math.radians(ang or 0.0)
+            self.pole = (ref[0] + r * math.cos(ang), ref[1] + r * math.sin(ang))
+            return
+        d = {a1: 0.0, a2: 0.0}
+        for axis, v, _ in self._eval_words(self._words(s.target)):
+            if axis in d:
+                d[axis] = v
+        self.pole = (ref[0] + d[a1], ref[1] + d[a2])
 
     def _machine_move(self, vals) -> None:
         """G53: the words are machine coordinates of the controlled point, this block only."""
@@ -1699,7 +1770,8 @@ class Interpreter:
         if (self.fast_sink is None or st.cycle != "off" or self.modal_cycle is not None
                 or self.comp is not None or self.comp_exit or st.comp_side != "off"
                 or not self.frame.identity or self.modal_call is not None or self.hook is not None
-                or st.feed_mode not in ("per_min", "per_rev") or self.out):
+                or st.feed_mode not in ("per_min", "per_rev") or self.out
+                or self.unmodelled_motion is not None):
             return False
         axes = "".join(self.pos)
         return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)

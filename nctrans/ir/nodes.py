@@ -348,6 +348,19 @@ class DataSetting:
 
 
 @node
+class PolarPole:
+    """Sets the pole of polar motion words (Motion.polar) in the active plane (Sinumerik
+    G110/G111/G112). relative_to: "last_point" (the last programmed point, G110), "zero" (the
+    workpiece zero, G111) or "pole" (the last pole, G112); target: the pole's plane coordinates
+    relative to that point (an axis left out counts 0); polar: the pole given itself in polar
+    words (angle, radius) about that point. code: how the source spelled it, for emitters."""
+    relative_to: str
+    target: dict[str, AxisValue] = field(default_factory=dict)
+    polar: Optional[dict[str, Expr]] = None
+    code: str = ""
+
+
+@node
 class Passthrough:
     """A valid construct the IR has no concept for: kept verbatim (never dropped) with why."""
     text: str
@@ -359,7 +372,7 @@ Statement = Union[
     ModeChange, Motion, Feed, SpindleSpeed, ToolSelect, ToolChange, OffsetSelect, Dwell,
     SetPosition, ResetSetPosition, FrameOp, HomeReturn, CycleParams, CycleCall, SubCall,
     ModalCallOff, Return, ProgramEnd, Stop, Assign, VarDecl, Goto, Message, Alarm, Passthrough,
-    DataSetting,
+    DataSetting, PolarPole,
 ]
 
 

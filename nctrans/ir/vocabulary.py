@@ -46,3 +46,21 @@ VAR_SPACES = ("num", "R", "name", "system", "arg")
 # CycleCall kinds beyond the "cycle" modal values: hole patterns that run the modal cycle at each
 # position (Sinumerik HOLES1/HOLES2, parameters in rules/cycles.toml [[pattern]]).
 CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle", "swivel_plane")
+
+# Passthrough reasons for constructs known to have no effect on the programmed path (front ends
+# give these; nctrans.interp.unmodelled and --flatten pass over them without a warning). A reason
+# starting with NO_EFFECT_PREFIX is such a construct too; one starting with MILL_ONLY only on a mill.
+NO_MOTION_EFFECT = frozenset((
+    "ISO dialect mode", "Siemens mode", "directive", "preprocessing stop", "data attribute",
+    "macro definition", "declaration", "feedforward", "program attribute",
+))
+NO_EFFECT_PREFIX = "no motion effect"
+MILL_ONLY = "no motion effect on a mill"
+
+# Modal values the interpreter records but does not model: selecting one is reported (NC220) with
+# what it leaves out. A value leaves this table when the interpreter models it.
+UNMODELLED_MODES: dict[tuple[str, str], str] = {
+    ("polar", "on"): "polar coordinate mode: axis words are read as Cartesian coordinates",
+    ("spindle_mode", "css"): "constant surface speed: spindle speeds are the programmed S values",
+    ("diameter", "diameter"): "diameter programming: X words are read as radius values",
+}

@@ -43,6 +43,7 @@ from typing import Any, Callable, Optional
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
+from nctrans.interp.unmodelled import no_motion_effect
 from nctrans.ir import nodes as n
 from nctrans.toolpath import ToolpathRecord
 
@@ -52,11 +53,6 @@ ISO_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
 CENTRE_WORD = {"X": "I", "Y": "J", "Z": "K"}
 STRUCTURE = (n.If, n.While, n.ForLoop, n.Loop, n.RepeatUntil, n.Case)
 
-# Passthrough reasons (front ends' words) for constructs with no effect on the programmed path
-NO_MOTION_EFFECT = frozenset((
-    "ISO dialect mode", "Siemens mode", "directive", "preprocessing stop", "data attribute",
-    "macro definition", "declaration", "feedforward", "program attribute",
-))
 _M_FUNCTION = re.compile(r"^\s*(?:M\d+(?:\.\d+)?(?:\s*=\s*\d+)?\s*)+$", re.IGNORECASE)
 
 # kinds of lowering: key -> message (one NC401 each, at the first source line where it applies)
@@ -104,8 +100,9 @@ def _has_expr(obj: Any) -> bool:
 class _Walker:
     """Static scan of the source for the lowerings flattening applies and for dropped constructs."""
 
-    def __init__(self, diags: list[Diagnostic]):
+    def __init__(self, diags: list[Diagnostic], machine_kind: str = "mill"):
         self.diags = diags
+        self.machine_kind = machine_kind
         self.first: dict[str, n.Span] = {}
         self.dropped: set = set()
         self.seen_programs: set[int] = set()
@@ -150,7 +147,8 @@ class _Walker:
         elif t is n.CycleCall or t is n.CycleParams or (t is n.ModeChange and s.group == "cycle"
                                                          and s.value != "off"):
             self.note("cycle", span)
-        elif t in (n.FrameOp, n.SetPosition, n.ResetSetPosition, n.DataSetting, n.HomeReturn):
+        elif t in (n.FrameOp, n.SetPosition, n.ResetSetPosition, n.DataSetting, n.HomeReturn,
+                   n.PolarPole):
             self.note("frame", span)
         elif t is n.Assign or t is n.VarDecl:
             self.note("expr", span)
@@ -181,7 +179,7 @@ class _Walker:
             return
         self.dropped.add(key)
         what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
-        if s.reason in NO_MOTION_EFFECT:
+        if no_motion_effect(s.reason, self.machine_kind):
             self.diags.append(at_span("NC401", "info", f"--flatten leaves out {what}: no effect on "
                                       "the motion", span))
         elif _M_FUNCTION.match(s.text):
@@ -407,7 +405,7 @@ def flatten(program: n.Program, machine=None, *, diagnostics: list,
     if machine is None:
         from nctrans.machine import default_mill
         machine = default_mill()
-    walker = _Walker(diagnostics)
+    walker = _Walker(diagnostics, getattr(machine, "kind", "mill"))
     walker.program(program)
 
     wrapped = None

@@ -1047,6 +1047,10 @@ class IsoEmitter:
         return _Lines([[("#", f"#{base + i}={format_expr(init[i] if i < len(init) else n.Num(0.0), self)}")]
                        for i in range(size)])
 
+    def w_PolarPole(self, s: n.PolarPole):
+        raise NotExpressible(f"a polar pole ({s.code or 'G111'}): ISO polar coordinates turn about "
+                             "the work zero")
+
     def w_Passthrough(self, s: n.Passthrough):
         self.forget()
         if s.dialect not in ("", self.dialect):

@@ -351,6 +351,13 @@ class Emitter:
         elif isinstance(s, ir.Alarm):
             extra = f", {self.expr(s.text)}" if s.text is not None else ""
             out.words.append(f"SETAL({self.expr(s.number)}{extra})")
+        elif isinstance(s, ir.PolarPole):
+            code = self.t.code_for("pole", s.relative_to)
+            ws = [self.axis(a, v) for a, v in s.target.items()]
+            if s.polar:
+                ws += [f"{k}={self.expr(s.polar[key])}" for k, key in (("AP", "angle"), ("RP", "radius"))
+                       if key in s.polar]
+            out.alone(" ".join([code.code if code else "G111", *ws]))
         elif isinstance(s, ir.Passthrough):
             if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
                 out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)

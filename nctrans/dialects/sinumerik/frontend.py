@@ -30,7 +30,7 @@ from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import ParseResult
 from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
 from nctrans.ir import nodes as ir
-from nctrans.ir.vocabulary import MODAL_GROUPS
+from nctrans.ir.vocabulary import MILL_ONLY, MODAL_GROUPS, NO_EFFECT_PREFIX
 from nctrans.rules import load_table, normalise_code
 
 GRAMMAR = resources.path("grammars", "sinumerik.lark")
@@ -255,8 +255,11 @@ def func(name: str, args: list) -> ir.Expr:
 _ORDER = {"Assign": 0, "VarDecl": 0, "ModeChange": 1, "Feed": 2, "SpindleSpeed": 2,
           "ToolSelect": 2, "OffsetSelect": 2, "ToolChange": 3, "Message": 5, "Alarm": 5,
           "Passthrough": 5, "FrameOp": 5, "HomeReturn": 5, "Dwell": 6, "Motion": 6, "CycleCall": 6,
-          "CycleParams": 6, "SubCall": 7, "ModalCallOff": 7, "Stop": 8, "ProgramEnd": 8,
+          "CycleParams": 6, "PolarPole": 5, "SubCall": 7, "ModalCallOff": 7, "Stop": 8, "ProgramEnd": 8,
           "Return": 8, "Goto": 8}
+
+
+_LEADING = re.compile(r"\s*([A-Za-z_][A-Za-z_0-9]*)")
 
 
 def _t(text) -> str:
@@ -309,6 +312,7 @@ class _Words:
     home: Optional[str] = None          # G74 / G75
     fixed_point: Optional[ir.Expr] = None
     frame: Optional[str] = None
+    pole: Optional[tuple[str, str]] = None   # G110/G111/G112: (relative_to, code)
 
 
 class Lowerer:
@@ -327,6 +331,9 @@ class Lowerer:
         self.commands = t.options.get("machine_commands", {})
         self.whole_block = set(t.options.get("whole_block_commands", []))
         self.unsupported = t.options.get("unsupported_functions", {})
+        known = t.options.get("no_motion_effect", {})
+        self.no_effect = {w: NO_EFFECT_PREFIX for w in known.get("words", ())}
+        self.no_effect.update({w: MILL_ONLY for w in known.get("mill_only", ())})
 
     # ---- diagnostics
     def error(self, rule: str, msg: str, line: int, col: int, end_col: int = 0) -> None:
@@ -363,6 +370,8 @@ class Lowerer:
             w.frame = rule.value
         elif g == "home":
             w.home = rule.code
+        elif g == "pole":
+            w.pole = (rule.value, rule.code)
         else:
             w.out.append(ir.Passthrough(_t(text), g, DIALECT))
 
@@ -604,6 +613,14 @@ class Lowerer:
             self.frame_op(w)
         if w.home:
             self.home(w)
+        elif w.fixed_point is not None:
+            w.out.append(ir.Passthrough("FP=" + _expr_text(w.fixed_point), "fixed point without G75",
+                                        DIALECT))
+        if w.pole:
+            # the block's axis / polar words place the pole; it moves nothing (spec 9.2)
+            w.out.append(ir.PolarPole(w.pole[0], dict(w.target), dict(w.polar) or None, w.pole[1]))
+            w.target.clear()
+            w.polar.clear()
         if w.dwell:
             secs = w.feed
             revs = w.speed[0][1] if w.speed else None
@@ -625,6 +642,12 @@ class Lowerer:
                 calls[-1].repeat = w.repeat
             else:
                 w.out.append(ir.Passthrough(f"P{w.repeat.text}", "address P", DIALECT))
+        for st in w.out:
+            if type(st) is ir.Passthrough and self.no_effect:
+                m = _LEADING.match(st.text)
+                mark = self.no_effect.get(m.group(1).upper()) if m else None
+                if mark and not st.reason.startswith(NO_EFFECT_PREFIX):
+                    st.reason = f"{mark} ({st.reason})" if st.reason else mark
         return sorted(w.out, key=_priority)
 
     def vardecls(self, st: Tree) -> list:

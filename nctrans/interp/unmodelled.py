@@ -1,0 +1,67 @@
+"""What the interpreter does with a construct it does not model (an IR Passthrough).
+
+The rule (issue 8): a word, G/M code or function the interpreter does not model never moves the
+tool, and toolpath, lint and check always say so: NC220 (warning) naming the construct at its line.
+Two kinds of Passthrough are exempt, both decided by data, not code:
+- constructs known to have no effect on the programmed path (set-up, HMI, machine-data and
+  preprocessing words): their front end gives them a reason in NO_MOTION_EFFECT, or a reason that
+  starts with "no motion effect" (words listed in `[options.no_motion_effect]` of a rules table);
+  reasons starting with MILL_ONLY have no effect on a mill only (Sinumerik DIAM90 on a mill);
+- nothing else: an unknown M function is reported like any other word.
+An unmodelled code that takes over the block's motion (a thread, a tapping or a soft-approach G
+code: `[options.unmodelled_motion] codes` of the rules table, plus every code of motion group 1 the table
+marks "passthrough") makes the block's axis words and the following blocks' until the next
+modelled motion code move nothing, with NC220 naming the code.
+"""
+from __future__ import annotations
+
+import re
+from functools import lru_cache
+from typing import Optional
+
+from nctrans.ir import nodes as n
+from nctrans.ir.vocabulary import MILL_ONLY, NO_EFFECT_PREFIX, NO_MOTION_EFFECT
+_CODE = re.compile(r"\s*([A-Za-z_$][A-Za-z_0-9.]*)")
+
+
+def no_motion_effect(reason: str, machine_kind: str = "mill") -> bool:
+    """True when a Passthrough with this reason changes nothing on the toolpath of this machine."""
+    if reason in NO_MOTION_EFFECT:
+        return True
+    if reason.startswith(MILL_ONLY):
+        return machine_kind == "mill"
+    return reason.startswith(NO_EFFECT_PREFIX)
+
+
+def leading_word(text: str) -> str:
+    """The construct's name as written first in its text (G34, TRAORI, CHF), upper case."""
+    m = _CODE.match(text)
+    if not m:
+        return text.strip()[:16]
+    w = m.group(1).upper()
+    g = re.match(r"^([GM])0*(\d+(?:\.\d+)?)$", w)
+    return f"{g.group(1)}{g.group(2)}" if g else w
+
+
+@lru_cache(maxsize=None)
+def motion_codes(dialect: str) -> frozenset[str]:
+    """Codes of `dialect` that take over the block's motion when the interpreter does not model
+    them: the table's `unmodelled_motion` list plus its motion-group codes kept as passthrough."""
+    if not dialect:
+        return frozenset()
+    try:
+        from nctrans.rules import load_table
+        t = load_table(dialect)
+    except Exception:           # a dialect without a table of its own
+        return frozenset()
+    out = {str(c).upper() for c in t.options.get("unmodelled_motion", {}).get("codes", ())}
+    for c in t.codes:
+        if c.group == "passthrough" and str(c.dialect_group) == "1":
+            out.add(c.code.upper())
+    return frozenset(out)
+
+
+def takes_motion(s: n.Passthrough) -> Optional[str]:
+    """The code when this unmodelled construct is a motion code (see motion_codes), else None."""
+    word = leading_word(s.text)
+    return word if word in motion_codes(s.dialect) else None

@@ -1,0 +1,210 @@
+"""Nothing unmodelled passes silently (issue 8): the Sinumerik pole, NC220 for every word, code or
+function the interpreter does not model, and a walk over every code and function of every rules
+table. Expected positions are computed by hand in the comments."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from nctrans import pipeline
+from nctrans.dialects import base
+from nctrans.interp.unmodelled import no_motion_effect
+from nctrans.ir import nodes as n
+from nctrans.ir.vocabulary import UNMODELLED_MODES
+from nctrans.source import from_text
+
+ROOT = Path(__file__).resolve().parents[1]
+RULES = ROOT / "rules"
+
+
+def run(text: str, dialect: str = "sinumerik"):
+    ld = pipeline.load_source(from_text(text, "t.mpf"), "t.mpf", dialect)
+    recs = list(pipeline.toolpath_of(ld))
+    return recs, ld.diagnostics
+
+
+def moves(recs):
+    return [r for r in recs if r.kind in ("rapid", "linear", "arc")]
+
+
+def xy(r):
+    return (round(r.end["X"], 6), round(r.end["Y"], 6))
+
+
+def nc220(diags):
+    return [d for d in diags if d.rule == "NC220"]
+
+
+# --------------------------------------------------------------------------- the pole
+
+def test_g111_sets_the_pole_and_moves_nothing():
+    # pole (10,10); AP=90 RP=5 -> (10 + 5 cos 90, 10 + 5 sin 90) = (10, 15)
+    recs, diags = run("G17 G90\nG111 X10 Y10\nG0 AP=90 RP=5\nM30\n")
+    assert [xy(r) for r in moves(recs)] == [(10.0, 15.0)]
+    assert moves(recs)[0].line == 3
+    assert nc220(diags) == []
+
+
+def test_g110_g112_are_relative_to_last_point_and_last_pole():
+    text = ("G17 G90\nG0 X5 Y5\nG111 X10 Y10\nG0 AP=90 RP=5\n"   # (10,15)
+            "G1 AP=180 F100\n"           # RP stays 5: (10-5, 10) = (5,10)
+            "G110 X2\n"                  # pole = last point (5,10) + (2,0) = (7,10)
+            "G1 RP=1 AP=0\n"             # (8,10)
+            "G112 AP=90 RP=10\n"         # pole = (7,10) + 10*(cos 90, sin 90) = (7,20)
+            "G0 AP=0 RP=0\n"             # the pole itself: (7,20)
+            "G91 G111 X1 Y1\n"           # absolute to the work zero whatever G91: (1,1)
+            "G90 G0 AP=-90 RP=2\n"       # (1, 1-2) = (1,-1)
+            "M30\n")
+    recs, _ = run(text)
+    assert [xy(r) for r in moves(recs)] == [(5.0, 5.0), (10.0, 15.0), (5.0, 10.0), (8.0, 10.0),
+                                            (7.0, 20.0), (1.0, -1.0)]
+
+
+def test_pole_in_the_zx_plane():
+    # G18: plane axes Z (first) and X (second); pole Z=10 X=0; AP=90 RP=4 -> Z 10, X 4
+    recs, _ = run("G18 G90\nG111 Z10 X0\nG0 AP=90 RP=4\nM30\n")
+    end = moves(recs)[0].end
+    assert (round(end["Z"], 6), round(end["X"], 6)) == (10.0, 4.0)
+
+
+def test_pole_round_trips_through_sinumerik_and_flattens_for_iso(tmp_path):
+    src = tmp_path / "pole.mpf"
+    src.write_text("G17 G90\nG111 X10 Y10\nG0 AP=90 RP=5\nM30\n")
+    out = subprocess.run([sys.executable, "-m", "nctrans", "convert", str(src), "--from", "sinumerik",
+                          "--to", "sinumerik"], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and "G111 X10 Y10" in out.stdout
+    out = subprocess.run([sys.executable, "-m", "nctrans", "convert", str(src), "--from", "sinumerik",
+                          "--to", "iso-m"], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "X10. Y15." in out.stdout
+
+
+# --------------------------------------------------------------------------- the general rule
+
+def test_unmodelled_motion_code_moves_nothing_until_the_next_motion_code():
+    text = "G0 X1 Y2 Z3\nG331 Z-10 K1.5\nZ-20\nG1 Z5 F100\nM30\n"
+    recs, diags = run(text)
+    # G331 and the Z-20 after it move nothing; G1 Z5 starts from (1,2,3)
+    assert [(r.line, r.end["Z"]) for r in moves(recs)] == [(1, 3.0), (4, 5.0)]
+    lines = [(d.line, d.severity) for d in nc220(diags)]
+    assert lines == [(2, "warning"), (3, "warning")]
+    assert "G331" in nc220(diags)[0].message and "G331" in nc220(diags)[1].message
+
+
+def test_unmodelled_word_in_a_modelled_block_is_named_at_its_line():
+    recs, diags = run("G1 X5 Y0 F100\nG1 X10 RND=2\nG1 Y5\nM30\n")
+    assert len(moves(recs)) == 3
+    (d,) = nc220(diags)
+    assert d.line == 2 and "RND=2" in d.message
+
+
+def test_known_no_effect_vocabulary_is_silent():
+    text = ("FNORM\nTRAFOOF\nSETMS(1)\nNEWCONF\nCHANDATA(1)\nDIAM90\nSTOPRE\nMSG(\"hello\")\n"
+            "G0 X1\nM30\n")
+    recs, diags = run(text)
+    assert [xy(r) for r in moves(recs)] == [(1.0, 0.0)]
+    assert [d for d in diags if d.severity in ("warning", "error")] == []
+
+
+def test_diameter_programming_is_no_effect_on_a_mill_only():
+    from nctrans.machine import default_lathe
+    ld = pipeline.load_source(from_text("DIAM90\nG0 X1\nM30\n", "t.mpf"), "t.mpf", "sinumerik")
+    list(pipeline.toolpath_of(ld, default_lathe()))
+    assert [d.line for d in nc220(ld.diagnostics)] == [1]
+
+
+def test_iso_unmodelled_modes_and_thread_are_reported():
+    recs, diags = run("G0 X1\nG34 X10 K1 F1\nX20\nG16\nG1 X5 F100\nM30\n", "iso-m")
+    # G34 X10 and X20 move nothing; G1 X5 starts from X1
+    assert [(r.line, r.end["X"]) for r in moves(recs)] == [(1, 1.0), (5, 5.0)]
+    msgs = {}
+    for d in nc220(diags):
+        msgs[d.line] = msgs.get(d.line, "") + d.message
+    assert "G34" in msgs[2] and "G34" in msgs[3] and "G16" in msgs[4]
+
+
+@pytest.mark.parametrize("command", ["toolpath", "lint"])
+def test_fail_on_warning_exits_1(tmp_path, command):
+    src = tmp_path / "p.mpf"
+    src.write_text("G0 X0 Y0\nTRAORI\nG1 X1 F100\nM30\n")
+    argv = [sys.executable, "-m", "nctrans", command, str(src), "--from", "sinumerik"]
+    clean = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert "NC220" in clean.stderr + clean.stdout and "TRAORI" in clean.stderr + clean.stdout
+    strict = subprocess.run(argv + ["--fail-on", "warning"], capture_output=True, text=True,
+                            timeout=120)
+    assert strict.returncode == 1
+
+
+# --------------------------------------------------------------------------- every code of every table
+
+def _tables():
+    for path in sorted(RULES.glob("*.toml")):
+        data = tomllib.loads(path.read_text())
+        if "dialect" in data and "codes" in data:
+            yield path.stem, data
+
+
+def _constructs(data: dict) -> list[str]:
+    """One line per G/M code and per named word or function the table lists."""
+    lines = [c["code"] for c in data["codes"]]
+    opts = data.get("options", {})
+    for section in ("machine_commands", "unsupported_functions"):
+        lines += list(opts.get(section, {}))
+    lines += [f"{w}=1" for w in opts.get("passthrough_words", {}) if w.isalpha()]
+    lines += [f"R1={f}(1)" if f.upper() not in ("ATAN2", "MINVAL", "MAXVAL") else f"R1={f}(1,1)"
+              for f in opts.get("functions", {})]
+    return lines
+
+
+def _line_statements(program: n.Program, line: int) -> list:
+    out = []
+
+    def walk(nodes_):
+        for node in nodes_:
+            if isinstance(node, n.Block):
+                if node.span.line == line:
+                    out.extend(node.body)
+            else:
+                for attr in ("then", "orelse", "body"):
+                    walk(getattr(node, attr, None) or [])
+    walk(program.body)
+    return out
+
+
+def _silently_unmodelled(dialect: str, construct: str) -> str | None:
+    text = f"G0 X0 Y0 Z0\n{construct}\nM30\n"
+    ld = pipeline.load_source(from_text(text, "all.nc"), "all.nc", dialect)
+    if ld.program is None:
+        return None
+    list(pipeline.toolpath_of(ld))
+    said = [d for d in ld.diagnostics if d.line == 2 and d.severity in ("warning", "error")]
+    stmts = _line_statements(ld.program, 2)
+    unmodelled = [s for s in stmts if isinstance(s, n.Passthrough)
+                  and not no_motion_effect(s.reason)]
+    unmodelled += [s for s in stmts if isinstance(s, n.ModeChange)
+                   and (s.group, s.value) in UNMODELLED_MODES]
+    if unmodelled and not said:
+        return f"{construct}: {unmodelled} with no warning"
+    if not stmts and not said and not any(d.line == 2 for d in ld.diagnostics):
+        if construct[0] in "GM" or construct.isalpha():
+            # a one-shot modifier of axis words (G53, ATRANS): it must act on them
+            return _silently_unmodelled(dialect, construct + " X1") if " " not in construct else \
+                f"{construct}: parsed to nothing and said nothing"
+        return f"{construct}: parsed to nothing and said nothing"
+    return None
+
+
+@pytest.mark.parametrize("table", [t for t, _ in _tables()])
+def test_no_code_or_function_of_any_table_is_silently_unmodelled(table):
+    data = dict(_tables())[table]
+    dialect = data["dialect"]
+    if dialect not in base.names():
+        pytest.skip(f"no front end for {dialect} yet")
+    constructs = _constructs(data)
+    assert len(constructs) > 20
+    bad = [msg for c in constructs if (msg := _silently_unmodelled(dialect, c))]
+    assert bad == [], "\n".join(bad)
