@@ -32,6 +32,7 @@ class ToolpathRecord:
     spindle_dir: Optional[str] = None      # spindle events: "cw" | "ccw" | "off" | "orient"
     coolant: Optional[str] = None          # coolant events: "mist" | "flood" | "off"
     stop_kind: Optional[str] = None        # stop events: "stop" | "optional" | "end"
+    pitch: Optional[float] = None          # spindle-synchronised feed (tapping): lead in mm/rev
 
     def to_dict(self) -> dict:
         out = {}

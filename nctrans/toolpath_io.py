@@ -22,7 +22,7 @@ CSV_COLUMNS = (
     ["seq", "file", "line", "kind"]
     + [f"{p}_{a}" for p in ("start", "end", "center") for a in CSV_AXES]
     + ["direction", "plane", "turns", "feed", "feed_mode", "spindle", "tool", "dwell_s",
-       "spindle_dir", "coolant", "stop_kind"]
+       "spindle_dir", "coolant", "stop_kind", "pitch"]
 )
 
 
@@ -154,6 +154,8 @@ def to_json_line(r: ToolpathRecord) -> str:
         s += f',"coolant":"{r.coolant}"'
     if r.stop_kind is not None:
         s += f',"stop_kind":"{r.stop_kind}"'
+    if r.pitch is not None:
+        s += ',"pitch":' + _spell(r.pitch)
     s += "}"
     if "nan" in s or "inf" in s:      # a non-finite number (or a file name containing the letters)
         return _safe_json_line(r)
@@ -199,7 +201,7 @@ def write_csv(records: Iterable[ToolpathRecord], out: IO[str], on_record=None) -
         row += [r.direction or "", r.plane or "", "" if r.turns is None else r.turns,
                 _csv_num(r.feed), r.feed_mode or "", _csv_num(r.spindle),
                 "" if r.tool is None else r.tool, _csv_num(r.dwell_s),
-                r.spindle_dir or "", r.coolant or "", r.stop_kind or ""]
+                r.spindle_dir or "", r.coolant or "", r.stop_kind or "", _csv_num(r.pitch)]
         w.writerow(row)
         if on_record is not None:
             on_record(r)

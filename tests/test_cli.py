@@ -27,7 +27,7 @@ NCTRANS = [sys.executable, "-m", "nctrans"]
 TIMEOUT = 120
 
 TOOLPATH_KEYS = {"seq", "file", "line", "kind", "start", "end", "center", "direction", "plane", "turns",
-                 "feed", "feed_mode", "spindle", "tool", "dwell_s", "spindle_dir", "coolant", "stop_kind"}
+                 "feed", "feed_mode", "spindle", "tool", "dwell_s", "spindle_dir", "coolant", "stop_kind", "pitch"}
 KINDS = {"rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant", "stop"}
 
 

@@ -66,13 +66,17 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
                  dwell_s: float | None, shift: float | None, feed: float,
                  spindle_dir: str | None, units_mm: bool,
                  repeat: int = 1, step: Optional[dict[str, float]] = None,
-                 liftoff: Optional[str] = None) -> list[Step]:
+                 liftoff: Optional[str] = None, position_at: str = "clear_level") -> list[Step]:
     """The steps of one cycle block: ("rapid"|"linear", point) | ("dwell", s) | ("spindle", dir) | ("stop", "stop").
 
     `retract` is the level the hole ends at: the initial level Zi under G98 (may be below R; the
     clear level is then R), `approach` (R) under G99. `repeat` (ISO K/L) drills that many holes in
     one block, each shifted by `step` (the G91 plane increments) from the previous one; `hole` is
     the first. Points are full axis dicts. Never raises on user values; see `cycle_problems`.
+    `position_at` (rules/cycles.toml [positioning]): "clear_level" moves in the plane at the G98
+    level even after a G99 hole (LinuxCNC: it rises diagonally), "current" at the height the tool
+    is at (Fanuc: after a G99 hole at R; Sinumerik cycles: where the call finds the tool), with no
+    plane move when the tool is already over the hole.
     `feed` and `units_mm` do not change the steps (feeds are the caller's; the LinuxCNC peck
     clearance is 0.254 mm in both unit systems). One approximation: under G98 with Zi exactly at R,
     the plane move happens at the current height (LinuxCNC: at Zi), which differs only if a G99
@@ -101,7 +105,10 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
         return (a - b) * up > 0
 
     # Where the tool travels in the plane, and where each hole ends (LinuxCNC old_cc / clear_cc).
-    base = retract if retract != approach else cur.get(ax, approach)
+    if position_at == "current":
+        base = cur.get(ax, approach)
+    else:
+        base = retract if retract != approach else cur.get(ax, approach)
     travel = base
     if kind != "back_bore" and above(approach, base):
         to_level("rapid", approach)
@@ -116,7 +123,9 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
     for k in range(max(repeat, 0)):
         if k and step:
             target = {a: target[a] + step.get(a, 0.0) for a in (a1, a2)}
-        move("rapid", **target, **{ax: travel})
+        if not (position_at == "current" and cur.get(ax) == travel
+                and all(cur.get(a) == target[a] for a in (a1, a2))):
+            move("rapid", **target, **{ax: travel})
         if kind == "back_bore":
             _back_bore(steps, move, to_level, ax, lift_axis, lift_sign * q_shift, target,
                        approach, bottom, clear, dwell_s, spindle_dir)
@@ -175,6 +184,90 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
                 to_level("rapid", clear)
         travel = clear
     return steps
+
+
+def deep_hole_depths(rfp: float, bottom: float, first: Optional[float], decrement: float,
+                     up: float) -> list[float]:
+    """Sinumerik CYCLE83 infeed depths [GK, Siemens cycles manual]: the first at `first` (FDEP,
+    absolute); each later stroke is the previous one less DAM while that stays above DAM, then
+    DAM; the last ends at `bottom`. No first depth: strokes of DAM (one stroke without DAM)."""
+    total = (rfp - bottom) * up
+    if total <= 0:
+        return [bottom]
+    stroke = (rfp - first) * up if first is not None else (decrement or total)
+    if stroke <= 0:
+        stroke = decrement or total
+    depths: list[float] = []
+    z = rfp
+    while (z - bottom) * up > stroke + 1e-9 and len(depths) < MAX_PECKS:
+        z -= up * stroke
+        depths.append(z)
+        if decrement > 0:
+            stroke = stroke - decrement if stroke - decrement > decrement else decrement
+    depths.append(bottom)
+    return depths
+
+
+def deep_hole_steps(*, plane: str, vari: int, approach: float, rfp: float, bottom: float,
+                    retract: float, first: Optional[float], decrement: float,
+                    dwell_bottom: Optional[float], dwell_top: Optional[float],
+                    relief: Optional[float], feed: float, first_factor: Optional[float]) -> list[Step]:
+    """Sinumerik CYCLE83 at the current position [GK, Siemens cycles manual]: G0 to RFP+SDIS, then
+    each infeed with G1 (the first at F*FRF), DTB dwell at each depth; VARI=1 (swarf removal):
+    G0 back to RFP+SDIS, DTS dwell, G0 to the last depth less the anticipation distance (0.6 mm,
+    or depth/50 up to 7 mm beyond 30 mm) before the next infeed; VARI=0 (chip breaking): G1 back
+    by _VRT (1 mm when not given) before the next infeed. Last: G0 to RTP. Steps as expand_cycle's,
+    plus ("feed", f) setting the feed of the linear steps after it. Points hold the drilling axis
+    only: the caller completes them from the current point."""
+    ax = DRILL_AXIS[plane]
+    up = 1.0 if approach >= bottom else -1.0
+    total = abs(rfp - bottom)
+    anticipation = 0.6 if total <= 30 else min(total / 50.0, 7.0)
+    back = abs(relief) if relief else 1.0
+    steps: list[Step] = [("rapid", {ax: approach})]
+    depths = deep_hole_depths(rfp, bottom, first, abs(decrement or 0.0), up)
+    factor = first_factor if first_factor and 0 < first_factor <= 1 else 1.0
+    last = None
+    for i, depth in enumerate(depths):
+        if i == 0:
+            steps.append(("feed", feed * factor))
+        elif vari == 1:
+            steps.append(("rapid", {ax: approach}))
+            if dwell_top:
+                steps.append(("dwell", dwell_top))
+            steps.append(("rapid", {ax: last + up * anticipation}))
+        else:
+            steps.append(("linear", {ax: last + up * back}))
+        steps.append(("linear", {ax: depth}))
+        if i == 0 and factor != 1.0:
+            steps.append(("feed", feed))
+        if dwell_bottom:
+            steps.append(("dwell", dwell_bottom))
+        last = depth
+    steps.append(("rapid", {ax: retract if (retract - approach) * up > 0 else approach}))
+    return steps
+
+
+def tap_steps(*, plane: str, approach: float, bottom: float, retract: float,
+              dwell_s: Optional[float], forward: str, after: Optional[str]) -> list[Step]:
+    """Sinumerik CYCLE84/CYCLE840 at the current position [GK, Siemens cycles manual]: G0 to
+    RFP+SDIS, tap to the depth (G331: spindle-synchronised), dwell DTB, spindle reversed and tap
+    back (G332) to RFP+SDIS, spindle `after` (SDAC; else as before), G0 to RTP. The caller marks
+    the two linear steps as synchronised (the record's pitch)."""
+    ax = DRILL_AXIS[plane]
+    up = 1.0 if approach >= bottom else -1.0
+    reverse = "ccw" if forward == "cw" else "cw"
+    steps: list[Step] = [("rapid", {ax: approach}), ("linear", {ax: bottom})]
+    if dwell_s:
+        steps.append(("dwell", dwell_s))
+    steps += [("spindle", reverse), ("linear", {ax: approach}), ("spindle", after or forward)]
+    steps.append(("rapid", {ax: retract if (retract - approach) * up > 0 else approach}))
+    return steps
+
+
+def coarse_pitch(size: float) -> Optional[float]:
+    """Metric coarse thread pitch of an M thread size (CYCLE84 MPIT), rules/cycles.toml."""
+    return cycle_table().metric_coarse_pitch.get(f"{abs(size):g}")
 
 
 def _back_bore(steps, move, to_level, ax, lift_axis, q, target, approach, bottom, clear,
@@ -290,6 +383,8 @@ class CycleTable:
     swivel: list[SwivelCycle] = field(default_factory=list)
     swivel_mode: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "axis"}))
     swivel_retract: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "none"}))
+    positioning: dict[str, Literal["clear_level", "current"]] = field(default_factory=dict)
+    metric_coarse_pitch: dict[str, float] = field(default_factory=dict)
 
     @classmethod
     def from_data(cls, d: dict) -> "CycleTable":
@@ -301,7 +396,13 @@ class CycleTable:
                    pattern=[HolePattern(**p) for p in d["pattern"]],
                    swivel=[SwivelCycle(**w) for w in d["swivel"]],
                    swivel_mode=SwivelModes(**d["swivel_mode"]),
-                   swivel_retract=SwivelModes(**d["swivel_retract"]))
+                   swivel_retract=SwivelModes(**d["swivel_retract"]),
+                   positioning=dict(d.get("positioning", {})),
+                   metric_coarse_pitch=dict(d.get("metric_coarse_pitch", {})))
+
+    def position_at(self, dialect: str) -> str:
+        """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle)."""
+        return self.positioning.get(dialect, self.positioning.get("default", "clear_level"))
 
     def neutral(self, name: str) -> str:
         """The neutral key of a Siemens parameter name, or its lowercase spelling if it has none."""

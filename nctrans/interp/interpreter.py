@@ -51,9 +51,11 @@ try:  # the colleague's modules; without them the feature is skipped
 except ImportError:  # pragma: no cover
     expand_cycle = None
 try:
-    from nctrans.interp.cycles import cycle_table, hole_pattern, sinumerik_cycle_levels, swivel_plan
+    from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, hole_pattern,
+                                       sinumerik_cycle_levels, swivel_plan, tap_steps)
 except ImportError:  # pragma: no cover
-    cycle_table = hole_pattern = sinumerik_cycle_levels = swivel_plan = None
+    cycle_table = hole_pattern = sinumerik_cycle_levels = swivel_plan = deep_hole_steps = None
+    coarse_pitch = tap_steps = None
 try:
     from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
 except ImportError:  # pragma: no cover
@@ -1231,7 +1233,14 @@ class Interpreter:
             step = {a: v for a, v, m in plane_vals if m != "abs"}
         self._expand(st.cycle, hole, zr, zb, retract, p, int(round(repeat)), step)
 
-    def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None) -> None:
+    def _position_at(self) -> str:
+        mode = self.__dict__.get("_cycle_positioning")
+        if mode is None:
+            mode = self._cycle_positioning = cycle_table().position_at(self.program.dialect)
+        return mode
+
+    def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None,
+                steps=None) -> None:
         st = self.st
         feed = p.get("feed")
         feed = feed * st.scale if feed is not None else (st.feed or 0.0)
@@ -1239,19 +1248,35 @@ class Interpreter:
             self._need_feed()
         if repeat < 1:
             return
-        steps = expand_cycle(kind, plane=st.plane, position=dict(self.pos), hole=hole,
-                             approach=approach, bottom=bottom, retract=retract,
-                             peck=p.get("peck"), dwell_s=p.get("dwell"), shift=p.get("shift"),
-                             feed=feed, spindle_dir=st.spindle_dir, units_mm=st.scale == 1.0,
-                             repeat=repeat, step=step)
+        if steps is None:
+            steps = expand_cycle(kind, plane=st.plane, position=dict(self.pos), hole=hole,
+                                 approach=approach, bottom=bottom, retract=retract,
+                                 peck=p.get("peck"), dwell_s=p.get("dwell"), shift=p.get("shift"),
+                                 feed=feed, spindle_dir=st.spindle_dir, units_mm=st.scale == 1.0,
+                                 repeat=repeat, step=step, position_at=self._position_at())
+        elif callable(steps):
+            steps = steps(feed)
+        pitch = None
+        if kind in ("tap", "tap_left"):
+            pitch = p.get("pitch")
+            if pitch is None:
+                pitch = feed if st.feed_mode == "per_rev" else (
+                    feed / st.spindle_speed if st.spindle_speed else None)
         saved = st.feed
         st.feed = feed
         try:
             for s in steps:
                 k = s[0]
                 if k in ("rapid", "linear"):
-                    pt = dict(s[1])
+                    pt = dict(self.pos)
+                    pt.update(s[1])
+                    mark = len(self.out)
                     self._move(k, pt)
+                    if pitch is not None and k == "linear":
+                        for rec in self.out[mark:]:
+                            rec.pitch = pitch     # tapping: the feed is the spindle's times the lead
+                elif k == "feed":
+                    st.feed = s[1]
                 elif k == "dwell":
                     self._record("dwell", dwell_s=float(s[1] or 0.0))
                 elif k == "spindle":
@@ -1316,8 +1341,63 @@ class Interpreter:
             self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
             return
         approach, bottom, retract = sinumerik_cycle_levels(params, current=self.pos.get(ax, 0.0))
-        hole = dict(self.pos) if hole is None else hole
-        self._expand(s.kind, hole, approach, bottom, retract, params)
+        steps = None
+        if hole is not None and any(abs(hole.get(a, 0.0) - self.pos.get(a, 0.0)) > 0
+                                    for a in PLANE_AXES[st.plane][:2]):
+            self._move("rapid", {**self.pos, **{a: hole[a] for a in PLANE_AXES[st.plane][:2]}})
+        hole = dict(self.pos)
+        kind = s.kind
+        if kind in ("peck", "chip_break") and "peck" not in params:
+            steps = self._deep_hole(params, approach, bottom, retract)
+        elif kind in ("tap", "tap_left"):
+            kind, steps = self._tap(s, params, approach, bottom, retract)
+            if steps is None:
+                return
+        self._expand(kind, hole, approach, bottom, retract, params, steps=steps)
+
+    def _tap(self, s: n.CycleCall, p: dict, approach: float, bottom: float, retract: float):
+        """CYCLE84/CYCLE840: lead from PIT, else from the M size MPIT; its sign gives the hand;
+        feed = lead * S (spindle-synchronised)."""
+        st = self.st
+        lead = p.get("pit") or None
+        if lead is None and p.get("mpit"):
+            lead = coarse_pitch(p["mpit"])
+            if lead is not None and p["mpit"] < 0:
+                lead = -lead
+        if lead is None:
+            self.diag("NC206", "error", f"{s.name or 'tapping cycle'} without a thread pitch "
+                      "(PIT) or a known thread size (MPIT)")
+            return s.kind, None
+        kind = "tap_left" if lead < 0 else "tap"
+        lead = abs(lead) * (st.scale if "pit" in p and p.get("pit") else 1.0)
+        if not st.spindle_speed:
+            self.diag("NC206", "error", f"{s.name or 'tapping cycle'} with no spindle speed")
+            return kind, None
+        p["pitch"] = lead
+        p["feed"] = lead * st.spindle_speed / st.scale
+        after = {3: "cw", 4: "ccw", 5: "off"}.get(int(p.get("sdac", 0) or 0))
+        steps = tap_steps(plane=st.plane, approach=approach, bottom=bottom, retract=retract,
+                          dwell_s=p.get("dwell"), forward="ccw" if kind == "tap_left" else "cw",
+                          after=after)
+        return kind, steps
+
+    def _deep_hole(self, p: dict, approach: float, bottom: float, retract: float):
+        """CYCLE83 infeeds from FDEP/FDPR and DAM (cycles.deep_hole_steps)."""
+        rfp = p.get("r_plane", 0.0)
+        up = 1.0 if approach >= bottom else -1.0
+        first = p.get("first_peck")
+        if "fdpr" in p:
+            first = rfp - up * abs(p["fdpr"] * self.st.scale)
+        vari = int(p.get("vari", 0) or 0)
+        vari = 1 if vari % 10 == 1 else 0
+
+        def make(feed: float):
+            return deep_hole_steps(plane=self.st.plane, vari=vari, approach=approach, rfp=rfp,
+                                   bottom=bottom, retract=retract, first=first,
+                                   decrement=p.get("decrement", 0.0), dwell_bottom=p.get("dwell"),
+                                   dwell_top=p.get("dts"), relief=p.get("relief"), feed=feed,
+                                   first_factor=p.get("frf"))
+        return make
 
     def _swivel_plane(self, s: n.CycleCall) -> None:
         """Sinumerik CYCLE800 [GK]: retract in machine coordinates (_FR), then the programmable
