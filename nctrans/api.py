@@ -106,7 +106,7 @@ def _search_path(dirs: Iterable[PathLike]) -> Iterator[None]:
         if not os.path.isdir(d):
             raise NCInputError(f"search path {d}: not a directory")
     saved = list(pipeline.SEARCH_PATHS)
-    pipeline.SEARCH_PATHS[:] = extra
+    pipeline.SEARCH_PATHS[:] = [*extra, *saved]     # the CLI's --search-path stays in force
     try:
         yield
     finally:
@@ -132,11 +132,14 @@ def _machine(machine: MachineLike, dialect: Optional[str]) -> Machine:
     raise NCInputError(f"machine must be a Machine, a path to MACHINE.toml or None, not {type(machine).__name__}")
 
 
-def _load(source: Union[str, "os.PathLike[str]"], dialect: Optional[str], *, stream: bool = False,
-          file: str = STRING_LABEL) -> pipeline.Loaded:
-    """Read and parse text (a str) or a file (a PathLike)."""
+def _load(source: Union[str, "os.PathLike[str]", _source.SourceText], dialect: Optional[str], *,
+          stream: bool = False, file: str = STRING_LABEL) -> pipeline.Loaded:
+    """Read and parse text (a str) or a file (a PathLike). The CLI also passes already decoded
+    standard input (a SourceText)."""
     _check_dialect(dialect)
     with _api_errors():
+        if isinstance(source, _source.SourceText):
+            return pipeline.load_source(source, _source.STDIN, dialect, stream)
         if isinstance(source, str):
             return pipeline.load_source(_source.from_text(source, file), _source.STDIN, dialect, stream)
         if isinstance(source, os.PathLike):
@@ -335,8 +338,8 @@ def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], d
          error_level: ErrorLevel = ErrorLevel.IGNORE) -> list[Diagnostic]:
     """Diagnostics of program text, a file, a directory (recursed for NC file endings, as
     `nctrans lint DIR`) or several paths, filtered by rule-code prefixes `select`/`ignore`."""
-    if isinstance(source, str) or isinstance(source, os.PathLike):
-        sources: list[Union[str, os.PathLike[str]]] = [source]
+    if isinstance(source, (str, os.PathLike, _source.SourceText)):
+        sources: list[Union[str, os.PathLike[str], _source.SourceText]] = [source]
     else:
         sources = list(source)
     keep = rule_filter(list(select), list(ignore))
@@ -344,7 +347,8 @@ def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], d
     with _search_path(search_path):
         for s in sources:
             if isinstance(s, os.PathLike) and os.path.isdir(s):
-                files: list[Union[str, os.PathLike[str]]] = [Path(f) for f in pipeline.iter_inputs([os.fspath(s)])]
+                files: list[Union[str, os.PathLike[str], _source.SourceText]] = [
+                    Path(f) for f in pipeline.iter_inputs([os.fspath(s)])]
             else:
                 files = [s]
             for f in files:

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 from typing import Iterable, Optional
 
-from nctrans import __version__
+from nctrans import __version__, api
 from nctrans import output as _output
 from nctrans import pipeline
 from nctrans import source as _source
@@ -132,11 +132,14 @@ def write_atomic(path: Path, text: str) -> None:
         raise
 
 
-def _flatten(program, machine, diags: list[Diagnostic], ld: pipeline.Loaded):
-    """Plain-motion form of `program` on `machine`, resolving calls as the source's toolpath does."""
-    from nctrans.lower.flatten import flatten
-    return flatten(program, machine, diagnostics=diags,
-                   resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
+def _cli_source(path: str):
+    """What the API reads for a command-line input: a Path, or standard input already decoded."""
+    if path != _source.STDIN:
+        return Path(path)
+    try:
+        return _source.read_source(path)
+    except _source.SourceError as e:
+        raise pipeline.PipelineError(str(e)) from None
 
 
 def cmd_convert(args) -> int:
@@ -189,28 +192,16 @@ def cmd_convert(args) -> int:
         if bar is not None:
             bar.advance(bar.task_ids[0])
         try:
-            ld = pipeline.load(s, args.from_)
-        except pipeline.PipelineError as e:
+            conv = api.transpile(_cli_source(s), read=args.from_, write=target.name, flatten=args.flatten,
+                                 strict=args.strict, machine=machine)
+        except (api.NCError, pipeline.PipelineError) as e:
             _err(str(e))
             status = EXIT_USAGE
             continue
-        diags = ld.diagnostics
-        text = None
-        if ld.program is not None and not _at_or_above(diags, "error"):
-            from nctrans.convert import convert
-            program = ld.program
-            flat_machine = machine or pipeline.load_machine(None, ld.dialect)
-            result = convert(
-                program, target, flatten=args.flatten, strict_mode=args.strict,
-                flatten_with=lambda into, p=program, m=flat_machine, l=ld: _flatten(p, m, into, l))
-            diags.extend(result.diagnostics)
-            text = result.text
-        elif args.strict:
-            from nctrans.convert import strict
-            diags[:] = strict(diags)
-        _print_text_diags(diags, sys.stderr)
-        if text is None or _at_or_above(diags, "error"):
-            _err(f"{ld.label}: not converted (errors above)")
+        _print_text_diags(conv.diagnostics, sys.stderr)
+        text = conv.text
+        if text is None:
+            _err(f"{_source.label_for(s)}: not converted (errors above)")
             status = max(status, EXIT_DIAGNOSTICS)
             continue
         out = outputs[s]
@@ -230,18 +221,6 @@ def cmd_convert(args) -> int:
 
 # --------------------------------------------------------------------------- lint
 
-def _rule_filter(select: list[str], ignore: list[str]):
-    sel = [p.strip().upper() for group in select for p in group.split(",") if p.strip()]
-    ign = [p.strip().upper() for group in ignore for p in group.split(",") if p.strip()]
-
-    def keep(d: Diagnostic) -> bool:
-        code = d.rule.upper()
-        if sel and not any(code.startswith(p) for p in sel):
-            return False
-        return not any(code.startswith(p) for p in ign)
-    return keep
-
-
 def cmd_lint(args) -> int:
     _check_dialect(args.from_)
     machine = pipeline.load_machine(args.machine, args.from_) if args.machine else None
@@ -252,7 +231,7 @@ def cmd_lint(args) -> int:
         return EXIT_OK
     if _source.STDIN in files and files.count(_source.STDIN) > 1:
         raise UsageError("'-' (stdin) can be given once")
-    keep = _rule_filter(args.select or [], args.ignore or [])
+    keep = api.rule_filter(args.select or [], args.ignore or [])
     all_diags: list[Diagnostic] = []
     status = EXIT_OK
     bar = _progress(len(files), "lint")
@@ -260,11 +239,9 @@ def cmd_lint(args) -> int:
     try:
         for f in files:
             try:
-                ld = pipeline.load(f, args.from_, stream=True)
-                m = machine or pipeline.load_machine(None, ld.dialect)
-                diags = pipeline.lint(ld, m)
+                diags = api.lint(_cli_source(f), args.from_, machine)
                 done += 1
-            except pipeline.PipelineError as e:
+            except (api.NCError, pipeline.PipelineError) as e:
                 _err(str(e))
                 status = EXIT_USAGE
                 continue
@@ -319,33 +296,24 @@ def cmd_toolpath(args) -> int:
 # --------------------------------------------------------------------------- equiv
 
 def cmd_equiv(args) -> int:
-    from nctrans import equivalence as _equiv
-    if args.tol is None:
-        args.tol = _equiv.DEFAULT_TOL
-    if not args.tol > 0:
-        raise UsageError("--tol must be a positive number of mm")
-    _check_dialect(args.from_a)
-    _check_dialect(args.from_b)
     if args.a == _source.STDIN and args.b == _source.STDIN:
         raise UsageError("only one of A and B can be '-' (stdin)")
-    la = pipeline.load(args.a, args.from_a)
-    lb = pipeline.load(args.b, args.from_b)
-    ma = pipeline.load_machine(args.machine, la.dialect)
-    mb = ma if args.machine else pipeline.load_machine(None, lb.dialect)
-    ra = list(pipeline.toolpath_of(la, ma))
-    rb = list(pipeline.toolpath_of(lb, mb))
-    _print_text_diags(la.diagnostics + lb.diagnostics, sys.stderr)
-    if la.program is None or lb.program is None:
+    machine = pipeline.load_machine(args.machine) if args.machine else None
+    tol = api.DEFAULT_TOL if args.tol is None else args.tol
+    try:
+        result = api.equiv(_cli_source(args.a), _cli_source(args.b), tol=tol, read_a=args.from_a,
+                           read_b=args.from_b, machine=machine)
+    except api.NCInputError as e:
+        raise UsageError(str(e).replace("tol must", "--tol must")) from None
+    _print_text_diags(result.diagnostics, sys.stderr)
+    if not result.equivalent and result.difference is None:
         _err("cannot compare: an input did not parse")
         return EXIT_DIAGNOSTICS
-    diff = _equiv.compare(ra, rb, args.tol)
-    if diff is not None:
-        print(f"different: {diff.format()}")
+    if not result:
+        print(f"different: {result.message}")
         return EXIT_DIAGNOSTICS
-    print(f"equivalent within {args.tol:g} mm ({len(ra)} and {len(rb)} toolpath records)")
-    if _at_or_above(la.diagnostics + lb.diagnostics, "error"):
-        return EXIT_DIAGNOSTICS
-    return EXIT_OK
+    print(result.message)
+    return EXIT_DIAGNOSTICS if _at_or_above(result.diagnostics, "error") else EXIT_OK
 
 
 # --------------------------------------------------------------------------- detect, rules, stubs
@@ -480,7 +448,7 @@ def _main(argv: Optional[list[str]]) -> int:
     pipeline.SEARCH_PATHS[:] = getattr(args, "search_path", [])
     try:
         return args.func(args)
-    except (UsageError, pipeline.PipelineError) as e:
+    except (UsageError, pipeline.PipelineError, api.NCError) as e:
         _err(str(e))
         return EXIT_USAGE
 
