@@ -13,6 +13,7 @@ import re
 from typing import Any, Callable, Optional
 
 from nctrans.ir import nodes as n
+from nctrans.ir.walk import literal
 
 
 class _Unknown:
@@ -266,16 +267,8 @@ _FUNCS: dict[str, Callable[..., Any]] = {
 }
 
 
-def constant(expr: Any) -> Optional[float]:
-    """The value of a literal number (or a signed one), else None: lets hot paths skip closures."""
-    if type(expr) is n.Num:
-        return float(expr.value)
-    if type(expr) is n.Unary and type(expr.operand) is n.Num:
-        if expr.op == "-":
-            return -float(expr.operand.value)
-        if expr.op == "+":
-            return float(expr.operand.value)
-    return None
+# The value of a literal number (or a signed one), else None: lets hot paths skip closures.
+constant = literal
 
 
 _AXES = "XYZABC"

@@ -45,6 +45,7 @@ from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.unmodelled import no_motion_effect
 from nctrans.ir import nodes as n
+from nctrans.ir.walk import walk
 from nctrans.toolpath import ToolpathRecord
 
 DECIMALS = 6                        # mm / degrees written: 1 nm, far under any controller's resolution
@@ -120,23 +121,18 @@ class _Walker:
             self.nodes(sub.body)
 
     def nodes(self, nodes_: list) -> None:
-        for node in nodes_:
+        for node in walk(nodes_):
             t = type(node)
             if t is n.Block:
                 for s in node.body:
                     self.statement(s, node.span)
-                continue
-            if t in (n.While, n.ForLoop, n.Loop, n.RepeatUntil):
+            elif t in (n.While, n.ForLoop, n.Loop, n.RepeatUntil):
                 self.note("loop", node.span)
                 if t is not n.Loop:
                     self.note("expr", node.span)
             else:
                 self.note("branch", node.span)
                 self.note("expr", node.span)
-            for attr in ("then", "orelse", "body"):
-                sub = getattr(node, attr, None)
-                if sub:
-                    self.nodes(sub)
 
     def statement(self, s, span: n.Span) -> None:
         t = type(s)

@@ -32,6 +32,8 @@ from typing import Any, Optional
 
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.ir import nodes as n
+from nctrans.ir import walk
+from nctrans.ir.walk import constant
 from nctrans.rules import load_table
 
 from . import plan as pl
@@ -239,13 +241,13 @@ class IsoEmitter:
         if len(idx) != len(arr.dims):
             raise NotExpressible(f"the array {v.key} used without all {len(arr.dims)} indices")
         for e, dim in zip(idx, arr.dims):
-            c = pl.constant(e)
+            c = constant(e)
             if c is not None and (c != int(c) or not 0 <= c < dim):
                 raise NotExpressible(f"index {format_number(c)} of the array {v.key} (size {dim})")
         offset = idx[0]
         for e, dim in zip(idx[1:], arr.dims[1:]):
             offset = n.Binary("+", n.Binary("*", offset, n.Num(float(dim))), e)
-        c = pl.constant(offset)
+        c = constant(offset)
         if c is not None:
             return f"#{arr.base + int(c)}"
         return f"#[{format_expr(n.Binary('+', n.Num(float(arr.base)), offset), self)}]"
@@ -334,10 +336,12 @@ class IsoEmitter:
         """Labels, locals and O numbers of every unit, before any jump or call is written."""
         p = self.program
         self.plans[None] = pl.unit_plan(None, p.body, self.fresh_label)
-        self.targets[None] = pl.jump_targets(p.body)
+        # a return to a block number (M99 P) lands in the calling unit: the main program
+        self.targets[None] = walk.jump_targets(p.body).union(
+            *(walk.return_targets(sub.body) for sub in p.subprograms.values()))
         for key, sub in p.subprograms.items():
             self.plans[key] = pl.unit_plan(sub, sub.body, self.fresh_label)
-            self.targets[key] = pl.jump_targets(sub.body)
+            self.targets[key] = walk.jump_targets(sub.body)
         if p.dialect == self.dialect:
             return
         taken = {pl.iso_number(k) for k in p.subprograms if pl.iso_number(k) is not None}
@@ -365,13 +369,9 @@ class IsoEmitter:
         return None
 
     def _collect_numbers(self, nodes_) -> None:
-        for node in nodes_:
-            if type(node) is n.Block:
-                if node.number:
-                    self.used_numbers.add(node.number.lstrip("0") or "0")
-            else:
-                for attr in ("then", "orelse", "body"):
-                    self._collect_numbers(getattr(node, attr, None) or [])
+        for b in walk.blocks(nodes_):
+            if b.number:
+                self.used_numbers.add(b.number.lstrip("0") or "0")
 
     # -------------------------------------------------------------- structure
     def nodes(self, nodes_) -> None:
@@ -619,7 +619,7 @@ class IsoEmitter:
                 self.pos = {}
             return
         for k, av in s.target.items():
-            v = pl.constant(av.value)
+            v = constant(av.value)
             inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
             if v is None or (inc and k not in self.pos):
                 self.pos.pop(k, None)
@@ -639,7 +639,7 @@ class IsoEmitter:
         def point(words):
             out = dict(start)
             for k, av in words.items():
-                v = pl.constant(av.value)
+                v = constant(av.value)
                 inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
                 if v is None or (inc and k not in start):
                     raise NotExpressible("a three-point arc (CIP) whose points are not constants")
@@ -671,7 +671,7 @@ class IsoEmitter:
         """Opening angle AR= with an end point: the ISO R word of that arc (negative over 180 deg),
         when the start, the end and the angle are constants."""
         a1, a2, _ = pl.PLANE.get(self.plane, pl.PLANE["XY"])
-        ang = pl.constant(s.aperture)
+        ang = constant(s.aperture)
         if s.center or s.radius is not None or ang is None or not 0 < ang < 360:
             raise NotExpressible("an arc by opening angle (AR=) with a centre or a computed angle")
         if any(a not in start or a not in self.pos for a in (a1, a2)):
@@ -703,7 +703,7 @@ class IsoEmitter:
                 if av.mode == "abs" and self.arc_distance != "absolute":
                     # an absolute centre (Sinumerik I=AC(..)) from the known constant start point
                     axis = {"I": "X", "J": "Y", "K": "Z"}.get(k, k)
-                    c = pl.constant(value)
+                    c = constant(value)
                     if c is None or axis not in start:
                         raise NotExpressible(f"an absolute arc centre {k} from an unknown start point")
                     self.lowered(f"absolute arc centre {k} written incremental from the start point")
@@ -794,7 +794,7 @@ class IsoEmitter:
             if s.clear:
                 self.frame_trans = {}
                 return
-            vals = {k: pl.constant(v) for k, v in s.values.items()}
+            vals = {k: constant(v) for k, v in s.values.items()}
             self.frame_trans = None if None in vals.values() else vals
             if not s.local:
                 self.frame_other = False
@@ -805,7 +805,7 @@ class IsoEmitter:
 
     def _additive_trans(self, s: n.FrameOp):
         """ATRANS with no rotation, scale or mirror active: G52 with the accumulated shift."""
-        vals = {k: pl.constant(v) for k, v in s.values.items()}
+        vals = {k: constant(v) for k, v in s.values.items()}
         if self.frame_trans is None or self.frame_other:
             raise NotExpressible("an additive translation (ATRANS) where the frame is not a known plain shift")
         if None in vals.values() or set(vals) - set("XYZ"):

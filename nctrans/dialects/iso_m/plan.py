@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 from nctrans.ir import nodes as n
+from nctrans.ir.walk import blocks, walk
 
 # G65 Type I letters for PROC parameters in order, and the local each one lands in (spec §1.8.1).
 # I/J/K are left out (their Type II repetition makes the order ambiguous), G L N O P are not arguments.
@@ -61,39 +62,6 @@ class UnitPlan:
     refusal: Optional[str] = None                               # why its calls cannot be written
 
 
-def walk(nodes_):
-    """Every Block of a node list, in source order, with the structures' bodies."""
-    for node in nodes_:
-        if type(node) is n.Block:
-            yield node
-        for attr in ("then", "orelse", "body"):
-            sub = getattr(node, attr, None)
-            if sub and type(node) is not n.Block:
-                yield from walk(sub)
-
-
-def jump_targets(nodes_) -> set[str]:
-    """Block numbers and labels some jump in this unit can reach (positions are unknown there)."""
-    out: set[str] = set()
-
-    def scan(ns):
-        for node in ns:
-            if type(node) is n.Case:
-                out.update(str(lbl) for _, lbl in node.branches)
-                if node.default is not None:
-                    out.add(str(node.default))
-            elif type(node) is n.Block:
-                for s in node.body:
-                    if type(s) is n.Goto:
-                        out.add(str(s.target))
-            for attr in ("then", "orelse", "body"):
-                sub = getattr(node, attr, None)
-                if sub and type(node) is not n.Block:
-                    scan(sub)
-    scan(nodes_)
-    return out
-
-
 def circle_through(p1, p2, p3) -> Optional[tuple[float, float, bool]]:
     """Centre (c1, c2) and clockwise flag of the circle through three plane points, or None when
     they are collinear (no arc)."""
@@ -106,22 +74,6 @@ def circle_through(p1, p2, p3) -> Optional[tuple[float, float, bool]]:
     cy = (s1 * (x3 - x2) + s2 * (x1 - x3) + s3 * (x2 - x1)) / den
     cw = ((x2 - x1) * (y3 - y2) - (y2 - y1) * (x3 - x2)) < 0
     return cx, cy, cw
-
-
-def constant(e) -> Optional[float]:
-    """The value of a constant expression (numbers and + - * / only), else None."""
-    t = type(e)
-    if t is n.Num:
-        return e.value
-    if t is n.Unary and e.op in ("-", "+"):
-        v = constant(e.operand)
-        return None if v is None else (-v if e.op == "-" else v)
-    if t is n.Binary and e.op in ("+", "-", "*", "/"):
-        a, b = constant(e.left), constant(e.right)
-        if a is None or b is None or (e.op == "/" and b == 0):
-            return None
-        return {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else 0.0}[e.op]
-    return None
 
 
 def max_r_used(program: n.Program) -> tuple[int, bool]:
@@ -162,7 +114,7 @@ def max_r_used(program: n.Program) -> tuple[int, bool]:
 
     units = [program.body] + [s.body for s in program.subprograms.values()]
     for body in units:
-        for node in _all_nodes(body):
+        for node in walk(body):
             if type(node) is n.Block:
                 for s in node.body:
                     expr(s)
@@ -172,25 +124,16 @@ def max_r_used(program: n.Program) -> tuple[int, bool]:
     return top, dynamic
 
 
-def _all_nodes(nodes_):
-    for node in nodes_:
-        yield node
-        for attr in ("then", "orelse", "body"):
-            sub = getattr(node, attr, None)
-            if sub and type(node) is not n.Block:
-                yield from _all_nodes(sub)
-
-
 def unit_plan(sub: Optional[n.Subprogram], body, fresh_number) -> UnitPlan:
     """Labels -> fresh N numbers; for a subprogram, parameters -> G65 letters/locals and its DEF
     scalars -> the locals left over (a G65 call gives the body its own local level)."""
     plan = UnitPlan()
-    for b in walk(body):
+    for b in blocks(body):
         if b.label and b.label not in plan.labels:
             plan.labels[b.label] = fresh_number()
     if sub is None:
         return plan
-    decls = [s for b in walk(body) for s in b.body if type(s) is n.VarDecl and not s.dims]
+    decls = [s for b in blocks(body) for s in b.body if type(s) is n.VarDecl and not s.dims]
     if not sub.params and not decls:
         return plan
     plan.uses_locals = True

@@ -35,6 +35,7 @@ from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.dialects.base import EmitResult
 from nctrans.dialects.sinumerik.lexer import number_value
 from nctrans.ir import nodes as ir
+from nctrans.ir import walk
 from nctrans.rules import load_table
 
 DIALECT = "sinumerik"
@@ -93,7 +94,7 @@ class Emitter:
         self.axes = set(self.t.options.get("axes", []))
         self.span: Optional[ir.Span] = None
         self.pending = None
-        self.targets = _jump_targets(program)
+        self.targets = walk.program_jump_targets(program)
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -824,31 +825,6 @@ _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z_0-9]{0,30}$")
 
 
 _STRUCT = (ir.If, ir.While, ir.ForLoop, ir.Loop, ir.RepeatUntil, ir.Case)
-
-
-def _jump_targets(p: ir.Program) -> set:
-    """Labels and block numbers some jump can reach (where statically known positions end)."""
-    out: set = set()
-
-    def walk(ns):
-        for n in ns:
-            if isinstance(n, ir.Block):
-                for s in n.body:
-                    if isinstance(s, ir.Goto):
-                        out.add(s.target)
-                    elif isinstance(s, ir.Return) and s.to_label:
-                        out.add(s.to_label)
-            elif isinstance(n, ir.Case):
-                out.update(t for _, t in n.branches)
-                if n.default:
-                    out.add(n.default)
-            for attr in ("then", "orelse", "body"):
-                if isinstance(getattr(n, attr, None), list):
-                    walk(getattr(n, attr))
-    walk(p.body)
-    for sub in p.subprograms.values():
-        walk(sub.body)
-    return out
 
 
 def _deco(b: ir.Block):
