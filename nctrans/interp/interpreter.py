@@ -62,6 +62,7 @@ except ImportError:  # pragma: no cover
     CutterCompensator = PlannedMove = None
 
 BLOCK, JUMP, JFALSE, EXEC, CASE, PLAIN = range(6)
+SHARED_SCOPE_CALLS = frozenset(("m98", "shared"))
 MAX_CALL_DEPTH = 16
 STREAM_BATCH = 256          # blocks of a streamed main body compiled at a time
 PLAIN_EXPAND = 64           # blocks of a PlainRun expanded at a time when the kernel cannot run it
@@ -1653,11 +1654,15 @@ class Interpreter:
 
     def _make_scope(self, s: n.SubCall, unit: Unit, args: tuple) -> Callable[[], Scope]:
         pos, named = args
-        share = s.kind == "m98" and not pos and not named
+        # calls that open no parameter level of their own: ISO M98, and "shared" (Fagor LL, L,
+        # #CALL), which shares the caller's named locals too
+        share = s.kind in SHARED_SCOPE_CALLS and not pos and not named
         caller = self.ev.scope
 
         def make():
             sc = Scope(num=caller.num if share else None, args=dict(named))
+            if share and s.kind == "shared":
+                sc.names, sc.args = caller.names, caller.args
             for p, v in zip(unit.params, pos):
                 sc.names[p.name.upper()] = v
             for k, v in named.items():
