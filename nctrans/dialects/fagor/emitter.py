@@ -251,7 +251,7 @@ class _Emitter:
         return "\n".join(self.out) + "\n"
 
     def _reset(self) -> None:
-        self.motion = "rapid"
+        self.motion = None
         self.pending_motion = None
 
     def nodes(self, nodes: list) -> None:
@@ -346,6 +346,8 @@ class _Emitter:
                 used.clear()
 
         def word(letter: str, text: str, alone: bool = False):
+            if letter and letter in used and text in lines[-1]:
+                return                       # the same word twice (D of G43 and of G41)
             if alone or letter in used:
                 new_line()
             lines[-1].append(text)
@@ -491,13 +493,13 @@ class _Emitter:
                 word("D", "D0")
                 return 0
             self.length_on = True
-            # the offset comes with the next OffsetSelect of this block, if any
+            # a Fagor source names its D in the code; an ISO G43 takes the H of this block
             nxt = next((x for x in rest if isinstance(x, n.OffsetSelect)), None)
-            if nxt is None:
+            if s.code.upper().startswith("D") and len(s.code) > 1:
+                word("D", s.code.upper())
+            elif nxt is None:
                 word("D", "D" + (_value(self.spell, self.radius_index) if self.radius_index is not None
                                  else "1"))
-            elif nxt.kind == "length":
-                pass
             return 0
         if g == "work_offset":
             if v.upper().startswith("G54.1P"):
@@ -529,6 +531,10 @@ class _Emitter:
             word("G", "G08")
         elif s.via:
             raise NotExpressible("an intermediate point outside a three-point arc")
+        if self.motion is None:
+            # the first move of a unit: its mode is the power-on default, written out
+            self.motion = "rapid"
+            word("GMOTION", "G00")
         for a, av in s.target.items():
             if av.mode is not None and av.mode != ("abs" if self.distance == "absolute" else "inc"):
                 raise NotExpressible(f"{a} in {av.mode} mode for one word")

@@ -223,6 +223,7 @@ class Lowerer:
         self.expr = _Expr(self.note)
         self.soft_limits: list[dict] = []
         self.mirror: set[str] = set()     # axes mirrored by G11-G14, in source order
+        self.offset: ir.Expr = ir.Num(1.0, "1")   # the D in force (D1 is the default)
 
     def note(self, rule: str, severity: str, message: str, col: Optional[int] = None) -> None:
         self.diags.append(Diagnostic(rule, severity, message, self.file, self.line, col or self.col))
@@ -361,7 +362,7 @@ class Lowerer:
             elif g == "cycle":
                 if v == "off":
                     self.cycle = False
-                    out.append((B_NONMODAL, ir.Passthrough(code, "canned cycle cancel", DIALECT)))
+                    out.append((B_NONMODAL, ir.ModeChange("cycle", "off", code)))
                 else:
                     self.cycle = True
                     self.note("NC416", "warning", f"canned cycle {code}: its parameters are defined in "
@@ -418,7 +419,7 @@ class Lowerer:
                 out.append((B_M6, ir.ToolChange()))
                 if "D" not in vals:       # after a tool change D1 is implicit (spec §8.9)
                     out.append((B_M6, ir.ModeChange("tool_length", "plus", "D1")))
-                    out.append((B_M6, ir.OffsetSelect("radius", ir.Num(1.0, "1"))))
+                    self.offset = ir.Num(1.0, "1")
             else:
                 out.append((B_NONMODAL, ir.Passthrough(code, rule.meaning, DIALECT)))
         for q_m, q in line.qualifiers:
@@ -442,10 +443,15 @@ class Lowerer:
         if "T" in vals:
             out.append((B_TOOL, ir.ToolSelect(vals.pop("T"))))
         if "D" in vals:
+            # D: offset of the active tool; its length applies at once, its radius is what the next
+            # G41/G42 uses (so it is handed to the IR with the compensation that reads it)
             d = vals.pop("D")
             zero = _const(d) == 0
-            out.append((B_TLC, ir.ModeChange("tool_length", "off" if zero else "plus", "D")))
-            out.append((B_TLC, ir.OffsetSelect("radius", d)))
+            out.append((B_TLC, ir.ModeChange("tool_length", "off" if zero else "plus",
+                                             "D" + _text_expr(d))))
+            self.offset = d
+        if any(r.group == "cutter_comp" and r.value != "off" for r, _, _ in w.gs):
+            out.append((B_COMP, ir.OffsetSelect("radius", self.offset)))
         if "H" in vals:
             out.append((B_NONMODAL, ir.Passthrough("H" + _text_expr(vals.pop("H")), "H function to "
                                                    "the PLC", DIALECT)))
