@@ -1,42 +1,60 @@
 """Fagor CNC 8060/8065 (`fagor`): front end, emitter and detection.
 
-Modules: blocks (line shape: headers, comments, skip, labels), frontend (lark grammar of record in
-grammars/fagor.lark, lowering to the IR), emitter (IR -> Fagor text). Spec: shared/specs/fagor8065.md.
+Fagor extends the ISO family: its blocks are ISO word-address blocks (G/M codes, axis words, F S T
+D), to which it adds its own high-level language (`$` flow control, `#` instructions, P parameters,
+`V.` variables) and its own comment, label and subroutine shapes. Modules: blocks (line shape:
+headers, comments, skip, labels), frontend (lark grammar of record in grammars/fagor.lark, lowering
+to the IR), emitter (IR -> Fagor text). Spec: shared/specs/fagor8065.md.
 """
 from __future__ import annotations
 
 import re
 
-from nctrans.dialects.base import Dialect, EmitResult, ParseResult
+from nctrans.dialects.base import EmitResult, Marker, ParseResult
+from nctrans.dialects.iso_m import IsoFamily
+
+_I = re.IGNORECASE
+
+# Constructs only Fagor writes, per line of code with its comments removed (nctrans.detect).
+MARKERS = (
+    Marker(4.0, 3, re.compile(r"^[ \t]*(?:N\d+:?[ \t]*)?\$(?:IF|ELSEIF|ELSE|ENDIF|WHILE|ENDWHILE|DO|ENDDO|FOR|"
+                              r"ENDFOR|SWITCH|CASE|ENDSWITCH|GOTO|BREAK|CONTINUE)\b", _I)),
+    Marker(4.0, 3, re.compile(r"#(?:MSG|WARNING|ERROR)[ \t]*\[", _I)),
+    Marker(3.0, 3, re.compile(r"#(?:CALL|PCALL|MCALL|MDOFF|RET|TIME|SCALE|RPT|PATH|MCS|TOOL[ \t]+AX|CS|ACS|"
+                              r"KIN[ \t]+ID|RTCP|HSC|FLUSH|DGWZ|COMMENT)\b", _I)),
+    Marker(5.0, 1, re.compile(r"^[ \t]*%L[ \t]+\w+", _I)),
+    Marker(3.0, 3, re.compile(r"\bV\.(?:\[\d\]\.)?(?:A|G|P|S|TM|SP|MPA|MPG|MTB|C|PLC)\.\w+", _I)),
+    Marker(2.0, 3, re.compile(r"(?:^|[ \t])P\d+[ \t]*=", _I)),
+    Marker(2.0, 2, re.compile(r"^[ \t]*N\d+:", _I)),
+    Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+:?[ \t]*)?LL[ \t]+\w+", _I)),
+    Marker(3.0, 2, re.compile(r"\bG159[ \t]*=", _I)),
+)
 
 
-def parse(text: str, file: str = "<stdin>") -> ParseResult:
-    from .frontend import parse as _parse
-    return _parse(text, file)
+class Fagor(IsoFamily):
+    name = "fagor"
+    description = "Fagor CNC 8060/8065"
+    extensions = (".nc", ".pim", ".fnc")
+    markers = MARKERS
+    comment_evidence = {"semicolon_line": (0.5, 2)}
+    subprogram_endings = (".nc", ".NC", ".pim", ".fnc", ".fst")
 
+    def sniff(self, text: str) -> float:
+        """0..1: share of Fagor markers found in the first 20 000 characters."""
+        head = text[:20000]
+        hits = sum(1 for m in MARKERS if m.pattern.search(head) or
+                   re.search(m.pattern.pattern, head, re.I | re.M))
+        return min(1.0, hits / 3)
 
-def emit(program) -> EmitResult:
-    from .emitter import emit_program
-    return emit_program(program)
+    def subprogram_stems(self, name: str) -> list[str]:
+        """Global subroutines are called by file name, with or without ending (spec §1.3)."""
+        stem = name.rsplit(".", 1)[0] if "." in name else name
+        return list(dict.fromkeys([name, stem, name.upper(), stem.upper()]))
 
+    def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
+        from .frontend import parse
+        return parse(text, file)
 
-# constructs only Fagor writes: $ flow keywords, # instructions with [ ] arguments, %L local
-# subroutines, V. variables, P parameters assigned with =, N<n>: targets, [LABEL] labels
-_MARKS = [re.compile(p, re.IGNORECASE | re.MULTILINE) for p in (
-    r"^\s*(?:N\d+:?\s*)?\$(?:IF|ELSEIF|ELSE|ENDIF|WHILE|ENDWHILE|DO|ENDDO|FOR|ENDFOR|SWITCH|CASE|"
-    r"ENDSWITCH|GOTO|BREAK|CONTINUE)\b",
-    r"#(?:MSG|WARNING|ERROR|CALL|PCALL|MCALL|MDOFF|RET|TIME|SCALE|RPT|PATH|MCS|COMMENT|TOOL\s+AX|"
-    r"CS|ACS|KIN|RTCP|HSC|FLUSH|SYNC|DGWZ)\b",
-    r"^\s*%L\s+\w+", r"\bV\.(?:\[\d\]\.)?[A-Z]{1,3}\.\w+", r"\bP\d+\s*=", r"^\s*N\d+:",
-    r"\bLL\s+\w+", r"\bG159\s*=")]
-
-
-def sniff(text: str) -> float:
-    """0..1: share of Fagor markers found in the first 20 000 characters."""
-    head = text[:20000]
-    hits = sum(1 for m in _MARKS if m.search(head))
-    return min(1.0, hits / 3)
-
-
-DIALECT = Dialect(name="fagor", extensions=(".nc", ".pim", ".fnc"), parse=parse, emit=emit,
-                  sniff=sniff, description="Fagor CNC 8060/8065")
+    def emit(self, program) -> EmitResult:
+        from .emitter import emit_program
+        return emit_program(program)

@@ -24,12 +24,12 @@ from __future__ import annotations
 import copy
 import re
 from functools import lru_cache
-from pathlib import Path
 from typing import Any, Optional
 
 from lark import Lark, Token, Tree
 from lark.exceptions import LarkError, UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
+from nctrans import resources
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import ParseResult
 from nctrans.ir import nodes as ir
@@ -38,7 +38,7 @@ from nctrans.rules import load_table, normalise_code
 from . import blocks
 
 DIALECT = "fagor"
-GRAMMAR = Path(__file__).resolve().parents[3] / "grammars" / "fagor.lark"
+GRAMMAR = resources.path("grammars", "fagor.lark")
 STARTS = ["start", "call_tail", "msg_tail", "value_tail", "words_tail", "rpt_tail"]
 AXES = "XYZUVWABC"
 LOCAL_PARAMS = 100
