@@ -66,6 +66,9 @@ class Machine:
     # When empty, H n / D n read tool n's length / radius from the tool table.
     length_offsets: dict[int, float] = field(default_factory=dict)
     radius_offsets: dict[int, float] = field(default_factory=dict)
+    # controller and machine-builder system variables the program may read, by the dialect's own
+    # name (Fagor "V.MPA.MAXFEED.X", "V.MTB.P1"): what the machine model knows of them
+    variables: dict[str, float] = field(default_factory=dict)
     source_dir: Optional[str] = None
 
     def __post_init__(self) -> None:

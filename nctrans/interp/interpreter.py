@@ -1692,6 +1692,8 @@ class Interpreter:
         sysv["$P_TOOL"] = lambda: float(st.radius_index or 0)
         sysv["$P_F"] = lambda: st.feed or 0.0
         sysv["$P_S"] = lambda: st.spindle_speed or 0.0
+        for name, value in (getattr(self.machine, "variables", None) or {}).items():
+            sysv[str(name).upper()] = lambda value=value: float(value)
 
     # ================================================================ the loop
     def run(self) -> Iterator[ToolpathRecord]:
