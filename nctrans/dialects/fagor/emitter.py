@@ -132,7 +132,7 @@ class _Spell:
         sp, key = v.space, v.key
         if sp == "arg":
             k = str(key).upper()
-            if k.startswith("P") and k[1:].isdigit() and not v.indices:
+            if (k.startswith("P") and k[1:].isdigit() or k.startswith(("V.P.", "V.S."))) and not v.indices:
                 return k
             raise NotExpressible(f"call argument {key} read by letter")
         if sp == "name":

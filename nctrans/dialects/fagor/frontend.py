@@ -66,6 +66,9 @@ NO_EFFECT = frozenset((  # no effect on the programmed path: kept verbatim, no d
     "#ROUNDPAR", "#HSC", "#SYNC", "#UNSYNC", "#TSYNC", "#SERVO", "#CD", "#MEET", "#WAIT", "#SIGNAL",
     "#CLEAR", "#SWTOUT", "#PWMOUT", "#DELETE", "#INIT", "#ABORT", "#SELECT", "#MASTER", "#TANGFEED",
     "#CONTJOG", "#INCJOG", "#MPG", "#AXIS", "#KIN", "#ROTATEMZ", "#DEF"))
+# Passthrough reason of constructs with no effect on the programmed path (dynamics, look-ahead,
+# software limits, search folders): the word the shared passes read as "no motion effect"
+NO_PATH_EFFECT = "directive"
 NUMBERED_AXIS = re.compile(r"^([XYZUVWABC])([1-9])$")
 
 
@@ -182,7 +185,9 @@ def v_variable(name: str, idx: list, tail: str, note) -> ir.Var:
     full = name + tail
     parts = name.split(".")
     if len(parts) >= 3 and parts[1] in ("P", "S") and not idx:
-        return ir.Var("name", ".".join(parts[2:]) + tail.replace(".", "_"))
+        # user variables live with the local parameters (created by their first assignment);
+        # V.S globals are analysed in the program's frame too (shared by LL, L and #CALL)
+        return ir.Var("arg", full.upper())
     vocab = system_vocabulary()
     base = re.sub(r"^V\.\[\d+\]\.", "V.", name)
     meaning = vocab.get(base)
@@ -303,8 +308,8 @@ class Lowerer:
             elif d == "spos":
                 self.once("spos", "NC415", "info", "spindle positioning speed S.POS= has no effect on "
                           "the path; kept verbatim")
-                out.append((B_NONMODAL, ir.Passthrough(f"{ch[0]}={_text(ch[1])}", "spindle "
-                                                       "positioning speed", DIALECT)))
+                out.append((B_NONMODAL, ir.Passthrough(f"{ch[0]}={_text(ch[1])}", NO_PATH_EFFECT,
+                                                       DIALECT)))
             elif d == "assign":
                 target = self.expr(ch[0])
                 op = next((str(c) for c in ch[1:-1] if isinstance(c, Token)), "=")
@@ -391,7 +396,7 @@ class Lowerer:
             elif g == "call":
                 pass
             elif g == "dynamics":
-                out.append((B_NONMODAL, ir.Passthrough(code, rule.meaning, DIALECT)))
+                out.append((B_NONMODAL, ir.Passthrough(code, NO_PATH_EFFECT, DIALECT)))
             else:        # unmodelled
                 self.note("NC415", "warning", f"{code} ({rule.meaning}) changes the path in a way the "
                           "interpreter does not model; kept verbatim")
@@ -421,7 +426,7 @@ class Lowerer:
                     out.append((B_M6, ir.ModeChange("tool_length", "plus", "D1")))
                     self.offset = ir.Num(1.0, "1")
             else:
-                out.append((B_NONMODAL, ir.Passthrough(code, rule.meaning, DIALECT)))
+                out.append((B_NONMODAL, ir.Passthrough(code, NO_PATH_EFFECT, DIALECT)))
         for q_m, q in line.qualifiers:
             if re.search(r"\.S[2-9]", q):
                 self.note("NC415", "warning", f"M{q_m}{q} addresses another spindle than the first; "
@@ -504,6 +509,12 @@ class Lowerer:
             self.note("NC416", "warning", "positioning while a canned cycle is modal: the cycle would "
                       "run here; only the positioning is analysed")
 
+        if unmodelled:
+            # the words of a function the interpreter does not model are its own (G30 I J, G36 I,
+            # G158 X Y, G33 Z K ...): kept with it, and the block's path is not analysed
+            words = " ".join(f"{k}{_text_expr(e)}" for k, e in vals.items())
+            unmodelled = [" ".join(unmodelled + ([words] if words else []))]
+            vals.clear()
         motion = self._motion(vals, arc_once, motion_g, out)
         nr = vals.pop("NR", None)
         if motion is not None:
@@ -616,7 +627,7 @@ class Lowerer:
                 entry["axes"][a] = c
             self.soft_limits.append(entry)
             out.append((B_NONMODAL, ir.Passthrough(code + " " + " ".join(
-                f"{a}{_text_expr(e)}" for a, e in axes.items()), "software limits", DIALECT)))
+                f"{a}{_text_expr(e)}" for a, e in axes.items()), NO_PATH_EFFECT, DIALECT)))
 
 
 def _const(e) -> Optional[float]:
@@ -912,7 +923,7 @@ class Parser:
             return body + [marker]
         if name == "#PATH":
             self.meta.setdefault("path", tail)
-            return body + [ir.Passthrough(f"#PATH {tail}", "subroutine search folder", DIALECT)]
+            return body + [ir.Passthrough(f"#PATH {tail}", NO_PATH_EFFECT, DIALECT)]
         if name == "#MCS":
             if tail.strip().upper() in ("ON", "OFF"):
                 low.note("NC415", "warning", f"#MCS {tail.strip()}: machine-coordinate programming "
@@ -941,7 +952,8 @@ class Parser:
         if name not in NO_EFFECT:
             low.note("NC415", "warning", f"{name}: its effect on the toolpath is not modelled; kept "
                      "verbatim")
-        return body + [ir.Passthrough(text, "instruction", DIALECT)]
+        return body + [ir.Passthrough(text, NO_PATH_EFFECT if name in NO_EFFECT else "instruction",
+                                      DIALECT)]
 
     # ---------------------------------------------------------------- $ flow
     def flow(self, t: Tree, line: blocks.Line, span: ir.Span) -> None:

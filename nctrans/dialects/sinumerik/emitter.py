@@ -816,8 +816,10 @@ def _reads_as_sinumerik(text: str) -> bool:
     if not text.strip() or "\n" in text or ";" in text:
         return False
     res = parse(text, "<passthrough>")
+    # text that would move the axes on a Sinumerik (Fagor "G198 X-100": limits, not a move) is
+    # not the same construct there: refused, not kept
     return not res.diagnostics and all(
-        not isinstance(s, ir.Passthrough) or s.reason != "syntax error"
+        (not isinstance(s, ir.Passthrough) or s.reason != "syntax error") and not isinstance(s, ir.Motion)
         for b in res.program.body if isinstance(b, ir.Block) for s in b.body)
 
 

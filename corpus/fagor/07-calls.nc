@@ -1,0 +1,22 @@
+; Calls: #PCALL opens a new local-parameter level (A = P0, B = P1), #CALL shares it, #MCALL is modal
+; until #MDOFF (spec §13).
+%L HOLE
+G00 XP0 Y0 Z2
+G01 ZP1 F100
+G00 Z2
+#RET
+%L PATTERN
+$FOR P10 = 0, 2, 1
+  #PCALL HOLE A[P10 * 10] B-3
+$ENDFOR
+M17
+%CALLS
+P0 = 99
+#PCALL HOLE A50 B-1
+G01 XP0 F100
+#CALL PATTERN
+#MCALL HOLE A7 B-2
+G00 Y5
+#MDOFF
+G00 Y9
+M30

@@ -1,0 +1,118 @@
+"""Fagor conversion, proven with LinuxCNC's rs274 and `equiv`.
+
+a) iso-m -> fagor -> iso-m: every corpus/iso-mill program that rs274 runs to PROGRAM_END is emitted
+   as Fagor (`nctrans convert` policy: structural, or lowered to plain motion where Fagor cannot say
+   it), parsed by the Fagor front end with no error, emitted as iso-m and run in rs274 again: the
+   same moves as the original. The helpers and the rs274 runs of the originals are those of the
+   Sinumerik round trip (tests/test_conversion_iso_sinumerik.py).
+b) fagor -> iso-m and fagor -> sinumerik on the conformance programs (corpus/fagor): either no error
+   and `equiv` holds between the Fagor source and the target text parsed back, or the conversion is
+   refused with NC4xx errors that each name a source line.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+import pytest
+
+import rs274 as h
+from nctrans import equiv
+from nctrans.dialects.base import get
+from nctrans.interp import interpret
+from nctrans.machine import default_mill
+from test_conversion_iso_sinumerik import (ISO_MILL, _errors, _policy, _read, originals,  # noqa: F401
+                                           zero_table)
+
+REPO = Path(__file__).resolve().parents[1]
+FAGOR = sorted((REPO / "corpus" / "fagor").glob("*.nc"))
+
+
+class FagorRoundTrip:
+    def __init__(self, path: Path):
+        self.source = get("iso-m").parse(_read(path), path.name).program
+        f = _policy(self.source, "fagor")
+        self.fagor_text, self.fagor_diags = f.text or "", f.diagnostics
+        back = get("fagor").parse(self.fagor_text, path.name + ".nc")
+        self.parse_diags = back.diagnostics
+        self.intermediate = back.program
+        iso = _policy(back.program, "iso-m")
+        self.iso_text, self.iso_diags = iso.text or "", iso.diagnostics
+
+
+@lru_cache(maxsize=None)
+def fagor_round_trip(path: Path) -> FagorRoundTrip:
+    return FagorRoundTrip(path)
+
+
+@pytest.mark.rs274
+@pytest.mark.parametrize("path", [pytest.param(p, id=p.name) for p in ISO_MILL])
+def test_iso_fagor_iso_round_trip_keeps_rs274_moves(path, originals, rs274_cache, zero_table):
+    ref = originals[path.name]
+    if not ref.completed:
+        pytest.skip(f"rs274 stops on the original: {ref.message.splitlines()[0] if ref.message else '?'}")
+    rt = fagor_round_trip(path)
+    refused = _errors(rt.fagor_diags) + _errors(rt.parse_diags) + _errors(rt.iso_diags)
+    assert not refused, "\n".join(d.format_text() for d in refused[:5])
+    syntax = [d for d in rt.parse_diags if d.rule.startswith("NC0")]
+    assert not syntax, "the Fagor text nctrans wrote does not parse:\n" + "\n".join(
+        d.format_text() for d in syntax[:5])
+    out = rs274_cache / f"conv-fagor-rt--{path.name}.ngc"
+    out.write_text(rt.iso_text, encoding="utf-8")
+    run = h.run_rs274(out, zero_table, out.with_suffix(".out"))
+    assert run.completed, f"rs274 stops on the round trip: {run.message}"
+    got = [h.Motion(m.kind, m.start, m.end, m.center, m.direction, m.plane, m.turns, m.where())
+           for m in run.moves]
+    problem = h.compare(ref.moves, got, path.name)
+    assert problem is None, problem
+
+
+@pytest.mark.rs274
+@pytest.mark.parametrize("path", [pytest.param(p, id=p.name) for p in ISO_MILL])
+def test_iso_and_fagor_intermediate_are_equivalent(path, originals):
+    if not originals[path.name].completed:
+        pytest.skip("rs274 stops on the original")
+    rt = fagor_round_trip(path)
+    a = list(interpret(rt.source, default_mill(), diagnostics=[]))
+    b = list(interpret(rt.intermediate, default_mill(), diagnostics=[]))
+    diff = equiv.compare(a, b)
+    assert diff is None, diff.format()
+
+
+# ------------------------------------------------------------------ b) fagor -> iso-m / sinumerik
+
+@lru_cache(maxsize=None)
+def _fagor(path: Path):
+    res = get("fagor").parse(path.read_text(encoding="utf-8"), path.name)
+    return res.program, list(interpret(res.program, default_mill(), diagnostics=[]))
+
+
+@pytest.mark.parametrize("target", ["iso-m", "sinumerik"])
+@pytest.mark.parametrize("path", [pytest.param(p, id=p.name) for p in FAGOR])
+def test_fagor_converts_equivalently_or_refuses_by_line(path, target):
+    program, records = _fagor(path)
+    conv = _policy(program, target)
+    if conv.text is None:
+        errors = _errors(conv.diagnostics)
+        assert errors, "refused without an error"
+        for d in errors:
+            assert d.rule.startswith("NC4") and d.line >= 1, d.format_text()
+        return
+    back = get(target).parse(conv.text, path.name + (".nc" if target == "iso-m" else ".mpf"))
+    assert not _errors(back.diagnostics), "\n".join(d.format_text() for d in _errors(back.diagnostics))
+    theirs = list(interpret(back.program, default_mill(), diagnostics=[]))
+    diff = equiv.compare(records, theirs)
+    assert diff is None, f"{target} text:\n{conv.text}\n{diff.format()}"
+
+
+def test_every_conformance_program_converts_to_both_targets():
+    """The conformance programs are Fagor's own vocabulary: none may be refused outright (what a
+    target cannot say is lowered to plain motion, with NC401 by line), except the program that is
+    about what nctrans does not model."""
+    refused = []
+    for path in FAGOR:
+        program, _ = _fagor(path)
+        for target in ("iso-m", "sinumerik"):
+            if _policy(program, target).text is None:
+                refused.append((path.name, target))
+    assert all(name.startswith("10-") for name, _ in refused), refused
