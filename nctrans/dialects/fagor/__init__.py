@@ -28,6 +28,11 @@ MARKERS = (
     Marker(2.0, 2, re.compile(r"^[ \t]*N\d+:", _I)),
     Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+:?[ \t]*)?LL[ \t]+\w+", _I)),
     Marker(3.0, 2, re.compile(r"\bG159[ \t]*=", _I)),
+    # a "%NAME" program header (ISO writes a bare "%", Sinumerik "%_N_NAME_MPF")
+    Marker(3.0, 1, re.compile(r"^[ \t]*%(?!_N_)[A-Za-z0-9]{1,14}[ \t]*$")),
+    Marker(2.0, 2, re.compile(r"\bG0?4[ \t]*K", _I)),                      # dwell G04 K<s>
+    Marker(2.0, 2, re.compile(r"\bG(?:198|199|261|262|263|72[ \t]*S|73[ \t]*Q)", _I)),
+    Marker(1.5, 1, re.compile(r"\bG7[01]\b", _I)),                        # inch / mm
 )
 
 
