@@ -139,8 +139,12 @@ def test_unmodelled_constructs_are_named_at_their_line():
 def test_software_limits_are_data_for_the_machine_check():
     res, _, _ = _corpus("11-limits.nc")
     limits = res.program.meta["soft_limits"]
-    assert limits == [{"line": 3, "bound": "lower", "axes": {"X": -100.0, "Y": -50.0, "Z": -200.0}},
-                      {"line": 4, "bound": "upper", "axes": {"X": 100.0, "Y": 50.0, "Z": 0.0}}]
+    assert limits == [{"line": 3, "bound": "lower", "axes": {"X": -100.0, "Y": -50.0, "Z": -200.0},
+                       "incremental": False},
+                      {"line": 4, "bound": "upper", "axes": {"X": 100.0, "Y": 50.0, "Z": 0.0},
+                       "incremental": False}]
+    res = _parse("%L\nG91 G198 X-700\nM30\n")                # G91: relative to the limit in force
+    assert res.program.meta["soft_limits"][0]["incremental"] is True
 
 
 def test_system_variables_are_read_from_the_machine_or_reported():
@@ -320,3 +324,22 @@ def test_generated_programs_convert_to_iso_equivalently(text):
     b = list(interpret(get("iso-m").parse(conv.text, "g.nc").program, default_mill(), diagnostics=[]))
     diff = equiv.compare(a, b)
     assert diff is None, conv.text + diff.format()
+
+
+_plain_word = st.tuples(st.sampled_from("GXYZIJKFSTRQM"), st.sampled_from(["", "-"]),
+                        st.one_of(st.integers(0, 999).map(str),
+                                  st.decimals(0, 999, places=3).map(lambda d: f"{d}".rstrip("0"))))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(_plain_word, min_size=1, max_size=6))
+def test_plain_word_fast_path_reads_as_the_grammar(words):
+    """Blocks of letter-number words skip lark (frontend._plain_items); the result must be the
+    grammar's own reading of the same block."""
+    from nctrans.dialects.fagor import blocks, frontend
+    code = " ".join(f"{l}{s}{n if not n.endswith('.') else n + '0'}" for l, s, n in words)
+    assert frontend._plain_items(code) is not None
+    line = blocks.split(1, code)
+    fast = frontend.Lowerer("f").items(frontend._plain_items(line.code), line)
+    slow = frontend.Lowerer("f").items(frontend.parser().parse(line.code, start="start").children, line)
+    assert fast == slow

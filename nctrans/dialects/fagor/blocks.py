@@ -98,12 +98,15 @@ def split(n: int, raw: str) -> Line:
     stripped = rest.lstrip()
     line.col = pos + len(rest) - len(stripped) + 1
     stripped = stripped.rstrip()
-    stripped = _CALL_PATH.sub(lambda k: f'{k.group(1)}{k.group(2)}{k.group(3)}"{k.group(4)}"', stripped)
+    if "L" in stripped or "l" in stripped or "#" in stripped:
+        stripped = _CALL_PATH.sub(lambda k: f'{k.group(1)}{k.group(2)}{k.group(3)}"{k.group(4)}"',
+                                  stripped)
 
     def qual(k):
         line.qualifiers.append((k.group(1), k.group(2).upper()))
         return f"M{k.group(1)}"
-    stripped = _M_QUAL.sub(qual, stripped)
+    if "." in stripped:
+        stripped = _M_QUAL.sub(qual, stripped)
     line.code = upper_outside_strings(stripped)
     if not line.code and line.number is None and line.label is None and not line.skip:
         line.kind = "blank"
@@ -111,6 +114,8 @@ def split(n: int, raw: str) -> Line:
 
 
 def upper_outside_strings(text: str) -> str:
+    if '"' not in text:
+        return text.upper()
     out, inq, i = [], False, 0
     while i < len(text):
         ch = text[i]
@@ -128,6 +133,8 @@ def upper_outside_strings(text: str) -> str:
 def _strip_comments(raw: str) -> tuple[str, Optional[str], Optional[tuple[str, str, int]]]:
     """(code with comments blanked out, comment text, error): `;` to the end of the line and
     `( .. )` anywhere, both only outside strings. Columns are kept (comments become blanks)."""
+    if ";" not in raw and "(" not in raw and '"' not in raw:
+        return raw, None, None
     out = []
     comments = []
     inq = False

@@ -96,6 +96,8 @@ class _Expr:
         self.note = note
 
     def __call__(self, t) -> ir.Expr:
+        if type(t) is ir.Num:           # a word read without the grammar (_plain_items)
+            return t
         if isinstance(t, Token):
             if t.type == "NUMBER":
                 return ir.Num(float(t), str(t))
@@ -229,6 +231,7 @@ class Lowerer:
         self.soft_limits: list[dict] = []
         self.mirror: set[str] = set()     # axes mirrored by G11-G14, in source order
         self.offset: ir.Expr = ir.Num(1.0, "1")   # the D in force (D1 is the default)
+        self.distance = "absolute"                 # G90/G91 in source order (for G198/G199)
 
     def note(self, rule: str, severity: str, message: str, col: Optional[int] = None) -> None:
         self.diags.append(Diagnostic(rule, severity, message, self.file, self.line, col or self.col))
@@ -364,6 +367,8 @@ class Lowerer:
                 out.append((B_WCS, ir.ModeChange("work_offset", name, f"G159={int(n)}")))
             elif g in SIMPLE_GROUPS:
                 out.append((SIMPLE_GROUPS[g], ir.ModeChange(g, v, code)))
+                if g == "distance":
+                    self.distance = v
             elif g == "cycle":
                 if v == "off":
                     self.cycle = False
@@ -618,7 +623,9 @@ class Lowerer:
             if rule.group != "soft_limit":
                 continue
             axes = {a: vals.pop(a) for a in list(vals) if a in AXES}
-            entry = {"line": self.line, "bound": rule.value, "axes": {}}
+            # G90: machine coordinates; G91: relative to the limit in force (spec §11.2)
+            entry = {"line": self.line, "bound": rule.value, "axes": {},
+                     "incremental": self.distance == "incremental"}
             for a, e in axes.items():
                 c = _const(e)
                 if c is None:
@@ -669,6 +676,8 @@ _INSTR = re.compile(r'#([A-Z][A-Z0-9]*)')
 
 def find_instruction(code: str) -> Optional[tuple[int, int, str]]:
     """(start, end, name) of the `#` instruction in a block (outside strings), or None."""
+    if "#" not in code:
+        return None
     inq = False
     for i, ch in enumerate(code):
         if ch == '"':
@@ -787,14 +796,17 @@ class Parser:
                                                                    DIALECT)], number, line.label))
             return
         code = line.code
-        code = re.sub(r'(\$GOTO\s*)\[\s*([A-Z0-9_]+)\s*\]', r'\1"\2"', code)
+        if "$GOTO" in code:
+            code = re.sub(r'(\$GOTO\s*)\[\s*([A-Z0-9_]+)\s*\]', r'\1"\2"', code)
         found = find_instruction(code)
         head, instr, tail = code, None, ""
         if found is not None:
             head, instr, tail = code[:found[0]], found[2], code[found[1]:]
         body: list = []
         try:
-            tree = parser().parse(head, start="start") if head.strip() else Tree("start", [])
+            fast = _plain_items(head)
+            tree = Tree("start", fast) if fast is not None else (  # type: ignore[arg-type]
+                parser().parse(head, start="start") if head.strip() else Tree("start", []))
         except UnexpectedInput as e:
             self._syntax(e, head, line)
             self.unit.current.append(ir.Block(span, [ir.Passthrough(code, "syntax error", DIALECT)],
@@ -1123,6 +1135,36 @@ class Parser:
                 continue
             host.body.remove(marker)
             body[idx + 1:idx + 1] = copies
+
+
+_NUM = r"(?:\d+\.?\d*|\.\d+)"
+_PLAIN = re.compile(rf"(?:\s*[A-Z]\s*[-+]?\s*{_NUM})+\s*")
+_PAIR = re.compile(rf"([A-Z])\s*([-+]?)\s*({_NUM})")
+
+
+class _PlainWord:
+    """A letter-number word read without the grammar: the shape of the grammar's word tree, with
+    its value already an IR number."""
+    __slots__ = ("data", "children")
+
+    def __init__(self, letter: str, value: ir.Num):
+        self.data = "gword" if letter == "G" else "word"
+        self.children = (letter, value)
+
+
+def _plain_items(code: str) -> Optional[list]:
+    """Blocks made only of letter-number words (`G01 X10.5 Y-3 F500`, the bulk of CAM output), as
+    the words the grammar would build, without the lexer and parser; anything else returns None
+    and takes the grammar of record (tests hold both to the same result)."""
+    if not code or not _PLAIN.fullmatch(code):
+        return None
+    out = []
+    for m in _PAIR.finditer(code):
+        letter, sign, number = m.groups()
+        value = float(number)
+        out.append(_PlainWord(letter, ir.Num(-value if sign == "-" else value,
+                                             ("-" if sign == "-" else "") + number)))
+    return out
 
 
 _FLOW = frozenset(("if_", "if_goto", "elseif", "else_", "endif", "while_", "endwhile", "do_", "enddo",
