@@ -121,6 +121,16 @@ def test_arc_facts():
     assert helix.start["Z"] == 0 and helix.end["Z"] == -5    # a full circle rising to Z-5
 
 
+def test_tangent_and_three_point_arcs():
+    _, recs, _ = _run("%T\nG00 X0 Y0 Z0\nG01 X10 F100\nG08 X20 Y10\nG09 X20 Y30 I30 J20\nX0\nM30\n")
+    arcs = [r for r in recs if r.kind == "arc"]
+    # G08 from (10,0) heading +X to (20,10): centre (10,10), counter-clockwise
+    assert (round(arcs[0].center["X"], 6), round(arcs[0].center["Y"], 6), arcs[0].direction) == (10, 10, "ccw")
+    # G09 from (20,10) through (30,20) to (20,30): centre (20,20), counter-clockwise; G01 again after
+    assert (round(arcs[1].center["X"], 6), round(arcs[1].center["Y"], 6), arcs[1].direction) == (20, 20, "ccw")
+    assert recs[-2].kind == "linear" and _end(recs[-2]) == (0, 30, 0)
+
+
 def test_tool_facts():
     """08-tools: one tool change, three dwells of 0.5 s, 2 s and 1.5 s, the spindle at 1000 rpm."""
     _, recs, _ = _corpus("08-tools.nc", "tool")
@@ -182,6 +192,8 @@ CONSTRUCTS = [
     ("G01 R10 Q90 F100", (0, 10, 0)),                        # polar
     ("G01 X10 F100\nG03 X0 Y10 R10", (0, 10, 0)),
     ("G18 G01 X10 F100\nG02 X0 Z10 I-10 K0", (0, 0, 10)),    # ZX plane, I K
+    ("G01 X10 F100\nG08 X20 Y10", (20, 10, 0)),             # tangent arc: centre (10, 10)
+    ("G01 X0 F100\nG09 X20 Y0 I10 J10", (20, 0, 0)),         # through (10, 10): centre (10, 0)
     ("N10: G01 X1 F100\n$GOTO N30\nX99\nN30: X2", (2, 0, 0)),
     ("[START] G01 X1 F100\n$IF 0 $GOTO [START]\nX3", (3, 0, 0)),
     ("G01 X1 F100 ; comment\nX2 (comment) Y1 (another)", (2, 1, 0)),
