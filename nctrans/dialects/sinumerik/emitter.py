@@ -362,7 +362,7 @@ class Emitter:
         elif isinstance(s, ir.Passthrough):
             if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
                 out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
-            elif _reads_as_sinumerik(s.text):
+            elif _reads_as_sinumerik(s.text, moves_allowed=s.reason != "directive"):
                 self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
                                           f"{s.text} ({s.reason})", self.span))
                 out.words.append(s.text)
@@ -810,16 +810,17 @@ class Emitter:
         return "\n".join(self.lines) + "\n"
 
 
-def _reads_as_sinumerik(text: str) -> bool:
-    """Foreign text is kept verbatim (NC403) only when it is also a valid Sinumerik block."""
+def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
+    """Foreign text is kept verbatim (NC403) only when it is also a valid Sinumerik block; a
+    directive (no effect on the path where it comes from, such as Fagor's "G198 X-100" limits)
+    that would move the axes here is not."""
     from nctrans.dialects.sinumerik.frontend import parse
     if not text.strip() or "\n" in text or ";" in text:
         return False
     res = parse(text, "<passthrough>")
-    # text that would move the axes on a Sinumerik (Fagor "G198 X-100": limits, not a move) is
-    # not the same construct there: refused, not kept
     return not res.diagnostics and all(
-        (not isinstance(s, ir.Passthrough) or s.reason != "syntax error") and not isinstance(s, ir.Motion)
+        (not isinstance(s, ir.Passthrough) or s.reason != "syntax error")
+        and (moves_allowed or not isinstance(s, ir.Motion))
         for b in res.program.body if isinstance(b, ir.Block) for s in b.body)
 
 
