@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 import rs274 as h
-from nctrans import equiv
+from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.machine import default_mill

@@ -14,7 +14,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from nctrans import cli, detect, equiv
+from nctrans import cli
+from nctrans import detection as detect
+from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.machine import Axis, Machine, Tool, default_mill

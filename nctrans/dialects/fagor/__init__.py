@@ -37,12 +37,18 @@ MARKERS = (
 
 
 class Fagor(IsoFamily):
+    """Fagor is an ISO-family dialect in its word-address blocks (its table, rules/fagor.toml,
+    gives the G/M codes their neutral meaning), but the rest of its block language (`[ ]`
+    expressions, `( )` comments anywhere, `$` flow, `#` instructions, P/V variables, `N<n>:` and
+    `[LABEL]` targets) has its own grammar of record, so it brings its own front end and emitter
+    instead of the ISO Lowering/IsoEmitter, and it does not stream (programs read as a whole)."""
     name = "fagor"
     description = "Fagor CNC 8060/8065"
     extensions = (".nc", ".pim", ".fnc")
     markers = MARKERS
     comment_evidence = {"semicolon_line": (0.5, 2)}
     subprogram_endings = (".nc", ".NC", ".pim", ".fnc", ".fst")
+    streams = False
 
     def sniff(self, text: str) -> float:
         """0..1: share of Fagor markers found in the first 20 000 characters."""
@@ -59,6 +65,15 @@ class Fagor(IsoFamily):
     def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
         from .frontend import parse
         return parse(text, file)
+
+    def parse_stream(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        return None
+
+    def lowering(self):
+        raise NotImplementedError("fagor has its own front end (nctrans.dialects.fagor.frontend)")
+
+    def emitter(self):
+        raise NotImplementedError("fagor has its own emitter (nctrans.dialects.fagor.emitter)")
 
     def emit(self, program) -> EmitResult:
         from .emitter import emit_program
