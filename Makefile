@@ -19,6 +19,8 @@ venv: $(STAMP)
 run: $(STAMP)
 	$(BIN)/nctrans convert $(SAMPLE) --from iso-m --to sinumerik
 	$(BIN)/nctrans toolpath $(SAMPLE) --from iso-m --summary
+	$(BIN)/nctrans backplot $(SAMPLE) --from iso-m -o out/sample-backplot.html
+	@echo "backplot viewer: $(CURDIR)/out/sample-backplot.html"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider --basetemp=$(CURDIR)/.pytest-tmp

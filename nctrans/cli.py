@@ -24,7 +24,7 @@ from nctrans.diagnostics import SEVERITY_RANK, Diagnostic
 # use them: start-up time is a large share of a `toolpath` or `lint` run on one file.
 
 EXIT_OK, EXIT_DIAGNOSTICS, EXIT_USAGE = 0, 1, 2
-NOT_IMPLEMENTED = ("check", "backplot", "audit", "fuzz", "lsp")
+NOT_IMPLEMENTED = ("check", "audit", "fuzz", "lsp")
 
 
 class UsageError(Exception):
@@ -109,14 +109,15 @@ def _same_file(a: Path, b: Path) -> bool:
     return a.resolve() == b.resolve()
 
 
-def write_atomic(path: Path, text: str) -> None:
-    """Write `text` to `path` through a temporary file in the same directory and os.replace, so a
-    reader never sees a half-written program and a failure leaves any old file intact."""
+def write_atomic(path: Path, text: str | bytes) -> None:
+    """Write `text` (or bytes) to `path` through a temporary file in the same directory and
+    os.replace, so a reader never sees a half-written file and a failure leaves any old file intact."""
     import tempfile
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+        binary = isinstance(text, bytes)
+        with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8", newline="")) as fh:
             fh.write(text)
             fh.flush()
             os.fsync(fh.fileno())
@@ -316,6 +317,83 @@ def cmd_equiv(args) -> int:
     return EXIT_DIAGNOSTICS if _at_or_above(result.diagnostics, "error") else EXIT_OK
 
 
+# --------------------------------------------------------------------------- backplot
+
+def _plot_input(path: str, dialect: Optional[str], machine_path: Optional[str]):
+    """(loaded file, machine, toolpath records) of one backplot input."""
+    _check_dialect(dialect)
+    ld = pipeline.load(path, dialect, stream=True)
+    machine = pipeline.load_machine(machine_path, ld.dialect)
+    records = list(pipeline.toolpath_of(ld, machine))   # a finished run completes ld.diagnostics
+    return ld, machine, records
+
+
+def cmd_backplot(args) -> int:
+    from nctrans import backplot
+    fmt = backplot.format_for(args.output)
+    if fmt is None:
+        raise UsageError(f"-o {args.output}: the ending must be one of {', '.join(backplot.FORMATS)}")
+    out = Path(args.output)
+    if out.is_dir():
+        raise UsageError(f"{out}: is a directory")
+    for src in [args.src] + ([args.compare] if args.compare else []):
+        if src != _source.STDIN and _same_file(out, Path(src)):
+            raise UsageError(f"refusing to overwrite the input {src} with the output {out}")
+    if args.tol is not None and not args.tol > 0:
+        raise UsageError("--tol must be a positive number of mm")
+    ld, machine, records = _plot_input(args.src, args.from_, args.machine)
+    status = EXIT_OK
+    diags = list(ld.diagnostics)
+    if ld.program is None:
+        _print_text_diags(diags, sys.stderr)
+        _err(f"{ld.label}: not plotted (errors above)")
+        return EXIT_DIAGNOSTICS
+    scene = backplot.build_scene(records, ld.label, diags)
+    sources = {ld.label: ld.source.text}
+    comparison = None
+    if args.compare:
+        from nctrans.equiv import DEFAULT_TOL
+        from nctrans.backplot.compare import compare_scenes
+        lb, _mb, records_b = _plot_input(args.compare, args.from_b, args.machine)
+        diags += lb.diagnostics
+        if lb.program is None:
+            _print_text_diags(diags, sys.stderr)
+            _err(f"{lb.label}: not plotted (errors above)")
+            return EXIT_DIAGNOSTICS
+        scene_b = backplot.build_scene(records_b, lb.label, lb.diagnostics)
+        sources.setdefault(lb.label, lb.source.text)
+        comparison = compare_scenes(scene, scene_b, records, records_b, args.tol or DEFAULT_TOL)
+    _print_text_diags(diags, sys.stderr)
+    if scene.empty and (comparison is None or comparison.b.empty):
+        _err(f"{ld.label}: the toolpath has no moves: nothing to plot")
+        return EXIT_DIAGNOSTICS
+    for sc in [scene] + ([comparison.b] if comparison else []):
+        for f in sc.files():
+            if f not in sources:
+                try:
+                    sources[f] = _source.read_source(f).text
+                except _source.SourceError:
+                    pass
+        for w in sc.warnings:
+            _err(f"{sc.label}: note: {w}")
+    data = backplot.render(fmt, scene, view=args.view, comparison=comparison, machine=machine,
+                           sources=sources)
+    try:
+        write_atomic(out, data)
+    except OSError as e:
+        _err(f"{out}: cannot write: {e.strerror or e}")
+        return EXIT_USAGE
+    moves = len(scene.moves) + (len(comparison.b.moves) if comparison else 0)
+    print(f"wrote {out} ({fmt}, {moves} moves)")
+    if comparison is not None:
+        print("equivalent" if comparison.equivalent else f"different: {comparison.marks[0].message}")
+        if not comparison.equivalent:
+            status = EXIT_DIAGNOSTICS
+    if _at_or_above(diags, "error"):
+        status = EXIT_DIAGNOSTICS
+    return status
+
+
 # --------------------------------------------------------------------------- detect, rules, stubs
 
 def cmd_detect(args) -> int:
@@ -419,6 +497,20 @@ def build_parser() -> argparse.ArgumentParser:
                    help="tolerance in mm (default 0.001)")
     _add_search_path(p)
     p.set_defaults(func=cmd_equiv)
+
+    p = sub.add_parser("backplot", help="plot the toolpath (svg, png, glb or an html viewer)")
+    p.add_argument("src", metavar="SRC", help="source file ('-' = stdin)")
+    p.add_argument("-o", dest="output", required=True, metavar="OUT",
+                   help="output file; the format is its ending: .svg .png .glb .html")
+    p.add_argument("--from", dest="from_", metavar="DIALECT")
+    p.add_argument("--view", choices=("top", "front", "side", "iso"), default="top",
+                   help="2D view for svg/png, first view of the html viewer (default top)")
+    p.add_argument("--machine", metavar="MACHINE.toml", help="machine (offsets, tools; stock and fixtures in glb)")
+    p.add_argument("--compare", metavar="B", help="overlay a second program and mark where the toolpaths differ")
+    p.add_argument("--from-b", metavar="DIALECT", help="dialect of the --compare program")
+    p.add_argument("--tol", type=float, default=None, metavar="MM", help="--compare tolerance in mm (default 0.001)")
+    _add_search_path(p)
+    p.set_defaults(func=cmd_backplot)
 
     p = sub.add_parser("detect", help="guess the dialect of files")
     p.add_argument("files", nargs="+", metavar="FILE")

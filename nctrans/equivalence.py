@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Iterable, Optional
+from typing import Iterable, Iterator, Optional
 
 from nctrans.toolpath import ToolpathRecord
 from nctrans.toolpath_io import PLANE_AXES, arc_sweep
@@ -293,6 +293,17 @@ def _what_next(seq: list, n: int) -> str:
 def compare(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: float = DEFAULT_TOL
             ) -> Optional[Difference]:
     """The first difference between toolpaths a and b, or None when they are equivalent."""
+    for d in differences(a, b, tol):
+        return d
+    return None
+
+
+def differences(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: float = DEFAULT_TOL
+                ) -> Iterator[Difference]:
+    """Every difference between the pieces (runs of motion, gaps of events) of a and b paired in
+    order; the first is compare's answer. Pairing is by position, so once the two have gone out of
+    step (a missing run), later differences may follow from the first (backplot --compare marks
+    them all)."""
     la, lb = list(a), list(b)
     axes = _axes_of(la + lb)
     sa, sb = build_sequence(la, axes, tol), build_sequence(lb, axes, tol)
@@ -310,13 +321,13 @@ def compare(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: float
         else:  # cannot happen: both sequences alternate gap/run from a gap
             d = Difference("toolpaths differ in structure", last_a, last_b)
         if d is not None:
-            return d
+            yield d
     if len(sa) != len(sb):
         longer, name = (sa, "A") if len(sa) > len(sb) else (sb, "B")
         extra = longer[min(len(sa), len(sb))]
         rec = extra.recs[0] if isinstance(extra, _Run) else (extra.events[0][2] if extra.events else None)
         what = f"{extra.cls} motion" if isinstance(extra, _Run) else "events"
         if name == "A":
-            return Difference(f"A continues with {what}; B has ended", rec, last_b)
-        return Difference(f"B continues with {what}; A has ended", last_a, rec)
-    return None
+            yield Difference(f"A continues with {what}; B has ended", rec, last_b)
+        else:
+            yield Difference(f"B continues with {what}; A has ended", last_a, rec)

@@ -50,6 +50,21 @@ def rs274() -> Path:
 
 
 @pytest.fixture(scope="session")
+def chromium():
+    """A headless Chromium (tests/browser.py): skip without one, but fail when CI is set."""
+    import browser
+    if not browser.CHROMIUM:
+        msg = "chromium not found (Debian package chromium; or set CHROMIUM=path)"
+        if os.environ.get("CI"):
+            pytest.fail(msg + " and CI is set: the backplot viewer must be tested in a real browser",
+                        pytrace=False)
+        pytest.skip(msg)
+    b = browser.Browser()
+    yield b
+    b.close()
+
+
+@pytest.fixture(scope="session")
 def rs274_cache(tmp_path_factory) -> Path:
     """Per-session directory for rs274 outputs, so each program runs through rs274 once."""
     return tmp_path_factory.mktemp("rs274")
