@@ -76,8 +76,11 @@
   const A = programs[0];
 
   // ------------------------------------------------------------------ WebGL
-  const gl = canvas.getContext("webgl2", { antialias: true, preserveDrawingBuffer: true }) ||
-             canvas.getContext("webgl", { antialias: true, preserveDrawingBuffer: true });
+  // Multisampling costs several times the frame on a software renderer (a browser without a GPU,
+  // headless Chromium): large programs, whose lines are dense anyway, are drawn without it.
+  const totalSegs = programs.reduce((a, P) => a + P.segs, 0);
+  const GL_OPTIONS = { antialias: totalSegs < 50000, depth: false };
+  const gl = canvas.getContext("webgl2", GL_OPTIONS) || canvas.getContext("webgl", GL_OPTIONS);
   if (!gl) {
     $("plot").innerHTML = '<p id="nogl">This browser gives the page no WebGL: the plot cannot be drawn.</p>';
     return;
@@ -312,19 +315,26 @@
 
   // ------------------------------------------------------------------ picking
   function pick(mx, my) {
-    const b = basis();
-    let best = null, bestD = 8;
-    programs.forEach((P, k) => {
-      const last = P.sstart[Math.min(k === 0 ? state.step : P.n, P.n)];
+    const { r, u } = basis();
+    const w2 = canvas.clientWidth / 2, h2 = canvas.clientHeight / 2, c = cam.c, k = 1 / cam.s;
+    // screen x = w2 + (p - c).r / s, y = h2 - (p - c).u / s, written out: no allocation per point
+    const ox = w2 - (c[0] * r[0] + c[1] * r[1] + c[2] * r[2]) * k, oy = h2 + (c[0] * u[0] + c[1] * u[1] + c[2] * u[2]) * k;
+    const rx = r[0] * k, ry = r[1] * k, rz = r[2] * k, ux = u[0] * k, uy = u[1] * k, uz = u[2] * k;
+    let best = null, bestD = 8 * 8;
+    programs.forEach((P, q) => {
+      const last = P.sstart[Math.min(q === 0 ? state.step : P.n, P.n)];
       const pos = P.pos;
       for (let s = 0; s < last; s++) {
-        const a = toScreen([pos[s * 6], pos[s * 6 + 1], pos[s * 6 + 2]], b);
-        const c = toScreen([pos[s * 6 + 3], pos[s * 6 + 4], pos[s * 6 + 5]], b);
-        const vx = c[0] - a[0], vy = c[1] - a[1], l2 = vx * vx + vy * vy;
-        let t = l2 > 0 ? ((mx - a[0]) * vx + (my - a[1]) * vy) / l2 : 0;
-        t = Math.max(0, Math.min(1, t));
-        const dd = Math.hypot(a[0] + t * vx - mx, a[1] + t * vy - my);
-        if (dd < bestD) { bestD = dd; best = { program: k, segment: s }; }
+        const o = s * 6;
+        const ax = ox + pos[o] * rx + pos[o + 1] * ry + pos[o + 2] * rz;
+        const ay = oy - (pos[o] * ux + pos[o + 1] * uy + pos[o + 2] * uz);
+        const vx = ox + pos[o + 3] * rx + pos[o + 4] * ry + pos[o + 5] * rz - ax;
+        const vy = oy - (pos[o + 3] * ux + pos[o + 4] * uy + pos[o + 5] * uz) - ay;
+        const l2 = vx * vx + vy * vy;
+        let t = l2 > 0 ? ((mx - ax) * vx + (my - ay) * vy) / l2 : 0;
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        const dx = ax + t * vx - mx, dy = ay + t * vy - my, dd = dx * dx + dy * dy;
+        if (dd < bestD) { bestD = dd; best = { program: q, segment: s }; }
       }
     });
     if (!best) return null;
@@ -535,18 +545,56 @@
   setView(D.view);
   state.loadMs = performance.now() - t0;
 
+  function midpoint(k, i) {
+    const P = programs[k];
+    const a = P.mstart[i], b = P.mstart[i + 1] - 1;
+    const v = a + Math.floor((b - a) / 2);
+    if (b - a >= 2) return [P.pts[v * 3 + 3], P.pts[v * 3 + 4], P.pts[v * 3 + 5]];
+    return [(P.pts[a * 3] + P.pts[b * 3]) / 2, (P.pts[a * 3 + 1] + P.pts[b * 3 + 1]) / 2, (P.pts[a * 3 + 2] + P.pts[b * 3 + 2]) / 2];
+  }
+
   window.ncViewer = {
-    state, programs, cam, setView, setStep, selectMove, selectLine, fit, drawNow,
+    state, programs, cam, setView, setStep, selectMove, selectLine, fit, drawNow, pick,
+    /** Mean milliseconds per frame over n orbiting frames, waiting for the GPU each time. */
+    timeFrames(n) {
+      const px = new Uint8Array(4), t = performance.now();
+      for (let i = 0; i < n; i++) {
+        cam.yaw += 360 / n;
+        drawNow();
+        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+      }
+      return (performance.now() - t) / n;
+    },
+    /** Smallest page distance (CSS px) from move i's screen point to a segment of a move on another line. */
+    clearance(k, i) {
+      const [x, y] = this.screenOfMove(k, i), rect = canvas.getBoundingClientRect();
+      const mx = x - rect.left, my = y - rect.top, b = basis();
+      const f0 = programs[k].file[i], l0 = programs[k].line[i];
+      let best = Infinity;
+      programs.forEach((P, q) => {
+        for (let m = 0; m < P.n; m++) {
+          if (q === k && P.file[m] === f0 && P.line[m] === l0) continue;
+          for (let s = P.sstart[m]; s < P.sstart[m + 1]; s++) {
+            const a = toScreen([P.pos[s * 6], P.pos[s * 6 + 1], P.pos[s * 6 + 2]], b);
+            const c = toScreen([P.pos[s * 6 + 3], P.pos[s * 6 + 4], P.pos[s * 6 + 5]], b);
+            const vx = c[0] - a[0], vy = c[1] - a[1], l2 = vx * vx + vy * vy;
+            const t = l2 > 0 ? Math.max(0, Math.min(1, ((mx - a[0]) * vx + (my - a[1]) * vy) / l2)) : 0;
+            best = Math.min(best, Math.hypot(a[0] + t * vx - mx, a[1] + t * vy - my));
+          }
+        }
+      });
+      return best;
+    },
     /** CSS-pixel point (page coordinates) in the middle of a move's drawn polyline. */
     screenOfMove(k, i) {
-      const P = programs[k];
-      const a = P.mstart[i], b = P.mstart[i + 1] - 1;
-      const v = a + Math.floor((b - a) / 2);
-      let p;
-      if (b - a >= 2) p = [P.pts[v * 3 + 3], P.pts[v * 3 + 4], P.pts[v * 3 + 5]];
-      else p = [(P.pts[a * 3] + P.pts[b * 3]) / 2, (P.pts[a * 3 + 1] + P.pts[b * 3 + 1]) / 2, (P.pts[a * 3 + 2] + P.pts[b * 3 + 2]) / 2];
-      const s = toScreen(p), rect = canvas.getBoundingClientRect();
+      const s = toScreen(midpoint(k, i)), rect = canvas.getBoundingClientRect();
       return [rect.left + s[0], rect.top + s[1]];
+    },
+    /** Centre the view on a move and zoom in by `factor`. */
+    focusMove(k, i, factor) {
+      cam.c = midpoint(k, i);
+      cam.s /= factor || 1;
+      drawNow();
     },
   };
 })();

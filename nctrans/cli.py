@@ -376,8 +376,11 @@ def cmd_backplot(args) -> int:
                     pass
         for w in sc.warnings:
             _err(f"{sc.label}: note: {w}")
-    data = backplot.render(fmt, scene, view=args.view, comparison=comparison, machine=machine,
-                           sources=sources)
+    try:
+        data = backplot.render(fmt, scene, view=args.view, comparison=comparison, machine=machine,
+                               sources=sources)
+    except backplot.BackplotError as e:
+        raise UsageError(str(e)) from None
     try:
         write_atomic(out, data)
     except OSError as e:

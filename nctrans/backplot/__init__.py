@@ -13,7 +13,13 @@ from nctrans.backplot.scene import Finding, Scene, build_scene
 FORMATS = {".svg": "svg", ".png": "png", ".glb": "glb", ".html": "html", ".htm": "html"}
 VIEW_NAMES = ("top", "front", "side", "iso")
 
-__all__ = ["FORMATS", "VIEW_NAMES", "Finding", "Scene", "build_scene", "format_for", "render"]
+
+
+class BackplotError(Exception):
+    """Something the plot needs that cannot be had (a machine mesh that does not load): exit 2."""
+
+
+__all__ = ["BackplotError", "FORMATS", "VIEW_NAMES", "Finding", "Scene", "build_scene", "format_for", "render"]
 
 
 def format_for(path: str | Path) -> Optional[str]:

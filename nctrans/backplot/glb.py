@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
+from nctrans.backplot import BackplotError
 from nctrans.backplot import project as P
 from nctrans.backplot.compare import Comparison
 from nctrans.backplot.scene import Scene
@@ -24,7 +25,7 @@ MARKER_COLOURS = {"start": (0.0, 0.67, 0.0, 1.0), "tool_change": (1.0, 0.8, 0.0,
                   "difference": (0.82, 0.0, 0.0, 1.0)}
 
 
-class GlbError(Exception):
+class GlbError(BackplotError):
     """A machine mesh that cannot be loaded (reported by the CLI, exit 2)."""
 
 
