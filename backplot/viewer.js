@@ -314,34 +314,40 @@
   }
 
   // ------------------------------------------------------------------ picking
-  function pick(mx, my) {
+  /** Squared page distance from (mx, my) to each segment [from, to) of P: calls visit(segment, d2). */
+  function scanSegments(P, from, to, mx, my, visit) {
     const { r, u } = basis();
     const w2 = canvas.clientWidth / 2, h2 = canvas.clientHeight / 2, c = cam.c, k = 1 / cam.s;
     // screen x = w2 + (p - c).r / s, y = h2 - (p - c).u / s, written out: no allocation per point
     const ox = w2 - (c[0] * r[0] + c[1] * r[1] + c[2] * r[2]) * k, oy = h2 + (c[0] * u[0] + c[1] * u[1] + c[2] * u[2]) * k;
     const rx = r[0] * k, ry = r[1] * k, rz = r[2] * k, ux = u[0] * k, uy = u[1] * k, uz = u[2] * k;
+    const pos = P.pos;
+    for (let s = from; s < to; s++) {
+      const o = s * 6;
+      const ax = ox + pos[o] * rx + pos[o + 1] * ry + pos[o + 2] * rz;
+      const ay = oy - (pos[o] * ux + pos[o + 1] * uy + pos[o + 2] * uz);
+      const vx = ox + pos[o + 3] * rx + pos[o + 4] * ry + pos[o + 5] * rz - ax;
+      const vy = oy - (pos[o + 3] * ux + pos[o + 4] * uy + pos[o + 5] * uz) - ay;
+      const l2 = vx * vx + vy * vy;
+      let t = l2 > 0 ? ((mx - ax) * vx + (my - ay) * vy) / l2 : 0;
+      t = t < 0 ? 0 : t > 1 ? 1 : t;
+      const dx = ax + t * vx - mx, dy = ay + t * vy - my;
+      visit(s, dx * dx + dy * dy);
+    }
+  }
+  function moveOfSegment(P, seg) {
+    let lo = 0, hi = P.n - 1;
+    while (lo < hi) { const mid = (lo + hi + 1) >> 1; if (P.sstart[mid] <= seg) lo = mid; else hi = mid - 1; }
+    return lo;
+  }
+  function pick(mx, my) {
     let best = null, bestD = 8 * 8;
     programs.forEach((P, q) => {
       const last = P.sstart[Math.min(q === 0 ? state.step : P.n, P.n)];
-      const pos = P.pos;
-      for (let s = 0; s < last; s++) {
-        const o = s * 6;
-        const ax = ox + pos[o] * rx + pos[o + 1] * ry + pos[o + 2] * rz;
-        const ay = oy - (pos[o] * ux + pos[o + 1] * uy + pos[o + 2] * uz);
-        const vx = ox + pos[o + 3] * rx + pos[o + 4] * ry + pos[o + 5] * rz - ax;
-        const vy = oy - (pos[o + 3] * ux + pos[o + 4] * uy + pos[o + 5] * uz) - ay;
-        const l2 = vx * vx + vy * vy;
-        let t = l2 > 0 ? ((mx - ax) * vx + (my - ay) * vy) / l2 : 0;
-        t = t < 0 ? 0 : t > 1 ? 1 : t;
-        const dx = ax + t * vx - mx, dy = ay + t * vy - my, dd = dx * dx + dy * dy;
-        if (dd < bestD) { bestD = dd; best = { program: q, segment: s }; }
-      }
+      scanSegments(P, 0, last, mx, my, (s, dd) => { if (dd < bestD) { bestD = dd; best = { program: q, segment: s }; } });
     });
     if (!best) return null;
-    const P = programs[best.program];
-    let lo = 0, hi = P.n - 1;               // move whose segment range holds the segment
-    while (lo < hi) { const mid = (lo + hi + 1) >> 1; if (P.sstart[mid] <= best.segment) lo = mid; else hi = mid - 1; }
-    return { program: best.program, move: lo };
+    return { program: best.program, move: moveOfSegment(programs[best.program], best.segment) };
   }
   function selectMove(k, i, scroll) {
     const P = programs[k];
@@ -568,22 +574,17 @@
     /** Smallest page distance (CSS px) from move i's screen point to a segment of a move on another line. */
     clearance(k, i) {
       const [x, y] = this.screenOfMove(k, i), rect = canvas.getBoundingClientRect();
-      const mx = x - rect.left, my = y - rect.top, b = basis();
+      const mx = x - rect.left, my = y - rect.top;
       const f0 = programs[k].file[i], l0 = programs[k].line[i];
       let best = Infinity;
       programs.forEach((P, q) => {
-        for (let m = 0; m < P.n; m++) {
-          if (q === k && P.file[m] === f0 && P.line[m] === l0) continue;
-          for (let s = P.sstart[m]; s < P.sstart[m + 1]; s++) {
-            const a = toScreen([P.pos[s * 6], P.pos[s * 6 + 1], P.pos[s * 6 + 2]], b);
-            const c = toScreen([P.pos[s * 6 + 3], P.pos[s * 6 + 4], P.pos[s * 6 + 5]], b);
-            const vx = c[0] - a[0], vy = c[1] - a[1], l2 = vx * vx + vy * vy;
-            const t = l2 > 0 ? Math.max(0, Math.min(1, ((mx - a[0]) * vx + (my - a[1]) * vy) / l2)) : 0;
-            best = Math.min(best, Math.hypot(a[0] + t * vx - mx, a[1] + t * vy - my));
-          }
-        }
+        scanSegments(P, 0, P.segs, mx, my, (s, dd) => {
+          if (dd >= best) return;
+          const m = moveOfSegment(P, s);
+          if (!(q === k && P.file[m] === f0 && P.line[m] === l0)) best = dd;
+        });
       });
-      return best;
+      return Math.sqrt(best);
     },
     /** CSS-pixel point (page coordinates) in the middle of a move's drawn polyline. */
     screenOfMove(k, i) {

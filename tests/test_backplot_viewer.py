@@ -62,7 +62,7 @@ def click_move(page, i: int) -> dict:
                          " hl: [...document.querySelectorAll('#src .src-line.hl')].map(e => +e.dataset.line)})")
 
 
-def isolated_move(page, moves: list[dict], need_px: float = 12.0, tries: int = 200) -> int:
+def isolated_move(page, moves: list[dict], need_px: float = 12.0, tries: int = 60) -> int:
     """A move whose screen point stands apart from every move of another source line, so a click
     there can only mean it: of the longest straight moves, the one with the most room around it,
     with the view centred on it and zoomed until that room is need_px."""
