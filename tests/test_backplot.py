@@ -293,3 +293,39 @@ def test_compare_marks_where_an_edited_program_differs(tmp_path):
     assert f"{SAMPLE.name}:21:" in r.stdout and "edited.nc:21:" in r.stdout
     marks = ET.parse(out).getroot().findall(f".//{SVG_NS}g[@class='difference']")
     assert [m.get("data-line") for m in marks[:2]] == ["21", "21"]      # A's mark, then B's
+
+
+# --------------------------------------------------------------------------- findings
+
+FINDING_PROGRAM = "%\nO1\nG21 G90 G17\nG0 X0 Y0 Z5\nG0 G1 X10 F100\nM30\n%\n"     # NC201 on line 5
+
+
+def test_lint_findings_are_marked_where_their_line_moves_the_tool(tmp_path):
+    src = tmp_path / "f.nc"
+    src.write_text(FINDING_PROGRAM)
+    out = tmp_path / "f.svg"
+    r = run("backplot", src, "-o", out)
+    assert r.returncode == 0 and "NC201" in r.stderr
+    root = ET.parse(out).getroot()
+    marks = root.findall(f".//{SVG_NS}g[@class='finding warning']")
+    assert [m.get("data-line") for m in marks] == ["5"]
+    assert "NC201" in "".join(marks[0].itertext())
+    # drawn at the end of line 5's move (X10 Y0): the end point of that move's path
+    move = [p for p in _move_paths(root) if p.get("data-line") == "5"][0]
+    ex, ey = _numbers(move.get("d"))[-2:]
+    rect = marks[0].find(f"{SVG_NS}rect")
+    assert float(rect.get("x")) + 5 == pytest.approx(ex) and float(rect.get("y")) + 5 == pytest.approx(ey)
+
+
+def test_findings_interface_takes_plain_records_with_or_without_a_position():
+    from nctrans.backplot import build_scene
+    from nctrans.toolpath import ToolpathRecord
+    recs = [ToolpathRecord(1, "p.nc", 4, "rapid", {"X": 0.0, "Y": 0.0, "Z": 5.0}, {"X": 0.0, "Y": 0.0, "Z": 1.0}),
+            ToolpathRecord(2, "p.nc", 6, "linear", {"X": 0.0, "Y": 0.0, "Z": 1.0}, {"X": 8.0, "Y": 0.0, "Z": 1.0})]
+    scene = build_scene(recs, "p.nc", [
+        {"line": 5, "severity": "error", "code": "NC301", "message": "overtravel"},     # no move on line 5
+        {"line": 6, "severity": "warning", "code": "NC302", "message": "collision", "position": [4.0, 0.0, 1.0]},
+    ])
+    a, b = scene.findings
+    assert a.position == (8.0, 0.0, 1.0)          # the first move at or after line 5 ends there
+    assert b.position == (4.0, 0.0, 1.0) and b.file == "p.nc"

@@ -138,6 +138,24 @@ def test_compare_viewer_marks_the_difference(chromium, tmp_path):
         page.close()
 
 
+def test_lint_findings_are_listed_marked_and_lead_to_their_line(chromium, tmp_path):
+    src = tmp_path / "f.nc"
+    src.write_text("%\nO1\nG21 G90 G17\nG0 X0 Y0 Z5\nG0 G1 X10 F100\nM30\n%\n")    # NC201 on line 5
+    html = tmp_path / "f.html"
+    backplot(src, html)
+    page, _ = open_viewer(chromium, html)
+    try:
+        rows = page.evaluate("[...document.querySelectorAll('#lists .row.warning')].map(e => e.textContent)")
+        assert len(rows) == 1 and ":5: warning[NC201]" in rows[0]
+        assert page.evaluate("[...document.querySelectorAll('#src .src-line.warning')].map(e => +e.dataset.line)") == [5]
+        page.evaluate("document.querySelector('#lists .row.warning').click()")
+        assert page.evaluate("[...document.querySelectorAll('#src .src-line.hl')].map(e => +e.dataset.line)") == [5]
+        assert page.evaluate("ncViewer.state.highlight") == [{"program": 0, "moves": [1]}]
+        assert page.errors == []
+    finally:
+        page.close()
+
+
 # --------------------------------------------------------------------------- real programs
 
 @pytest.mark.parametrize("rel", ["iso-mill/efgarro-fusion-6656.nc", "sinumerik/dubovikov-slot.mpf"])
