@@ -352,7 +352,7 @@ def cmd_backplot(args) -> int:
     sources = {ld.label: ld.source.text}
     comparison = None
     if args.compare:
-        from nctrans.equiv import DEFAULT_TOL
+        from nctrans.equivalence import DEFAULT_TOL
         from nctrans.backplot.compare import compare_scenes
         lb, _mb, records_b = _plot_input(args.compare, args.from_b, args.machine)
         diags += lb.diagnostics

@@ -83,9 +83,10 @@ def isolated_move(page, moves: list[dict], need_px: float = 12.0, tries: int = 6
 def test_sample_viewer_draws_and_links_moves_and_source(chromium, tmp_path):
     html = tmp_path / "sample.html"
     backplot(SAMPLE, html)
+    n = len(moves_of(SAMPLE))
     page, _ = open_viewer(chromium, html)
     try:
-        assert page.evaluate("ncViewer.programs[0].n") == 36
+        assert page.evaluate("ncViewer.programs[0].n") == n
         assert inked_pixels(page) > 500
         # move 8 is N110 G02 (line 14), move 6 is N90 G03 (line 12): see tests/test_backplot.py
         got = click_move(page, 8)
@@ -95,7 +96,7 @@ def test_sample_viewer_draws_and_links_moves_and_source(chromium, tmp_path):
         # the slider at 5 shows moves 1..5; the 5th move is N70 on line 10
         page.evaluate("(() => { const s = document.getElementById('slider'); s.value = '5';"
                       " s.dispatchEvent(new Event('input')); })()")
-        assert page.evaluate("document.getElementById('step').textContent") == "move 5 / 36 · line 10"
+        assert page.evaluate("document.getElementById('step').textContent") == f"move 5 / {n} · line 10"
         assert page.evaluate("[...document.querySelectorAll('#src .src-line.cur')].map(e => +e.dataset.line)") == [10]
         # a click past the slider hits nothing drawn in full: N110 (move 8) is not selectable now
         x, y = page.evaluate("ncViewer.screenOfMove(0, 8)")

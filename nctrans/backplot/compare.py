@@ -1,6 +1,6 @@
 """`backplot A --compare B`: two scenes on one plot, and marks where their toolpaths differ.
 
-The differences are equiv's (nctrans.equiv.differences), not a second comparison: each one names a
+The differences are equiv's (nctrans.equivalence.differences), not a second comparison: each one names a
 record of A and a record of B, and the mark goes where the tool is at that record in each plot.
 """
 from __future__ import annotations
@@ -60,7 +60,7 @@ def _side(scene: Scene, seqs: list[int], rec: Optional[ToolpathRecord]) -> Optio
 
 def compare_scenes(a: Scene, b: Scene, records_a: list[ToolpathRecord], records_b: list[ToolpathRecord],
                    tol: float) -> Comparison:
-    from nctrans.equiv import differences
+    from nctrans.equivalence import differences
     seqs_a = [m.record.seq for m in a.moves]
     seqs_b = [m.record.seq for m in b.moves]
     cmp = Comparison(a, b)

@@ -142,7 +142,7 @@ def shape(move: Move, lay: Layout):
 
 def arc_polyline(move: Move, tol: float) -> list[tuple[float, float, float]]:
     """Points along an arc move after its start (end included), chords within `tol` mm."""
-    from nctrans.equiv import arc_points
+    from nctrans.equivalence import arc_points
     return arc_points(move.record, LINEAR_AXES, max(tol, 1e-6))
 
 
