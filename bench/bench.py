@@ -28,6 +28,8 @@ ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
 CORPUS = SHARED / "corpus" / "iso-mill"
 PROGRAMS = ("mheaton-fusion-adaptive-1001.nc", "camotics-flower_mold.nc", "camotics-bear.nc")
+# a small Sinumerik program (26 lines): `lint` on it is nearly all start-up (imports, grammar, tables)
+STARTUP_PROGRAM = SHARED / "corpus" / "sinumerik" / "syil-DAILY.MPF"
 RS274 = shutil.which("rs274") or "/usr/bin/rs274"
 NCTRANS = [str(Path(sys.executable).with_name("nctrans"))]
 if not Path(NCTRANS[0]).exists():
@@ -235,6 +237,11 @@ def main(argv=None) -> int:
             except ValueError:
                 print(f"{label[:40]:40} {'n/a':>7} {'n/a':>11} {'n/a':>12} {'n/a':>14}")
                 notes.append(f"memory: {(proc.stderr.strip().splitlines() or ['?'])[-1]}")
+    if STARTUP_PROGRAM.exists():
+        t, rc = wall(NCTRANS + ["lint", str(STARTUP_PROGRAM)], args.repeat)
+        print()
+        print(f"start-up: CLI lint of {STARTUP_PROGRAM.name} ({read_text(STARTUP_PROGRAM).count(chr(10))} lines, "
+              f"Sinumerik): {fmt(t, '.3f')} s (exit {rc})")
     for n in notes:
         print("note:", n)
     return 0

@@ -137,8 +137,10 @@ def parser():
     global _parser
     if _parser is None:
         from lark import Lark
+
+        from nctrans.lark_cache import cache_option
         _parser = Lark(GRAMMAR_PATH.read_text(encoding="utf-8"), parser="lalr", lexer="contextual",
-                       transformer=_make_transformer(), cache=True)
+                       transformer=_make_transformer(), cache=cache_option("iso-m"))
     return _parser
 
 

@@ -31,6 +31,7 @@ from nctrans.dialects.base import ParseResult
 from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
 from nctrans.ir import nodes as ir
 from nctrans.ir.vocabulary import MILL_ONLY, MODAL_GROUPS, NO_EFFECT_PREFIX
+from nctrans.lark_cache import cache_option
 from nctrans.rules import load_table, normalise_code
 
 GRAMMAR = resources.path("grammars", "sinumerik.lark")
@@ -50,7 +51,7 @@ class _BlockLexer(Lexer):
 @lru_cache(maxsize=1)
 def parser() -> Lark:
     return Lark(GRAMMAR.read_text(encoding="utf-8"), parser="lalr", lexer=_BlockLexer,
-                maybe_placeholders=True)
+                maybe_placeholders=True, cache=cache_option(DIALECT))
 
 
 @lru_cache(maxsize=1)
