@@ -37,6 +37,7 @@ from nctrans.interp import arcs
 from nctrans.interp.evaluate import (UNKNOWN, EvalError, Evaluator, FrameValue, Scope,
                                      constant)
 from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
+from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
 from nctrans.interp.state import LINEAR_AXES, ModalState
 from nctrans.interp import unmodelled
 from nctrans.ir import nodes as n
@@ -145,7 +146,7 @@ class _Stop(Exception):
     """Internal: end the whole run (program end, alarm)."""
 
 
-class Interpreter:
+class Interpreter(LatheMixin):
     def __init__(self, program: n.Program, machine=None, *, diagnostics: list, resolver=None,
                  max_steps: int = 2_000_000, flatten_hook=None, preload=(), fast_sink=None):
         if machine is None:
@@ -170,7 +171,8 @@ class Interpreter:
         if self.st.work_offset:
             self.off.set_work(self._work_offset(self.st.work_offset))
         # machine position (last emitted end) and the same point in program coordinates
-        self.mpos: dict[str, float] = {"X": 0.0, "Y": 0.0, "Z": 0.0}
+        self.mpos: dict[str, float] = ({"X": 0.0, "Z": 0.0} if getattr(machine, "kind", "") == "lathe"
+                                       else {"X": 0.0, "Y": 0.0, "Z": 0.0})
         self.pos: dict[str, float] = {}
         self._resync()
         self.out: list = []
@@ -375,6 +377,7 @@ class Interpreter:
             n.DataSetting: lambda s: (self._h_data, s),
             n.PolarPole: lambda s: (self._h_pole, s),
             n.Passthrough: self._c_passthrough,
+            n.SpindleLimit: lambda s: (self._h_spindle_limit, s),
         }
 
     # ================================================================ helpers
@@ -412,6 +415,7 @@ class Interpreter:
     def _eval_words(self, words: tuple) -> list:
         """[(axis, value in mm/deg, mode)] with vacant words dropped."""
         scale = self.st.scale
+        diameter = self.st.diameter
         out = []
         for axis, c, f, mode in words:
             v = c if c is not None else self._value(f, f"{axis} word")
@@ -419,6 +423,8 @@ class Interpreter:
                 continue
             if axis in LENGTH_WORDS:
                 v *= scale
+            if diameter and axis == "X":        # the toolpath holds the radius (lathe.py)
+                v *= 0.5
             out.append((axis, v, mode))
         return out
 
@@ -475,6 +481,11 @@ class Interpreter:
         """Emit a move from the current program point to `end` (program coords); update position."""
         start = self.pos
         self.pos = end
+        if self.capture is not None:            # reading a turning contour: no motion
+            self.capture.append((kind, start, end, center, cw, self.span))
+            return
+        if self.css_surface is not None:
+            self._css_move(end)
         self.last_from = start
         self.last_arc = (center, cw) if kind == "arc" else None
         if self.comp_exit or self.comp is not None or (
@@ -623,6 +634,9 @@ class Interpreter:
             st.set(g, v)
         elif g == "plane":
             st.set(g, v)
+        elif g == "spindle_mode":
+            st.set(g, v)
+            self._css_mode(v)
         else:
             st.set(g, v)
         left_out = UNMODELLED_MODES.get((g, v))
@@ -674,6 +688,8 @@ class Interpreter:
             self.diag("NC105", "error", f"negative spindle speed {v:g}")
             return
         st = self.st
+        if st.groups.get("spindle_mode") == "css" and self._css_applies():
+            v = self._css_speed_word(v)
         changed = v != st.spindle_speed
         st.spindle_speed = v
         if changed and st.spindle_dir in ("cw", "ccw"):
@@ -887,7 +903,8 @@ class Interpreter:
         st = self.st
         if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
                 or self.comp_exit or st.comp_side != "off" or not self.frame.identity
-                or self.unmodelled_motion is not None):
+                or self.unmodelled_motion is not None or st.diameter
+                or self.css_surface is not None):
             return self._slow(d)
         motion = st.motion
         if motion == "rapid":
@@ -1294,6 +1311,8 @@ class Interpreter:
             self.mpos = self._to_machine(pos)
 
     def _h_cycle_call(self, s: n.CycleCall):
+        if s.kind in TURNING_KINDS:
+            return self._turning_cycle(s)
         if s.kind in ("holes_line", "holes_circle"):
             self._hole_pattern(s)
             return
@@ -1927,6 +1946,8 @@ class Interpreter:
     def _control(self, ctl, unit, pc, sidx):
         """Apply a control result from a statement: goto, call, return."""
         kind = ctl[0]
+        if kind == "turning":
+            return self._turning_control(ctl[1], unit, pc, sidx)
         if kind == "goto":
             target = self._find_label(unit, ctl[1], ctl[2], pc)
             if target is None:

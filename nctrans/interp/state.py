@@ -18,7 +18,7 @@ class ModalState:
     __slots__ = ("groups", "motion", "plane", "incremental", "arc_absolute", "scale", "feed_mode",
                  "feed", "spindle_speed", "spindle_dir", "tool", "tool_selected", "length_mode",
                  "length_index", "comp_side", "radius_index", "work_offset", "cycle",
-                 "cycle_retract", "coolant")
+                 "cycle_retract", "coolant", "diameter")
 
     def __init__(self, defaults: Optional[dict[str, Any]] = None):
         self.groups: dict[str, str] = {}
@@ -41,6 +41,7 @@ class ModalState:
         self.cycle = "off"
         self.cycle_retract = "initial"
         self.coolant = "off"
+        self.diameter = False             # lathe: X words are diameters (ISO-T, Sinumerik DIAMON)
         for g, v in (defaults or {}).items():
             self.set(str(g), str(v))
 
@@ -73,3 +74,5 @@ class ModalState:
             self.spindle_dir = value
         elif group == "coolant":
             self.coolant = value
+        elif group == "diameter":
+            self.diameter = value == "diameter"

@@ -171,6 +171,13 @@ class SpindleSpeed:
 
 
 @node
+class SpindleLimit:
+    """Maximum spindle speed in rpm, the clamp of constant surface speed (ISO-T G50 S, Sinumerik LIMS=)."""
+    value: Expr
+    spindle: int = 1
+
+
+@node
 class ToolSelect:
     tool: Expr
 
@@ -369,7 +376,7 @@ class Passthrough:
 
 
 Statement = Union[
-    ModeChange, Motion, Feed, SpindleSpeed, ToolSelect, ToolChange, OffsetSelect, Dwell,
+    ModeChange, Motion, Feed, SpindleSpeed, SpindleLimit, ToolSelect, ToolChange, OffsetSelect, Dwell,
     SetPosition, ResetSetPosition, FrameOp, HomeReturn, CycleParams, CycleCall, SubCall,
     ModalCallOff, Return, ProgramEnd, Stop, Assign, VarDecl, Goto, Message, Alarm, Passthrough,
     DataSetting, PolarPole,

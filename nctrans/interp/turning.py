@@ -1,0 +1,251 @@
+"""Turning-cycle geometry: the passes of the ISO lathe cycles, as plain moves.
+
+Everything here is two-dimensional and in radius: points are (d, p) pairs where `p` is the axis a
+pass travels along and `d` the axis the passes step across (G71: d = X, p = Z; G72 swaps them), so
+one function serves the turning and the facing form. The interpreter (nctrans.interp.lathe) turns
+the program's words into these numbers and the moves back into toolpath records.
+
+A move is (kind, end, center, cw): kind "rapid" | "linear" | "thread" | "arc"; center and cw only
+for arcs (center in the same (d, p) order). A contour is a list of such moves from a start point.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+EPS = 1e-9
+
+
+def _sign(v: float) -> float:
+    return -1.0 if v < 0 else 1.0
+
+
+# ------------------------------------------------------------------------------ contours
+
+def _arc_angles(start, end, center, cw):
+    """Start angle and signed sweep of an arc in the (p, d) frame the interpreter uses for G18
+    (first plane axis Z = p, second X = d): cw means the angle decreases."""
+    a0 = math.atan2(start[0] - center[0], start[1] - center[1])
+    a1 = math.atan2(end[0] - center[0], end[1] - center[1])
+    sweep = (a0 - a1) if cw else (a1 - a0)
+    sweep %= 2 * math.pi
+    if sweep < 1e-12:
+        sweep = 2 * math.pi
+    return a0, (-sweep if cw else sweep)
+
+
+def arc_points(start, end, center, cw, n: int = 16):
+    """n+1 points along an arc (for monotonicity checks)."""
+    a0, sw = _arc_angles(start, end, center, cw)
+    r = math.hypot(start[0] - center[0], start[1] - center[1])
+    return [(center[0] + r * math.sin(a0 + sw * i / n), center[1] + r * math.cos(a0 + sw * i / n))
+            for i in range(n + 1)]
+
+
+def hits(start, moves, level: float) -> list[float]:
+    """p of every point where the contour crosses the line d = level."""
+    out = []
+    cur = start
+    for kind, end, center, cw in moves:
+        if kind == "arc" and center is not None:
+            r = math.hypot(cur[0] - center[0], cur[1] - center[1])
+            dd = level - center[0]
+            if abs(dd) <= r + EPS:
+                h = math.sqrt(max(r * r - dd * dd, 0.0))
+                a0, sw = _arc_angles(cur, end, center, cw)
+                for p in (center[1] + h, center[1] - h):
+                    a = math.atan2(level - center[0], p - center[1])
+                    rel = (a - a0) if sw > 0 else (a0 - a)
+                    rel %= 2 * math.pi
+                    if rel <= abs(sw) + 1e-9 or rel >= 2 * math.pi - 1e-9:
+                        out.append(p)
+        else:
+            d1, d2 = cur[0], end[0]
+            if abs(d2 - d1) < EPS:
+                if abs(d1 - level) < EPS:
+                    out.extend((cur[1], end[1]))
+            elif (d1 - level) * (d2 - level) <= 0:
+                t = (level - d1) / (d2 - d1)
+                out.append(cur[1] + t * (end[1] - cur[1]))
+        cur = end
+    return out
+
+
+def shifted(moves, dd: float, dp: float):
+    """The contour moved by (dd, dp): end points and arc centres alike."""
+    return [(k, (e[0] + dd, e[1] + dp), None if c is None else (c[0] + dd, c[1] + dp), cw)
+            for k, e, c, cw in moves]
+
+
+def first_non_monotonic(start, moves) -> Optional[int]:
+    """Index of the first move where d turns back (type I stock removal needs d monotonic)."""
+    direction = 0.0
+    cur = start
+    for i, (kind, end, center, cw) in enumerate(moves):
+        pts = arc_points(cur, end, center, cw) if kind == "arc" and center is not None else [cur, end]
+        for a, b in zip(pts, pts[1:]):
+            step = b[0] - a[0]
+            if abs(step) < 1e-7:
+                continue
+            if direction == 0.0:
+                direction = _sign(step)
+            elif _sign(step) != direction:
+                return i
+        cur = end
+    return None
+
+
+# ------------------------------------------------------------------------------ stock removal
+
+def rough_levels(start, approach_end, contour, depth: float, retract: float):
+    """G71/G72 roughing passes (type I) as moves from `start`.
+
+    start: the cycle start point A (d0, p0). approach_end: A', the end of the first contour block
+    (already shifted by the finishing allowance). contour: the shifted moves A' -> B.
+    The material is bounded by A', the contour, and the line from B back across to d0, so a level
+    above the contour's last point still cuts to B's p (as the control does). Levels step from d0
+    towards A' by `depth`; a level reaching A' is left to the final contour pass. Each level:
+    rapid across to the level, cut along p to the contour, retract 45 degrees by `retract`, rapid
+    back along p to p0."""
+    d0, p0 = start
+    if not contour or depth <= 0:
+        return []
+    sd = _sign(approach_end[0] - d0)
+    b = contour[-1][1]
+    sp = _sign(b[1] - p0)
+    bounded = list(contour) + [("linear", (d0, b[1]), None, None)]
+    out = []
+    k = 1
+    while True:
+        level = d0 + sd * k * depth
+        if sd * (level - approach_end[0]) >= -1e-9:
+            break
+        k += 1
+        ahead = [p for p in hits(approach_end, bounded, level) if sp * (p - p0) > 1e-9]
+        if not ahead:
+            continue
+        stop = min(ahead, key=lambda p: sp * (p - p0))
+        out.append(("rapid", (level, p0), None, None))
+        out.append(("linear", (level, stop), None, None))
+        out.append(("rapid", (level - sd * retract, stop - sp * retract), None, None))
+        out.append(("rapid", (level - sd * retract, p0), None, None))
+    return out
+
+
+def return_to(point, current):
+    """Back to the cycle start: across in d first (away from the part), then along p."""
+    out = []
+    if abs(current[0] - point[0]) > EPS:
+        out.append(("rapid", (point[0], current[1]), None, None))
+    if abs(current[1] - point[1]) > EPS:
+        out.append(("rapid", point, None, None))
+    return out
+
+
+# ------------------------------------------------------------------------------ box cycles
+
+def box_turn(start, target, taper: float):
+    """G90 (d = X, p = Z) and, with axes swapped, G94: plunge (rapid), cut to the target (with the
+    taper: d at the start side is target + taper), cut back across to d0, rapid back along p."""
+    (d0, p0), (dt, pt) = start, target
+    return [("rapid", (dt + taper, p0), None, None), ("linear", (dt, pt), None, None),
+            ("linear", (d0, pt), None, None), ("rapid", (d0, p0), None, None)]
+
+
+def box_thread(start, target, taper: float):
+    """G92: plunge (rapid), thread to the target, rapid out across, rapid back along p."""
+    (d0, p0), (dt, pt) = start, target
+    return [("rapid", (dt + taper, p0), None, None), ("thread", (dt, pt), None, None),
+            ("rapid", (d0, pt), None, None), ("rapid", (d0, p0), None, None)]
+
+
+# ------------------------------------------------------------------------------ threading
+
+def thread_depths(height: float, first: float, min_step: float = 0.0, finish_allow: float = 0.0,
+                  finish_passes: int = 0) -> list[float]:
+    """G76 infeed depths from the crest, constant chip area: first * sqrt(n), each step at least
+    `min_step`, the roughing passes ending at height - finish_allow, then `finish_passes` passes
+    at the full height."""
+    if height <= 0 or first <= 0:
+        return [max(height, 0.0)] * max(finish_passes, 1)
+    rough_end = height - finish_allow
+    out: list[float] = []
+    prev = 0.0
+    n = 1
+    while True:
+        d = first * math.sqrt(n)
+        if d - prev < min_step:
+            d = prev + min_step
+        if d >= rough_end - 1e-12:
+            out.append(rough_end)
+            break
+        out.append(d)
+        prev = d
+        n += 1
+    if finish_allow > 0 and finish_passes == 0:
+        finish_passes = 1
+    out.extend([height] * finish_passes)
+    return out
+
+
+def thread_passes(start, target, height: float, depths: list[float], taper: float, angle: float):
+    """G76 passes (d = X, p = Z). The root is the target; the crest lies `height` outside it (on the
+    start side). Each pass: rapid along p to the flank-shifted start (single-edge infeed at half
+    the tool angle), rapid across to the depth, thread to the end, rapid out to d0, rapid to p0."""
+    (d0, p0), (dt, pt) = start, target
+    sd = _sign(dt - d0)
+    sp = _sign(pt - p0)
+    crest = dt - sd * height
+    half = math.tan(math.radians(angle) / 2) if angle else 0.0
+    out = []
+    for depth in depths:
+        shift = -sp * (height - depth) * half if half else 0.0
+        d_cut = crest + sd * depth
+        ps = p0 + shift
+        if abs(shift) > EPS:
+            out.append(("rapid", (d0, ps), None, None))
+        out.append(("rapid", (d_cut + taper, ps), None, None))
+        out.append(("thread", (d_cut, pt + shift), None, None))
+        out.append(("rapid", (d0, pt + shift), None, None))
+        out.append(("rapid", (d0, p0), None, None))
+    return out
+
+
+# ------------------------------------------------------------------------------ peck cycles
+
+def peck_passes(start, target, peck: float, shift: float, retract: float):
+    """G75 (d = X pecks, p = Z columns) and, swapped, G74. Each column: peck towards the target d
+    by `peck` (all at once when 0), rapid back by `retract` between pecks, rapid out to d0; the
+    next column is `shift` further along p (the last one exactly at the target p); finally rapid
+    back to p0."""
+    (d0, p0), (dt, pt) = start, target
+    sd = _sign(dt - d0)
+    sp = _sign(pt - p0)
+    columns = [p0]
+    if shift > EPS and abs(pt - p0) > EPS:
+        c = p0
+        while sp * (pt - c) > EPS:
+            c = c + sp * shift
+            if sp * (c - pt) > -EPS:
+                c = pt
+            columns.append(c)
+    elif abs(pt - p0) > EPS:
+        columns.append(pt)
+    out = []
+    for i, pc in enumerate(columns):
+        if i:
+            out.append(("rapid", (d0, pc), None, None))
+        cur = d0
+        while True:
+            nxt = cur + sd * peck if peck > EPS else dt
+            if sd * (nxt - dt) >= -EPS:
+                nxt = dt
+            out.append(("linear", (nxt, pc), None, None))
+            if nxt == dt:
+                break
+            out.append(("rapid", (nxt - sd * retract, pc), None, None))
+            cur = nxt
+        out.append(("rapid", (d0, pc), None, None))
+    if abs(columns[-1] - p0) > EPS:
+        out.append(("rapid", (d0, p0), None, None))
+    return out
