@@ -14,7 +14,7 @@ from nctrans.ir import nodes as n
 
 
 def test_every_dialect_package_registers_its_class():
-    assert sorted(base.names()) == ["fagor", "iso-m", "sinumerik"]
+    assert sorted(base.names()) == ["fagor", "iso-m", "iso-t", "sinumerik"]
     assert isinstance(base.get("iso-m"), IsoMilling) and base.get("nope") is None
     with pytest.raises(KeyError, match="unknown dialect 'nope'"):
         base.get_or_raise("nope")

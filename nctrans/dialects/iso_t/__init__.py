@@ -5,47 +5,51 @@ from __future__ import annotations
 
 import re
 
-from nctrans.dialects.base import Dialect, EmitResult, ParseResult
+from nctrans.dialects.base import EmitResult, Marker, ParseResult
+from nctrans.dialects.iso_m import ISO_MARKERS, IsoFamily
 
-# What makes an ISO program a lathe program: U/W incremental words, T0101 tool+offset, G50 S speed
-# clamp, G96 CSS, G99 feed per revolution, G70-G76 turning cycles with P..Q contours, X-Z only.
-_LATHE = [re.compile(p, re.IGNORECASE | re.MULTILINE) for p in (
-    r"\bG0*50\s*S\d", r"\bG0*9[69]\b", r"\bT\d{4}\b|^\s*(?:N\d+\s*)?(?:G0*0\s*)?T\d{3}\b",
-    r"\bG0*7[0-6]\b.*\bP\d+.*\bQ\d+|\bG7[1-6]\b[^\n]*\b[UWDKI][-.\d]",
-    r"^\s*(?:N\d+\s*)?(?:G0*[0-3]\s*)?[UW]-?[.\d]", r"\bG0*18\b", r"\bG0*28\s*U")]
-_MILL = re.compile(r"\b(?:Y-?[.\d]|G0*17\b|G4[34]\b|H\d|M0*6\b|G8[1-9]\b)", re.IGNORECASE)
+_I = re.IGNORECASE
+
+# What makes an ISO program a lathe program (per line of code, comments removed).
+LATHE_MARKERS = (
+    Marker(4.0, 2, re.compile(r"(?<![A-Z])G0*50[ \t]*S\d", _I)),                 # maximum spindle speed
+    Marker(3.0, 2, re.compile(r"(?<![A-Z])G0*96\b", _I)),                        # constant surface speed
+    Marker(3.0, 1, re.compile(r"(?<![A-Z])G0*99\b(?!.*\bR[-+.\d])", _I)),         # feed per revolution
+    Marker(4.0, 2, re.compile(r"(?:^|[ \t])T\d{4}\b|^[ \t]*(?:N\d+[ \t]*)?(?:G0*0[ \t]*)?T\d{3}\b", _I)),
+    Marker(4.0, 2, re.compile(r"(?<![A-Z])G0*7[0-3]\b.*P\d+.*Q\d+", _I)),    # stock removal with P..Q
+    Marker(2.0, 2, re.compile(r"(?<![A-Z])G0*7[4-6]\b.*[XU][-+.\d]", _I)),      # peck / thread cycles
+    Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?(?:G0*[0-3][ \t]*)?[UW][-+]?[.\d]", _I)),
+    Marker(1.0, 1, re.compile(r"(?<![A-Z])G0*18\b", _I)),
+    Marker(2.0, 1, re.compile(r"(?<![A-Z])G0*28[ \t]*[UW]", _I)),
+)
 
 
 def evidence(text: str) -> list[str]:
-    """The lathe markers found in `text` (for NC005's message)."""
+    """The lathe constructs found in the head of `text`."""
     head = text[:20000]
-    return [m.group(0).strip() for p in _LATHE for m in [p.search(head)] if m]
+    return [m.group(0).strip() for mk in LATHE_MARKERS for m in [mk.pattern.search(head)] if m]
 
 
-def sniff(text: str) -> float:
-    """0..1: how much `text` looks like an ISO lathe program."""
-    from nctrans.dialects.iso_m import sniff as iso_sniff
-    base = iso_sniff(text)
-    if base == 0.0:
-        return 0.0
-    head = text[:20000]
-    hits = len(evidence(head))
-    mill = len(_MILL.findall(head))
-    if hits == 0:
-        return 0.0
-    score = min(1.0, 0.35 + 0.15 * hits) - min(0.5, 0.05 * mill)
-    return round(max(0.0, score), 3)
+class IsoTurning(IsoFamily):
+    name = "iso-t"
+    description = "ISO / Fanuc-style turning, G-code system A (Fanuc 0i-T, Haas lathes)"
+    extensions = (".nc", ".tap", ".cnc")
+    table = "iso-t"
+    # The family's markers at a third of their weight: an ISO program is a lathe program on lathe evidence only.
+    markers = tuple(Marker(m.weight / 3, m.cap, m.pattern) for m in ISO_MARKERS) + LATHE_MARKERS
+    comment_evidence = {"paren_comment": (0.34, 3)}
+    machine_kind = "lathe"
 
+    def sniff(self, text: str) -> float:
+        """ISO-like and with a lathe construct stronger than a G18; 0 without one."""
+        head = text[:20000]
+        strong = any(m.weight >= 2.0 and m.pattern.search(head) for m in LATHE_MARKERS)
+        return super().sniff(text) if strong else 0.0
 
-def parse(text: str, file: str = "<stdin>") -> ParseResult:
-    from .frontend import parse_program
-    return parse_program(text, file)
+    def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
+        from .frontend import parse_program
+        return parse_program(text, file)
 
-
-def emit(program) -> EmitResult:
-    from .emitter import emit_program
-    return emit_program(program)
-
-
-DIALECT = Dialect(name="iso-t", extensions=(".nc", ".tap", ".cnc"), parse=parse, emit=emit,
-                  sniff=sniff, description="ISO / Fanuc-style turning, G-code system A")
+    def emit(self, program) -> EmitResult:
+        from .emitter import emit_program
+        return emit_program(program)
