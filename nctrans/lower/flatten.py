@@ -435,5 +435,6 @@ def flatten(program: n.Program, machine=None, *, diagnostics: list,
     meta: dict[str, object] = {"flattened_from": program.dialect, "percent": True}
     defaults = program.meta.get("defaults") if isinstance(program.meta, dict) else None
     if isinstance(defaults, dict):
-        meta["defaults"] = dict(defaults)
+        # the records hold the radius: the flattened program is in radius whatever the source was
+        meta["defaults"] = {g: v for g, v in defaults.items() if g != "diameter"}
     return n.Program(program.file, program.dialect, fl.blocks, {}, meta, None)

@@ -38,6 +38,8 @@ class TurningLowering(iso.Lowering):
         self.cycle_words = opts.get("cycle_words", {})
         self.increment_words = opts.get("cycle_increment_words", {})
         self.box: Optional[str] = None          # modal G90/G92/G94 as written
+        self.box_params: dict = {}              # its last words: a repeat block changes some
+        self.repeat = False
         self._line = 0
         self.g_handlers["turning_cycle"] = self._g_turning
         self.nonmodal_handlers["coordinate_setting"] = self._nm_g50
@@ -83,8 +85,10 @@ class TurningLowering(iso.Lowering):
                     written = True
             elif it[0] in "XZUW":
                 axes = True
+        self.repeat = False
         if self.box is None or written or not axes:
             return items
+        self.repeat = True
         at = 1 if items and items[0][0] == "N" else 0
         return items[:at] + [("G", self.box)] + items[at:]
 
@@ -172,6 +176,14 @@ class TurningLowering(iso.Lowering):
             if letter in scaled and type(v) is str and "." not in v:
                 value = Num(value.value * inc, v)
             params[key] = value
+        if kind in BOX_CYCLES:
+            if self.repeat:                     # X36. after G90 X40. Z-30.: the rest as before
+                for a, b_ in (("x", "x_inc"), ("z", "z_inc")):
+                    if a in params or b_ in params:
+                        self.box_params.pop(a, None)
+                        self.box_params.pop(b_, None)
+                params = {**self.box_params, **params}
+            self.box_params = dict(params)
         b.out.append((iso.B_MOTION, CycleCall(kind, params, False,
                                               "parameters" if form != kind else "")))
 

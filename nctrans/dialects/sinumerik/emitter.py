@@ -288,6 +288,8 @@ class Emitter:
         elif isinstance(s, ir.SpindleSpeed):
             out.words.append(self.word("S", s.value) if s.spindle == 1 else
                              f"S{s.spindle}={self.expr(s.value)}")
+        elif isinstance(s, ir.SpindleLimit):
+            out.words.append(f"LIMS={self.expr(s.value)}")
         elif isinstance(s, ir.ToolSelect):
             out.words.append(self.word("T", s.tool))
         elif isinstance(s, ir.ToolChange):

@@ -1,0 +1,73 @@
+"""ISO turning emitter: the ISO emitter with the lathe's table and spelling.
+
+X is written in diameter (an IR in radius, from a flattened program or Sinumerik DIAMOF, is doubled);
+incremental X/Z are U/W; T<tt><oo> selects tool and offset at once (no M06); G50 sets the position
+and the maximum spindle speed. Turning cycles are not written back as cycles: the conversion policy
+expands them (nctrans.convert)."""
+from __future__ import annotations
+
+from nctrans.dialects.iso_m import emitter as iso
+from nctrans.ir import nodes as n
+from nctrans.rules import load_table
+
+_INC = {"X": "U", "Z": "W", "C": "H"}
+
+
+class _TurningEmitter(iso._Emitter):
+    def __init__(self, program: n.Program):
+        super().__init__(program)
+        self.table = load_table("iso-t")
+        defaults = (program.meta or {}).get("defaults") or {}
+        self.diameter = defaults.get("diameter") == "diameter"
+        self.plane = defaults.get("plane", "ZX")
+
+    def w_ModeChange(self, s: n.ModeChange):
+        if s.group == "diameter":
+            self.diameter = s.value == "diameter"
+            self.pos = {}
+            return []
+        if s.group == "distance":
+            self.distance = s.value
+            return []                   # system A: incremental words are U/W
+        return super().w_ModeChange(s)
+
+    def _axes(self, target: dict) -> list:
+        words = []
+        for k, av in target.items():
+            value = av.value
+            if k == "X" and not self.diameter:
+                value = n.Num(2 * value.value) if type(value) is n.Num else n.Binary("*", value, n.Num(2.0))
+            inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
+            letter = _INC.get(k, k) if inc else k
+            if av.mode not in (None, "inc", "abs"):
+                raise iso.NotExpressible(f"per-word {av.mode} coordinate on {k}")
+            words.append((letter, self.addr(letter, value)))
+        return words
+
+    def w_ToolSelect(self, s):
+        t = s.tool
+        if type(t) is n.Num and t.value == int(t.value) and 0 <= t.value < 100:
+            return [("T", f"T{int(t.value):02d}{int(t.value):02d}")]
+        raise iso.NotExpressible("a tool number that is not 0..99")
+
+    def w_ToolChange(self, s):
+        self.pos = {}
+        return []
+
+    def w_OffsetSelect(self, s):
+        self.pos = {}
+        return []                       # the T word carries the offset
+
+    def w_SetPosition(self, s):
+        self.pos = {}
+        return [("G:0", "G50")] + self._axes(s.target)
+
+    def w_SpindleLimit(self, s):
+        return [("G:0", "G50"), ("S", self.addr("S", s.value))]
+
+
+def emit_program(program: n.Program):
+    from nctrans.dialects.base import EmitResult
+    em = _TurningEmitter(program)
+    text = em.run()
+    return EmitResult(text, em.diags)

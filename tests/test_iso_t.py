@@ -1,0 +1,210 @@
+"""ISO turning (iso-t): hand-computed passes of the turning cycles (corpus/iso-t), the shared lathe
+corpus, bad input, and conversion to Sinumerik and to a flat iso-m program that rs274 runs.
+
+Expected moves are worked out by hand from the cycle definitions in nctrans/interp/lathe.py and
+the numbers in each program's header comment; coordinates are radii (the toolpath convention)."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import CORPUS
+from nctrans.dialects.base import get
+from nctrans.interp.interpreter import interpret
+from nctrans.machine import default_lathe
+
+REPO = Path(__file__).resolve().parent.parent
+CONF = REPO / "corpus" / "iso-t"
+TURN = CORPUS / "iso-turn"
+
+
+def run(path: Path, text: str | None = None):
+    text = path.read_text(encoding="utf-8") if text is None else text
+    res = get("iso-t").parse(text, str(path))
+    diags = list(res.diagnostics)
+    recs = list(interpret(res.program, default_lathe(), diagnostics=diags))
+    return recs, diags
+
+
+def moves(recs, line=None):
+    """(kind, X, Z) of the rapid/linear records (of one source line)."""
+    return [(r.kind, round(r.end["X"], 6), round(r.end["Z"], 6)) for r in recs
+            if r.kind in ("rapid", "linear") and (line is None or r.line == line)]
+
+
+def level(x, z_stop, retract, z0):
+    """One G71 level: across to x, cut to z_stop, 45-degree retract, back to z0."""
+    return [("rapid", x, z0), ("linear", x, z_stop), ("rapid", x + retract, z_stop + retract),
+            ("rapid", x + retract, z0)]
+
+
+def test_g71_type1_levels_allowance_and_final_pass_then_g70():
+    recs, diags = run(CONF / "g71-g70-type1.nc")
+    assert not [d for d in diags if d.severity == "error"], diags
+    # start (20, 2); depth 2; retract 0.5; allowance 0.2 in X (U0.4 diameter), 0.1 in Z.
+    # shifted contour: (10.2, 2.1) -> (10.2, -9.9) -> (15.2, -19.9) -> (20.2, -19.9)
+    # level 18/16 meet the last segment at Z-19.9; level 14 meets the taper at
+    # Z = -9.9 - 10*(14-10.2)/5 = -17.5; level 12 at -9.9 - 10*(1.8/5) = -13.5; level 10 < 10.2: none
+    want = (level(18.0, -19.9, 0.5, 2.0) + level(16.0, -19.9, 0.5, 2.0) + level(14.0, -17.5, 0.5, 2.0)
+            + level(12.0, -13.5, 0.5, 2.0)
+            + [("rapid", 10.2, 2.1), ("linear", 10.2, -9.9), ("linear", 15.2, -19.9),
+               ("linear", 20.2, -19.9), ("rapid", 20.0, -19.9), ("rapid", 20.0, 2.0)])
+    assert moves(recs, 10) == want
+    # the contour blocks do not run again after G71; G70 runs them as programmed, then returns
+    assert moves(recs, 11) == [("rapid", 10.0, 2.0)]
+    assert [r.feed for r in recs if r.line in (12, 13, 14)] == [0.1, 0.1, 0.1]
+    assert moves(recs, 15) == [("rapid", 20.0, 2.0)]
+    assert all(r.feed == 0.25 for r in recs if r.line == 10 and r.kind == "linear")
+
+
+def test_g90_g94_g92_box_passes_with_modal_repeat_and_css():
+    recs, _ = run(CONF / "g90-g94-g92.nc")
+
+    def box(x, z, x0=25.0, z0=2.0):
+        return [("rapid", x, z0), ("linear", x, z), ("linear", x0, z), ("rapid", x0, z0)]
+    assert moves(recs, 8) == box(20.0, -30.0)
+    assert moves(recs, 9) == box(18.0, -30.0)          # X36. repeats G90 with Z-30.
+    assert moves(recs, 10) == box(16.0, -30.0)
+    # G94 facing: down Z, across to X, back along Z, rapid out in X
+    assert moves(recs, 12) == [("rapid", 25.0, -2.0), ("linear", 5.0, -2.0), ("linear", 5.0, 2.0),
+                               ("rapid", 25.0, 2.0)]
+    assert moves(recs, 13)[1] == ("linear", 5.0, -4.0)
+    # G92: thread pass at lead 1.5 per revolution
+    assert moves(recs, 17) == [("rapid", 14.6, 5.0), ("linear", 14.6, -20.0), ("rapid", 20.0, -20.0),
+                               ("rapid", 20.0, 5.0)]
+    thread = [r for r in recs if r.line == 17 and r.kind == "linear"][0]
+    assert (thread.feed, thread.feed_mode) == (1.5, "per_rev")
+    # CSS S200 m/min: at radius 25 mm 200000/(2*pi*25) = 1273.2395 rpm; at radius 5 it would be
+    # 6366 rpm, clamped by G50 S2000
+    first = [r for r in recs if r.kind == "rapid" and r.line == 7][0]
+    assert first.spindle == pytest.approx(1273.239545)
+    faced = [r for r in recs if r.line == 12 and r.kind == "linear"][0]
+    assert faced.spindle == 2000.0
+
+
+def test_haas_g75_g74_pecks_and_g76_infeed_depths():
+    recs, _ = run(CONF / "g75-g74-g76-haas.nc")
+    # G75 from (15, -10) to X10 Z-14: pecks of 2 with 0.5 back-off, columns -10, -13, -14
+    col = [("linear", 13.0, None), ("rapid", 13.5, None), ("linear", 11.0, None),
+           ("rapid", 11.5, None), ("linear", 10.0, None), ("rapid", 15.0, None)]
+    want = []
+    for i, z in enumerate((-10.0, -13.0, -14.0)):
+        if i:
+            want.append(("rapid", 15.0, z))
+        want += [(k, x, z) for k, x, _ in col]
+    want.append(("rapid", 15.0, -10.0))
+    assert moves(recs, 7) == want
+    # G74 from Z5 to Z-6 in pecks of 2.5
+    assert moves(recs, 9) == [("linear", 0.0, 2.5), ("rapid", 0.0, 3.0), ("linear", 0.0, 0.0),
+                              ("rapid", 0.0, 0.5), ("linear", 0.0, -2.5), ("rapid", 0.0, -2.0),
+                              ("linear", 0.0, -5.0), ("rapid", 0.0, -4.5), ("linear", 0.0, -6.0),
+                              ("rapid", 0.0, 5.0)]
+    # G76 K1.5 D0.5: depths 0.5*sqrt(n) until 1.5 (n = 9); root radius 12, crest 13.5
+    depths = [0.5 * n ** 0.5 for n in range(1, 9)] + [1.5]
+    cuts = [round(x, 6) for k, x, z in moves(recs, 12) if k == "linear"]
+    assert cuts == [round(13.5 - d, 6) for d in depths]
+    assert all(r.feed == 2.0 and r.feed_mode == "per_rev" for r in recs
+               if r.line == 12 and r.kind == "linear")
+
+
+def test_u_w_incremental_in_diameter_g50_setting_and_css_limit():
+    recs, _ = run(CONF / "u-w-g50-css.nc")
+    # G50 X100 Z50 at machine 0: program (50, 50); U-20 W-10 -> program (40, 40) = machine (-10, -10)
+    assert moves(recs, 6) == [("rapid", -10.0, -10.0)]
+    # G01 X50 Z0 -> program radius 25 -> machine -25; CSS 200 m/min at radius 25: 1273.2395 rpm
+    line9 = [r for r in recs if r.line == 9 and r.kind == "linear"][0]
+    assert (round(line9.end["X"], 6), line9.spindle) == (-25.0, pytest.approx(1273.239545))
+    # U-40 (diameter) -> radius 5: 6366 rpm, clamped at G50 S2000
+    line10 = [r for r in recs if r.line == 10 and r.kind == "linear"][0]
+    assert (round(line10.end["X"], 6), line10.spindle) == (-45.0, 2000.0)
+    assert [r.tool for r in recs if r.kind == "tool_change"] == [12]     # T1212 without M06
+    assert all(set(r.end) == {"X", "Z"} for r in recs if r.kind in ("rapid", "linear"))
+
+
+def test_repeated_sequence_number_each_cycle_takes_the_contour_that_follows_it():
+    recs, diags = run(CONF / "repeated-n45.nc")
+    assert not [d for d in diags if d.severity == "error"], diags
+    # first G71 (line 7): N45 X20 -> the contour of lines 8-9 (radius 10, Z-5): levels 13, 11
+    assert moves(recs, 7)[:2] == [("rapid", 13.0, 2.0), ("linear", 13.0, -5.0)]
+    assert ("linear", 10.0, -5.0) in moves(recs, 7)
+    # second G71 (line 11): the N45 after it (X24 -> radius 12, Z-8)
+    assert ("linear", 12.0, -8.0) in moves(recs, 11)
+    # G70 after both: no N45 follows, the nearest before it (lines 12-13) is finished
+    assert moves(recs, 13) == [("linear", 12.0, -8.0)]
+
+
+def test_non_monotonic_type1_contour_is_an_error_at_the_contour_block():
+    text = ("G18 G21 G99\nT0101\nG00 X40. Z2.\nG71 P10 Q20 U0 W0 D2. F0.2\nN10 G00 X20.\n"
+            "G01 Z-10.\nX30. Z-15.\nX24. Z-20.\nN20 X40.\nM30\n")
+    recs, diags = run(Path("bad.nc"), text)
+    bad = [d for d in diags if d.rule == "NC230"]
+    assert bad and bad[0].line == 8 and bad[0].severity == "error"
+    assert not [r for r in recs if r.line == 4 and r.kind == "linear"]   # the control alarms
+
+
+@pytest.mark.parametrize("path", sorted(TURN.glob("*")), ids=lambda p: p.name)
+def test_shared_lathe_corpus_parses_clean_and_runs(path):
+    from nctrans.detection import detect
+    from nctrans.source import read_source
+    text = read_source(path).text
+    assert detect(text, path.name).dialect == "iso-t"
+    recs, diags = run(path, text)
+    assert not [d for d in diags if d.rule.startswith("NC0")], diags
+    assert [r for r in recs if r.kind in ("rapid", "linear", "arc")]
+    if "snowman" in path.name:
+        # G71 P45 Q58: no N58; the next G71's contour holds a G71 block: the control alarms
+        assert {(d.rule, d.line) for d in diags} >= {("NC102", 15), ("NC133", 26)}
+    else:
+        assert not [d for d in diags if d.severity == "error"], diags
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "nctrans", *args], capture_output=True, text=True,
+                          cwd=REPO, timeout=120)
+
+
+def test_lathe_program_linted_as_iso_m_is_nc005_with_evidence():
+    p = _cli("lint", "--from", "iso-m", str(TURN / "kiely-haas-L8-Ex1.nc"))
+    assert p.returncode == 1
+    assert "NC005" in p.stdout and "iso-t" in p.stdout
+
+
+CONVERT = [CONF / "g71-g70-type1.nc", CONF / "g90-g94-g92.nc", TURN / "enier-haas-valve.nc",
+           TURN / "kiely-haas-thumbscrew.nc"]
+
+
+@pytest.mark.parametrize("path", CONVERT, ids=lambda p: p.name)
+def test_iso_t_to_sinumerik_and_back_is_equivalent(path, tmp_path):
+    mpf, back = tmp_path / "a.mpf", tmp_path / "b.nc"
+    p = _cli("convert", "--from", "iso-t", str(path), "--to", "sinumerik", "-o", str(mpf))
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "G18" in mpf.read_text() and "G95" in mpf.read_text()
+    p = _cli("equiv", "--from-a", "iso-t", str(path), str(mpf))
+    assert p.returncode == 0, p.stdout + p.stderr
+    p = _cli("convert", str(mpf), "--to", "iso-t", "-o", str(back))
+    assert p.returncode == 0, p.stdout + p.stderr
+    p = _cli("equiv", "--from-a", "iso-t", "--from-b", "iso-t", str(path), str(back))
+    assert p.returncode == 0, p.stdout + p.stderr
+
+
+@pytest.mark.rs274
+@pytest.mark.parametrize("path", [CONF / "g71-g70-type1.nc", CONF / "g90-g94-g92.nc",
+                                  TURN / "enier-haas-valve.nc"], ids=lambda p: p.name)
+def test_flattened_iso_t_runs_in_rs274_with_the_same_xz_moves(path, rs274, rs274_cache):
+    import rs274 as h
+    from nctrans.lower.flatten import flatten
+    from test_flatten import rs274_run
+    machine = default_lathe()
+    src = get("iso-t").parse(path.read_text(encoding="utf-8"), path.name).program
+    records = list(interpret(src, machine, diagnostics=[]))
+    flat = flatten(src, machine, diagnostics=[])
+    res = get("iso-m").emit(flat)
+    assert not [d for d in res.diagnostics if d.severity == "error"], res.diagnostics
+    result = rs274_run(res.text, "isot-" + path.stem, machine, rs274_cache)
+    assert result.completed, result.message
+    source = [h.Motion.of(r) for r in records if r.kind in ("rapid", "linear", "arc")]
+    problem = h.compare(result.moves, source, path.name)
+    assert problem is None, problem
