@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import re
 
-from nctrans.dialects.base import EmitResult, Marker, ParseResult
+from nctrans.dialects.base import Marker, ParseResult
 from nctrans.dialects.iso_m import ISO_MARKERS, IsoFamily
 
 _I = re.IGNORECASE
@@ -46,10 +46,16 @@ class IsoTurning(IsoFamily):
         strong = any(m.weight >= 2.0 and m.pattern.search(head) for m in LATHE_MARKERS)
         return super().sniff(text) if strong else 0.0
 
+    streams = False                     # G70-G73 read their contour blocks from the whole body
+
+    def lowering(self):
+        from .frontend import TurningLowering
+        return TurningLowering
+
+    def emitter(self):
+        from .emitter import TurningEmitter
+        return TurningEmitter
+
     def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
         from .frontend import parse_program
         return parse_program(text, file)
-
-    def emit(self, program) -> EmitResult:
-        from .emitter import emit_program
-        return emit_program(program)

@@ -8,15 +8,17 @@ from __future__ import annotations
 
 from nctrans.dialects.iso_m import emitter as iso
 from nctrans.ir import nodes as n
-from nctrans.rules import load_table
 
 _INC = {"X": "U", "Z": "W", "C": "H"}
 
 
-class _TurningEmitter(iso._Emitter):
+class TurningEmitter(iso.IsoEmitter):
+    dialect = "iso-t"
+    table_name = "iso-t"
+    target_text = "ISO turning"
+
     def __init__(self, program: n.Program):
         super().__init__(program)
-        self.table = load_table("iso-t")
         defaults = (program.meta or {}).get("defaults") or {}
         self.diameter = defaults.get("diameter") == "diameter"
         self.plane = defaults.get("plane", "ZX")
@@ -65,9 +67,3 @@ class _TurningEmitter(iso._Emitter):
     def w_SpindleLimit(self, s):
         return [("G:0", "G50"), ("S", self.addr("S", s.value))]
 
-
-def emit_program(program: n.Program):
-    from nctrans.dialects.base import EmitResult
-    em = _TurningEmitter(program)
-    text = em.run()
-    return EmitResult(text, em.diags)

@@ -29,6 +29,8 @@ _KEEP = frozenset("FSTMN")
 
 class TurningLowering(iso.Lowering):
     dialect = "iso-t"
+    table_name = "iso-t"
+    code_kind = "an ISO turning code"
 
     def __init__(self, file: str, diags: list[Diagnostic]):
         super().__init__(file, diags)
