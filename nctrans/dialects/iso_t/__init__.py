@@ -6,21 +6,21 @@ from __future__ import annotations
 import re
 
 from nctrans.dialects.base import Marker, ParseResult
-from nctrans.dialects.iso_m import ISO_MARKERS, IsoFamily
+from nctrans.dialects.iso_m import IsoFamily
 
 _I = re.IGNORECASE
 
 # What makes an ISO program a lathe program (per line of code, comments removed).
 LATHE_MARKERS = (
-    Marker(4.0, 2, re.compile(r"(?<![A-Z])G0*50[ \t]*S\d", _I)),                 # maximum spindle speed
-    Marker(3.0, 2, re.compile(r"(?<![A-Z])G0*96\b", _I)),                        # constant surface speed
-    Marker(3.0, 1, re.compile(r"(?<![A-Z])G0*99\b(?!.*\bR[-+.\d])", _I)),         # feed per revolution
-    Marker(4.0, 2, re.compile(r"(?:^|[ \t])T\d{4}\b|^[ \t]*(?:N\d+[ \t]*)?(?:G0*0[ \t]*)?T\d{3}\b", _I)),
-    Marker(4.0, 2, re.compile(r"(?<![A-Z])G0*7[0-3]\b.*P\d+.*Q\d+", _I)),    # stock removal with P..Q
-    Marker(2.0, 2, re.compile(r"(?<![A-Z])G0*7[4-6]\b.*[XU][-+.\d]", _I)),      # peck / thread cycles
-    Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?(?:G0*[0-3][ \t]*)?[UW][-+]?[.\d]", _I)),
+    Marker(8.0, 3, re.compile(r"(?<![A-Z])G0*50[ \t]*S\d", _I)),                 # maximum spindle speed
+    Marker(6.0, 3, re.compile(r"(?<![A-Z])G0*96\b", _I)),                        # constant surface speed
+    Marker(6.0, 1, re.compile(r"(?<![A-Z])G0*99\b(?!.*\bR[-+.\d])", _I)),         # feed per revolution
+    Marker(8.0, 3, re.compile(r"(?:^|[ \t])T\d{4}\b|^[ \t]*(?:N\d+[ \t]*)?(?:G0*0[ \t]*)?T\d{3}\b", _I)),
+    Marker(8.0, 3, re.compile(r"(?<![A-Z])G0*7[0-3]\b.*P\d+.*Q\d+", _I)),    # stock removal with P..Q
+    Marker(4.0, 2, re.compile(r"(?<![A-Z])G0*7[4-6]\b.*[XU][-+.\d]", _I)),      # peck / thread cycles
+    Marker(6.0, 3, re.compile(r"^[ \t]*(?:N\d+[ \t]*)?(?:G0*[0-3][ \t]*)?[UW][-+]?[.\d]", _I)),
     Marker(1.0, 1, re.compile(r"(?<![A-Z])G0*18\b", _I)),
-    Marker(2.0, 1, re.compile(r"(?<![A-Z])G0*28[ \t]*[UW]", _I)),
+    Marker(4.0, 1, re.compile(r"(?<![A-Z])G0*28[ \t]*[UW]", _I)),
 )
 
 
@@ -35,15 +35,16 @@ class IsoTurning(IsoFamily):
     description = "ISO / Fanuc-style turning, G-code system A (Fanuc 0i-T, Haas lathes)"
     extensions = (".nc", ".tap", ".cnc")
     table = "iso-t"
-    # The family's markers at a third of their weight: an ISO program is a lathe program on lathe evidence only.
-    markers = tuple(Marker(m.weight / 3, m.cap, m.pattern) for m in ISO_MARKERS) + LATHE_MARKERS
-    comment_evidence = {"paren_comment": (0.34, 3)}
+    # Only lathe constructs count: the family's markers are iso-m's evidence, and a lathe program
+    # outweighs them (a mill program gives iso-t nothing, so detection between others is unchanged).
+    markers = LATHE_MARKERS
+    comment_evidence: dict = {}
     machine_kind = "lathe"
 
     def sniff(self, text: str) -> float:
         """ISO-like and with a lathe construct stronger than a G18; 0 without one."""
         head = text[:20000]
-        strong = any(m.weight >= 2.0 and m.pattern.search(head) for m in LATHE_MARKERS)
+        strong = any(m.weight >= 4.0 and m.pattern.search(head) for m in LATHE_MARKERS)
         return super().sniff(text) if strong else 0.0
 
     streams = False                     # G70-G73 read their contour blocks from the whole body
