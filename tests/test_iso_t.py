@@ -182,9 +182,9 @@ def test_iso_t_to_sinumerik_and_back_is_equivalent(path, tmp_path):
     p = _cli("convert", "--from", "iso-t", str(path), "--to", "sinumerik", "-o", str(mpf))
     assert p.returncode == 0, p.stdout + p.stderr
     assert "G18" in mpf.read_text() and "G95" in mpf.read_text()
-    p = _cli("equiv", "--from-a", "iso-t", str(path), str(mpf))
+    p = _cli("equiv", "--from-a", "iso-t", "--from-b", "sinumerik", str(path), str(mpf))
     assert p.returncode == 0, p.stdout + p.stderr
-    p = _cli("convert", str(mpf), "--to", "iso-t", "-o", str(back))
+    p = _cli("convert", "--from", "sinumerik", str(mpf), "--to", "iso-t", "-o", str(back))
     assert p.returncode == 0, p.stdout + p.stderr
     p = _cli("equiv", "--from-a", "iso-t", "--from-b", "iso-t", str(path), str(back))
     assert p.returncode == 0, p.stdout + p.stderr
