@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import enum
+import html
 import math
 import os
 from dataclasses import dataclass, field
@@ -283,6 +284,21 @@ class Toolpath(Iterator[ToolpathRecord]):
             summ.add(r)
         text: str = summ.format(len(self.diagnostics))
         return text
+
+    def plot(self, view: str = "top") -> str:
+        """Run the rest of the toolpath and return its backplot as an SVG document (as
+        `nctrans backplot -o OUT.svg` draws it: rapids dashed, arcs as arcs, colours per tool)."""
+        from nctrans import backplot
+        scene = backplot.build_scene(self, self.label, self.diagnostics)
+        svg: bytes = backplot.render("svg", scene, view=view)
+        return svg.decode("utf-8")
+
+    def _repr_html_(self) -> str:
+        """Jupyter shows a toolpath that has not been iterated yet as its plot; one already
+        (partly) consumed cannot be replayed, so it shows its summary line."""
+        if self.count or self.done:
+            return f"<pre>{html.escape(repr(self))}</pre>"
+        return self.plot()
 
     def __repr__(self) -> str:
         state = "complete" if self.done else "running" if self.count else "not started"

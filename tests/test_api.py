@@ -263,3 +263,12 @@ def test_the_api_type_checks_with_mypy_strict(tmp_path):
            "--cache-dir", str(tmp_path / "cache"), str(ROOT / "nctrans" / "api.py"), str(script)]
     out = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env={**os.environ, "MYPYPATH": str(ROOT)})
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_toolpath_plots_inline_for_notebooks():
+    """`Toolpath._repr_html_` (Jupyter) draws the program: one SVG element per move."""
+    tp = nctrans.toolpath(SAMPLE)
+    svg = tp._repr_html_()
+    moves = sum(1 for r in nctrans.toolpath(SAMPLE) if r.kind in ("rapid", "linear", "arc"))
+    assert svg.startswith("<svg") and f'data-moves="{moves}"' in svg
+    assert tp.done and "complete" in tp._repr_html_()      # consumed: the summary, not a replay
