@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Iterable, Iterator, Optional, Sequence, Union
 from nctrans import pipeline
 from nctrans import source as _source
 from nctrans.diagnostics import Diagnostic
+from nctrans.dialects.base import DEFAULT_DIALECT
 from nctrans.ir.nodes import Program
 from nctrans.machine import Machine, MachineError
 from nctrans.toolpath import ToolpathRecord
@@ -207,7 +208,7 @@ class Conversion:
                 f"{len(self.lowered)} lowered>")
 
 
-def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, write: str = "iso-m", *,
+def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, write: str = DEFAULT_DIALECT, *,
               flatten: bool = False, strict: bool = False, machine: MachineLike = None,
               search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
               error_level: ErrorLevel = ErrorLevel.IGNORE) -> Conversion:

@@ -13,6 +13,7 @@ from typing import Literal, Optional
 from pydantic import BaseModel, ConfigDict, field_validator
 
 from nctrans import resources
+from nctrans.dialects.base import DEFAULT_DIALECT
 
 CATALOGUE_PATH = resources.path("rules", "lint-rules.toml")
 _CODE = re.compile(r"^NC\d{3}$")
@@ -43,7 +44,7 @@ class Rule(BaseModel):
     bad: str
     good: str
     fix: Optional[str] = None
-    dialect: str = "iso-m"
+    dialect: str = DEFAULT_DIALECT
     example_command: Literal["lint", "convert", "check"] = "lint"
     example_args: list[str] = []
     example_files: dict[str, str] = {}

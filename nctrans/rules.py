@@ -49,6 +49,8 @@ class RulesTable:
     options: dict[str, Any] = field(default_factory=dict)
     addresses: dict[str, str] = field(default_factory=dict)   # letter -> what it is
     codes: list[CodeRule] = field(default_factory=list)
+    # system variable as spelled ("#5001", "$AA_IW") -> neutral meaning (vocabulary.SYSTEM_VARIABLES)
+    system_variables: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._by_code = {c.code.upper(): c for c in self.codes}
@@ -72,6 +74,25 @@ class RulesTable:
     def defaults(self) -> dict[str, str]:
         """Power-on modal state {group: value}, handed to the interpreter via Program.meta."""
         return {c.group: c.value for c in self.codes if c.default}
+
+
+@lru_cache(maxsize=1)
+def _system_spellings() -> dict[str, str]:
+    """Every registered dialect's system-variable spellings (upper case) -> neutral meaning. All
+    dialects at once: a program may hold a section of another dialect (Sinumerik ISO mode)."""
+    from nctrans.dialects import base
+    out: dict[str, str] = {}
+    for d in base.dialects():
+        if resources.path("rules", f"{d.table_name}.toml").is_file():
+            for spelling, meaning in load_table(d.table_name).system_variables.items():
+                out.setdefault(spelling.upper(), meaning)
+    return out
+
+
+def system_meaning(key: str | int) -> Optional[str]:
+    """The neutral meaning of a system variable as the IR holds it: a name ("$P_EP") or a number
+    (ISO #5001 is the int 5001); None when no table knows it."""
+    return _system_spellings().get(f"#{key}" if isinstance(key, int) else str(key).upper())
 
 
 @lru_cache(maxsize=None)

@@ -15,8 +15,8 @@ import rs274 as h
 from hypothesis import given, settings, strategies as st
 
 from nctrans.interp.cycles import (
-    cycle_problems, cycle_table, expand_cycle, hole_pattern, sinumerik_cycle_args,
-    sinumerik_cycle_levels, sinumerik_cycles,
+    cycle_problems, cycle_table, expand_cycle, hole_pattern, bind_cycle_args,
+    plane_cycle_levels, named_cycles,
 )
 from nctrans.ir.vocabulary import CYCLE_PARAMS, MODAL_GROUPS
 
@@ -261,22 +261,22 @@ def test_cycle_table_is_valid_and_neutral():
             assert set(cyc.kind_by.values.values()) <= kinds
     assert set(table.names.values()) <= set(CYCLE_PARAMS)
     assert {"CYCLE81", "CYCLE82", "CYCLE83", "CYCLE84", "CYCLE840", "CYCLE85", "CYCLE86", "CYCLE87",
-            "CYCLE88", "CYCLE89"} <= set(sinumerik_cycles())
+            "CYCLE88", "CYCLE89"} <= set(named_cycles())
 
 
 def test_sinumerik_args_and_levels():
-    kind, params = sinumerik_cycle_args("cycle83", [50, 0, 2, -20, None, -5, None, 2, None, None, None, 1])
+    kind, params = bind_cycle_args("cycle83", [50, 0, 2, -20, None, -5, None, 2, None, None, None, 1])
     assert kind == "peck"
     assert params["retract_plane"] == 50 and params["bottom"] == -20 and params["first_peck"] == -5
     assert params["decrement"] == 2 and params["vari"] == 1
-    assert sinumerik_cycle_args("CYCLE83", [50, 0, 2, -20])[0] == "chip_break"
-    assert sinumerik_cycle_args("CYCLE999", [1]) is None
-    assert sinumerik_cycle_levels(params, current=100) == (2, -20, 50)
+    assert bind_cycle_args("CYCLE83", [50, 0, 2, -20])[0] == "chip_break"
+    assert bind_cycle_args("CYCLE999", [1]) is None
+    assert plane_cycle_levels(params, current=100) == (2, -20, 50)
     # DPR wins over DP; RTP missing -> the current height
-    assert sinumerik_cycle_levels({"r_plane": 10, "safety": 1, "bottom": -3, "depth_rel": 5},
+    assert plane_cycle_levels({"r_plane": 10, "safety": 1, "bottom": -3, "depth_rel": 5},
                                   current=80) == (11, 5, 80)
     # RTP below RFP: drilling upwards (+Z)
-    assert sinumerik_cycle_levels({"retract_plane": -50, "r_plane": 0, "safety": 2, "depth_rel": 10},
+    assert plane_cycle_levels({"retract_plane": -50, "r_plane": 0, "safety": 2, "depth_rel": 10},
                                   current=0) == (-2, 10, -50)
 
 

@@ -44,3 +44,25 @@ def test_unknown_tool_name_is_numbered_once_and_reported():
     changes = [r.tool for r in interpret(program, None, diagnostics=diags) if r.kind == "tool_change"]
     assert changes[0] == changes[2] != changes[1]
     assert [d.rule for d in diags] == ["NC107", "NC107"]
+
+
+def test_system_variables_are_read_by_their_neutral_meaning_from_each_rules_table():
+    from nctrans.dialects import base
+    from nctrans.ir.vocabulary import SYSTEM_VARIABLES
+    from nctrans.rules import load_table, system_meaning
+    for d in base.dialects():
+        for spelling, meaning in load_table(d.table_name).system_variables.items():
+            assert meaning.split(".")[0] in SYSTEM_VARIABLES, (d.name, spelling, meaning)
+    assert system_meaning(5001) == system_meaning(5041) == "axis_position_work.X"
+    assert system_meaning(5023) == "axis_position_machine.Z"
+    assert system_meaning("$aa_iw") == system_meaning("$P_EP") == "axis_position_work"
+    assert system_meaning("$P_AXN1") is None and system_meaning(5100) is None
+
+
+def test_iso_position_numbers_and_sinumerik_names_read_the_same_position():
+    iso = get("iso-m").parse("G21 G90 G0 X3 Y4 Z5\n#1=#5001+#5042+#5023\nG1 X#1 F100\nM30\n", "t.nc").program
+    diags: list = []
+    moves = [r for r in interpret(iso, None, diagnostics=diags) if r.kind == "linear"]
+    assert moves[-1].end["X"] == 3.0 + 4.0 + 5.0 and not diags
+    moves, diags = _run("G0 X3 Y4 Z5\nR1=$AA_IW[X]+$P_EP[Y]+$AA_MW[Z]+$P_TOOLNO\nG1 X=R1 F100\nM30\n")
+    assert moves[-1].end["X"] == 12.0

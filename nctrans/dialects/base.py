@@ -61,6 +61,10 @@ COMMENT_SHAPES = ("paren_comment",      # "(text)" comment with letters in it
                   "semicolon_line",     # a line that is only a ";" comment
                   "semicolon_tail")     # "G1 X1 ; text": a ";" comment after code
 
+# The dialect a conversion writes and a rule example is read in when none is named: ISO milling, the
+# one LinuxCNC's rs274 (the reference interpreter of the tests) runs.
+DEFAULT_DIALECT = "iso-m"
+
 # Endings that programs of many controllers use: they count as shared between dialects even when only
 # one registered dialect claims them, so they weigh less in detection than an ending of one dialect.
 COMMON_ENDINGS = frozenset({".nc", ".tap", ".cnc"})

@@ -339,7 +339,7 @@ class KindBy:
 
 
 @dataclass
-class SinumerikCycle:
+class CycleSignature:
     __pydantic_config__ = {"extra": "forbid"}
     name: str
     kind: str
@@ -378,7 +378,7 @@ class CycleTable:
     """rules/cycles.toml: Siemens standard cycles, hole patterns and CYCLE800 (schema for pydantic)."""
     __pydantic_config__ = {"extra": "forbid"}
     names: dict[str, str] = field(default_factory=dict)
-    cycle: list[SinumerikCycle] = field(default_factory=list)
+    cycle: list[CycleSignature] = field(default_factory=list)
     pattern: list[HolePattern] = field(default_factory=list)
     swivel: list[SwivelCycle] = field(default_factory=list)
     swivel_mode: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "axis"}))
@@ -389,9 +389,9 @@ class CycleTable:
     @classmethod
     def from_data(cls, d: dict) -> "CycleTable":
         """The table from validated data (tables.load)."""
-        def cycle(c: dict) -> SinumerikCycle:
+        def cycle(c: dict) -> CycleSignature:
             kb = c.get("kind_by")
-            return SinumerikCycle(**{**c, "kind_by": None if kb is None else KindBy(**kb)})
+            return CycleSignature(**{**c, "kind_by": None if kb is None else KindBy(**kb)})
         return cls(names=d["names"], cycle=[cycle(c) for c in d["cycle"]],
                    pattern=[HolePattern(**p) for p in d["pattern"]],
                    swivel=[SwivelCycle(**w) for w in d["swivel"]],
@@ -415,16 +415,16 @@ def cycle_table() -> CycleTable:
     return tables.load(RULES_DIR / "cycles.toml", CycleTable, CycleTable.from_data)
 
 
-def sinumerik_cycles() -> dict[str, SinumerikCycle]:
+def named_cycles() -> dict[str, CycleSignature]:
     return {c.name: c for c in cycle_table().cycle}
 
 
-def sinumerik_cycle_args(name: str, args: Sequence[float | None]) -> Optional[tuple[str, dict[str, float]]]:
+def bind_cycle_args(name: str, args: Sequence[float | None]) -> Optional[tuple[str, dict[str, float]]]:
     """Bind positional CYCLExx arguments (None = empty) to neutral keys: (kind, params), or None if unknown.
 
     Arguments beyond the parameter list are dropped (the front end reports them).
     """
-    cyc = sinumerik_cycles().get(name.upper())
+    cyc = named_cycles().get(name.upper())
     if cyc is None:
         return None
     table = cycle_table()
@@ -436,7 +436,7 @@ def sinumerik_cycle_args(name: str, args: Sequence[float | None]) -> Optional[tu
     return kind, params
 
 
-def sinumerik_cycle_levels(params: dict[str, float], *, current: float) -> tuple[float, float, float]:
+def plane_cycle_levels(params: dict[str, float], *, current: float) -> tuple[float, float, float]:
     """(approach, bottom, retract) of a Sinumerik drilling cycle from RTP, RFP, SDIS, DP, DPR.
 
     approach = RFP + SDIS (towards RTP), retract = RTP (`current` when RTP is not given), bottom = DP,

@@ -14,6 +14,7 @@ from typing import Any, Callable, Optional
 
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import literal
+from nctrans.rules import system_meaning
 
 
 class _Unknown:
@@ -272,8 +273,6 @@ constant = literal
 
 
 _AXES = "XYZABC"
-# system variable -> first ISO position number it mirrors (work / machine coordinates)
-_AXIS_POSITION_VARS = {"$P_EP": 5001, "$AA_IW": 5001, "$P_AXN1": None, "$AA_IM": 5021, "$AA_MW": 5021}
 
 
 def _axis_index(var: n.Var) -> Optional[str]:
@@ -301,9 +300,13 @@ class Evaluator:
         self.num_globals: dict[int, Any] = {}
         self.R: dict[int, Any] = {}
         self.global_names: dict[str, Any] = {}
+        # system variables by spelling (a name, or an int for a numbered one): filled from `meanings`
+        # through the rules tables (rules.system_meaning) on first read, and by writes
         self.system: dict[Any, Callable[[], Any]] = {}
-        # writable system variables with an effect ($P_PFRAME): name -> setter(value)
-        self.system_setters: dict[str, Callable[[Any], None]] = {}
+        # neutral meaning (vocabulary.SYSTEM_VARIABLES, "<meaning>.<axis>" per axis) -> reader and
+        # writer; the interpreter registers them
+        self.meanings: dict[str, Callable[[], Any]] = {}
+        self.meaning_setters: dict[str, Callable[[Any], None]] = {}
         self.unknown_used = False     # set when UNKNOWN was read; the interpreter reports it
 
     # ---------------------------------------------------------------- compiler
@@ -589,12 +592,27 @@ class Evaluator:
         if k in self.num_globals:
             return self.num_globals[k]
         if k >= 1000:
-            f = self.system.get(k)
+            f = self._system_reader(k)
             if f is not None:
                 return f()
             self.unknown_used = True
             return UNKNOWN
         return None
+
+    def _system_reader(self, key: Any) -> Optional[Callable[[], Any]]:
+        """The reader of a system variable by its spelling, through its neutral meaning."""
+        f = self.system.get(key)
+        if f is None:
+            meaning = system_meaning(key)
+            f = self.meanings.get(meaning) if meaning is not None else None
+            if f is not None:
+                self.system[key] = f
+        return f
+
+    def _system_setter(self, name: str) -> Optional[Callable[[Any], None]]:
+        """The writer of a writable system variable with an effect (the programmable frame)."""
+        meaning = system_meaning(name)
+        return self.meaning_setters.get(meaning) if meaning is not None else None
 
     def write_num(self, k: int, value: Any) -> None:
         if k == 0:
@@ -629,18 +647,17 @@ class Evaluator:
         return v
 
     def read_axis_system(self, name: str, axis: str) -> Any:
-        """Axis-indexed position variables (Sinumerik $P_EP[Z], $AA_IW[X], $AA_IM[Y]) read the
-        interpreter's current position, which it publishes as the ISO position numbers (#5001..
-        work coordinates, #5021.. machine coordinates) in program units."""
-        base = _AXIS_POSITION_VARS.get(name)
-        f = self.system.get(base + _AXES.index(axis)) if base is not None and axis in _AXES else None
+        """Axis-indexed position variables (a per-axis meaning read with an axis index, such as
+        Sinumerik $AA_IW[X]) read the interpreter's current position of that axis."""
+        meaning = system_meaning(name)
+        f = self.meanings.get(f"{meaning}.{axis}") if meaning is not None and axis in _AXES else None
         if f is not None:
             return f()
         self.unknown_used = True
         return UNKNOWN
 
     def read_system(self, name: str, idx: Optional[tuple]) -> Any:
-        f = self.system.get(name)
+        f = self._system_reader(name)
         if f is not None:
             return f()
         self.unknown_used = True
@@ -779,7 +796,7 @@ class Evaluator:
             name = str(var.key).upper()
 
             def set_sys(v):        # writable system data: kept so later reads see the value
-                setter = self.system_setters.get(name)
+                setter = self._system_setter(name)
                 if setter is not None and fns:
                     # $P_PFRAME[X,TR]=25: component writes are not modelled; keep the frame
                     raise EvalError("NC107", f"{name}[..] component write is not analysed; the "

@@ -53,9 +53,9 @@ except ImportError:  # pragma: no cover
     expand_cycle = None
 try:
     from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, hole_pattern,
-                                       sinumerik_cycle_levels, swivel_plan, tap_steps)
+                                       plane_cycle_levels, swivel_plan, tap_steps)
 except ImportError:  # pragma: no cover
-    cycle_table = hole_pattern = sinumerik_cycle_levels = swivel_plan = deep_hole_steps = None
+    cycle_table = hole_pattern = plane_cycle_levels = swivel_plan = deep_hole_steps = None
     coarse_pitch = tap_steps = None
 try:
     from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
@@ -1348,7 +1348,7 @@ class Interpreter(LatheMixin):
                 self._move("rapid", hole)
 
     def _run_cycle_call(self, s: n.CycleCall, hole: Optional[dict] = None) -> None:
-        if expand_cycle is None or sinumerik_cycle_levels is None:
+        if expand_cycle is None or plane_cycle_levels is None:
             return
         st = self.st
         ax = PLANE_AXES[st.plane][2]
@@ -1360,7 +1360,7 @@ class Interpreter(LatheMixin):
         if "bottom" not in params and "depth_rel" not in params:
             self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
             return
-        approach, bottom, retract = sinumerik_cycle_levels(params, current=self.pos.get(ax, 0.0))
+        approach, bottom, retract = plane_cycle_levels(params, current=self.pos.get(ax, 0.0))
         steps = None
         if hole is not None and any(abs(hole.get(a, 0.0) - self.pos.get(a, 0.0)) > 0
                                     for a in PLANE_AXES[st.plane][:2]):
@@ -1609,11 +1609,12 @@ class Interpreter(LatheMixin):
         frame instruction it stands for: the first replaces (TRANS/ROT/SCALE/MIRROR), the
         following ones add in the system it produced (ATRANS/AROT/ASCALE/AMIRROR)."""
         if value is UNKNOWN:
-            self.diag("NC107", "info", "$P_PFRAME is assigned a frame unknown at analysis time; "
-                      "the programmable frame is kept")
+            self.diag("NC107", "info", "the programmable frame variable is assigned a value unknown at "
+                      "analysis time; the programmable frame is kept")
             return
         if not isinstance(value, FrameValue):
-            raise EvalError("NC104", "$P_PFRAME needs a frame (CTRANS(..), a FRAME variable)")
+            raise EvalError("NC104", "the programmable frame needs a frame value (a frame expression or "
+                            "variable)")
         self.frame.clear()
         first = True
         for step in value.steps:
@@ -1699,18 +1700,22 @@ class Interpreter(LatheMixin):
 
     # ================================================================ system variables
     def _register_system(self) -> None:
+        """Values of the neutral system variables (vocabulary.SYSTEM_VARIABLES); each dialect's
+        rules table maps its spellings onto them."""
+        values = self.ev.meanings
         sysv = self.ev.system
         st = self.st
-        for i, a in enumerate("XYZABC"):
-            sysv[5001 + i] = (lambda a=a: self.pos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
-            sysv[5041 + i] = sysv[5001 + i]
-            sysv[5021 + i] = (lambda a=a: self.mpos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
-        sysv["$P_PFRAME"] = lambda: FrameValue((("state", copy_frame(self.frame)),))
-        self.ev.system_setters["$P_PFRAME"] = self._set_pframe
-        sysv["$P_TOOLNO"] = lambda: float(st.tool or 0)
-        sysv["$P_TOOL"] = lambda: float(st.radius_index or 0)
-        sysv["$P_F"] = lambda: st.feed or 0.0
-        sysv["$P_S"] = lambda: st.spindle_speed or 0.0
+        for a in "XYZABC":
+            values[f"axis_position_work.{a}"] = (
+                lambda a=a: self.pos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
+            values[f"axis_position_machine.{a}"] = (
+                lambda a=a: self.mpos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
+        values["programmable_frame"] = lambda: FrameValue((("state", copy_frame(self.frame)),))
+        self.ev.meaning_setters["programmable_frame"] = self._set_pframe
+        values["active_tool"] = lambda: float(st.tool or 0)
+        values["active_tool_edge"] = lambda: float(st.radius_index or 0)
+        values["feed"] = lambda: st.feed or 0.0
+        values["spindle_speed"] = lambda: st.spindle_speed or 0.0
         for name, value in (getattr(self.machine, "variables", None) or {}).items():
             sysv[str(name).upper()] = lambda value=value: float(value)
 

@@ -40,6 +40,21 @@ CYCLE_PARAMS = ("bottom", "r_plane", "retract_plane", "safety", "peck", "dwell",
                 "ref_x", "ref_y", "ref_z", "angle_1", "angle_2", "angle_3",
                 "shift_x", "shift_y", "shift_z", "swivel_dir", "retract_inc")
 
+# Neutral meanings of system variables. Each rules table maps its own spellings onto them in its
+# [system_variables] section (`#5001`, `$AA_IW`, ...); the interpreter provides the values by meaning.
+# A per-axis meaning is written "<meaning>.<axis>" for one axis (ISO #5001 = axis_position_work.X) or
+# alone for a variable indexed by an axis (Sinumerik $AA_IW[X]).
+SYSTEM_VARIABLES = (
+    "axis_position_work",        # current position of an axis in work coordinates (program units)
+    "axis_position_machine",     # the same in machine coordinates
+    "programmable_frame",        # the programmable frame as a FRAME value (writable)
+    "active_tool",               # number of the active tool
+    "active_tool_edge",          # active tool offset (edge / D number)
+    "feed",                      # programmed feed rate
+    "spindle_speed",             # programmed spindle speed
+)
+AXIS_MEANINGS = ("axis_position_work", "axis_position_machine")
+
 # Variable spaces of nodes.Var
 VAR_SPACES = ("num", "R", "name", "system", "arg")
 
