@@ -377,7 +377,8 @@ def cmd_backplot(args) -> int:
         for w in sc.warnings:
             _err(f"{sc.label}: note: {w}")
     try:
-        data = backplot.render(fmt, scene, view=args.view, comparison=comparison, machine=machine,
+        data = backplot.render(fmt, scene, view=args.view or scene.default_view(), comparison=comparison,
+                               machine=machine,
                                sources=sources)
     except backplot.BackplotError as e:
         raise UsageError(str(e)) from None
@@ -506,8 +507,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", dest="output", required=True, metavar="OUT",
                    help="output file; the format is its ending: .svg .png .glb .html")
     p.add_argument("--from", dest="from_", metavar="DIALECT")
-    p.add_argument("--view", choices=("top", "front", "side", "iso"), default="top",
-                   help="2D view for svg/png, first view of the html viewer (default top)")
+    p.add_argument("--view", choices=("top", "front", "side", "iso"), default=None,
+                   help="2D view for svg/png, first view of the html viewer (default top; front "
+                        "when nothing moves in Y, as on a lathe)")
     p.add_argument("--machine", metavar="MACHINE.toml", help="machine (offsets, tools; stock and fixtures in glb)")
     p.add_argument("--compare", metavar="B", help="overlay a second program and mark where the toolpaths differ")
     p.add_argument("--from-b", metavar="DIALECT", help="dialect of the --compare program")

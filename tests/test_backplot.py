@@ -329,3 +329,21 @@ def test_findings_interface_takes_plain_records_with_or_without_a_position():
     a, b = scene.findings
     assert a.position == (8.0, 0.0, 1.0)          # the first move at or after line 5 ends there
     assert b.position == (4.0, 0.0, 1.0) and b.file == "p.nc"
+
+
+def test_a_program_without_y_motion_is_drawn_from_the_front(tmp_path):
+    src = tmp_path / "xz.nc"
+    src.write_text("%\nO1\nG21 G90 G18\nG0 X20 Z5\nG1 Z-10 F100\nX30\nM30\n%\n")
+    out = tmp_path / "xz.svg"
+    assert run("backplot", src, "--from", "iso-m", "-o", out).returncode == 0
+    assert ET.parse(out).getroot().get("data-view") == "front"
+
+
+def test_a_program_with_an_error_is_plotted_with_the_error_marked_and_exit_1(tmp_path):
+    src = tmp_path / "bad.nc"
+    src.write_text("%\nO1\nG21 G90 G17\nG0 X0 Y0 Z5\nG1 X10 F100\nG2 X20 Y0 I3 J0\nM30\n%\n")   # radii 3 and 7
+    out = tmp_path / "bad.svg"
+    r = run("backplot", src, "-o", out)
+    assert r.returncode == 1 and "NC203" in r.stderr
+    marks = ET.parse(out).getroot().findall(f".//{SVG_NS}g[@class='finding error']")
+    assert [m.get("data-line") for m in marks] == ["6"]

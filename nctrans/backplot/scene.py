@@ -119,6 +119,13 @@ class Scene:
             return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
         return tuple(self.lo), tuple(self.hi)
 
+    def default_view(self) -> str:
+        """Top, unless nothing moves in Y (a lathe's X/Z program): then front, which shows X and Z."""
+        lo, hi = self.bounds()
+        if hi[1] - lo[1] < 1e-6 and hi[2] - lo[2] > 1e-6:
+            return "front"
+        return "top"
+
     def diagonal(self) -> float:
         lo, hi = self.bounds()
         return math.dist(lo, hi)
