@@ -489,6 +489,7 @@
   let drag = null;
   canvas.addEventListener("contextmenu", (ev) => ev.preventDefault());
   canvas.addEventListener("mousedown", (ev) => {
+    canvas.focus();
     drag = { x: ev.clientX, y: ev.clientY, x0: ev.clientX, y0: ev.clientY, pan: ev.button !== 0 || ev.shiftKey };
   });
   window.addEventListener("mousemove", (ev) => {
@@ -527,6 +528,14 @@
   document.querySelectorAll("#toolbar button[data-view]").forEach((b) =>
     b.addEventListener("click", () => setView(b.dataset.view)));
   $("fit").addEventListener("click", fit);
+  canvas.addEventListener("keydown", (ev) => {       // arrows step through the program, Home/End jump
+    const k = { ArrowLeft: -1, ArrowRight: 1, ArrowDown: -10, ArrowUp: 10 }[ev.key];
+    if (k) setStep(state.step + k);
+    else if (ev.key === "Home") setStep(0);
+    else if (ev.key === "End") setStep(A.n);
+    else return;
+    ev.preventDefault();
+  });
   window.addEventListener("resize", draw);
 
   // ------------------------------------------------------------------ header, legend, start

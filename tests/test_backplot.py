@@ -347,3 +347,16 @@ def test_a_program_with_an_error_is_plotted_with_the_error_marked_and_exit_1(tmp
     assert r.returncode == 1 and "NC203" in r.stderr
     marks = ET.parse(out).getroot().findall(f".//{SVG_NS}g[@class='finding error']")
     assert [m.get("data-line") for m in marks] == ["6"]
+
+
+def test_glb_compare_carries_both_toolpaths(tmp_path):
+    import trimesh
+    edited = tmp_path / "edited.nc"
+    edited.write_text(SAMPLE.read_text().replace("N180 X40.", "N180 X42."))
+    out = tmp_path / "cmp.glb"
+    assert run("backplot", SAMPLE, "--compare", edited, "-o", out).returncode == 1
+    geoms = trimesh.load(out).geometry
+    a = sum(len(g.metadata["moves"]) for n, g in geoms.items() if g.metadata.get("kind") and not n.startswith("B-"))
+    b = sum(len(g.metadata["moves"]) for n, g in geoms.items() if g.metadata.get("kind") and n.startswith("B-"))
+    assert a == len(moves_of(SAMPLE)) and b == len(moves_of(edited))
+    assert any(n.startswith("difference") for n in geoms)

@@ -98,6 +98,10 @@ def test_sample_viewer_draws_and_links_moves_and_source(chromium, tmp_path):
                       " s.dispatchEvent(new Event('input')); })()")
         assert page.evaluate("document.getElementById('step').textContent") == f"move 5 / {n} · line 10"
         assert page.evaluate("[...document.querySelectorAll('#src .src-line.cur')].map(e => +e.dataset.line)") == [10]
+        page.evaluate("document.getElementById('canvas').focus()")
+        page.call("Input.dispatchKeyEvent", type="keyDown", key="ArrowRight", code="ArrowRight",
+                  windowsVirtualKeyCode=39)
+        assert page.evaluate("document.getElementById('step').textContent") == f"move 6 / {n} · line 11"
         # a click past the slider hits nothing drawn in full: N110 (move 8) is not selectable now
         x, y = page.evaluate("ncViewer.screenOfMove(0, 8)")
         page.evaluate("ncViewer.state.selected = null")
