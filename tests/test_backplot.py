@@ -360,3 +360,15 @@ def test_glb_compare_carries_both_toolpaths(tmp_path):
     b = sum(len(g.metadata["moves"]) for n, g in geoms.items() if g.metadata.get("kind") and n.startswith("B-"))
     assert a == len(moves_of(SAMPLE)) and b == len(moves_of(edited))
     assert any(n.startswith("difference") for n in geoms)
+
+
+def test_a_move_with_a_non_finite_coordinate_is_left_out_and_said():
+    from nctrans.backplot import build_scene, render
+    from nctrans.toolpath import ToolpathRecord
+    nan = float("nan")
+    recs = [ToolpathRecord(1, "p.nc", 4, "linear", {"X": 0.0, "Y": 0.0, "Z": 0.0}, {"X": 5.0, "Y": 0.0, "Z": 0.0}),
+            ToolpathRecord(2, "p.nc", 5, "linear", {"X": 5.0, "Y": 0.0, "Z": 0.0}, {"X": nan, "Y": 0.0, "Z": 0.0})]
+    scene = build_scene(recs, "p.nc")
+    assert len(scene.moves) == 1 and "line 5" in scene.warnings[0]
+    page = render("html", scene, sources={"p.nc": "G1 X5\nG1 X#1\n"}).decode()
+    assert "NaN" not in page

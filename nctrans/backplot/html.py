@@ -101,7 +101,7 @@ _SLOT = re.compile(r"\{\{(TITLE|CSS|JS|DATA)\}\}")
 def render(scene: Scene, sources: dict[str, str], view: str = "top",
            comparison: Optional[Comparison] = None) -> str:
     """The viewer page as one string."""
-    data = json.dumps(page_data(scene, sources, view, comparison), separators=(",", ":"))
+    data = json.dumps(page_data(scene, sources, view, comparison), separators=(",", ":"), allow_nan=False)
     values = {
         "TITLE": escape(f"{scene.label} - nctrans backplot"),
         "CSS": assets.read_text("viewer.css"),

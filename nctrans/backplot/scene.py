@@ -184,12 +184,16 @@ def build_scene(records: Iterable[ToolpathRecord], label: str,
     moves = scene.moves
     seen_tools: set = set()
     hidden: set[str] = set()      # axes other than X, Y, Z that move
+    skipped: list[int] = []       # lines of moves with a non-finite coordinate
     pending_change: Optional[ToolpathRecord] = None
     last_pos: Optional[XYZ] = None
     for r in records:
         kind = r.kind
         if kind in MOTION_KINDS:
             start, end = xyz(r.start), xyz(r.end)
+            if not math.isfinite(sum(start) + sum(end) + sum((r.center or {}).values())):
+                skipped.append(r.line)      # said below; a NaN would break every renderer
+                continue
             if not moves:       # a tool change before the first move is told by the start marker
                 scene.markers.append(Marker("start", start, 0, r.file, r.line, r.tool))
                 scene.extend_bounds(start)
@@ -219,6 +223,9 @@ def build_scene(records: Iterable[ToolpathRecord], label: str,
     if hidden:
         scene.warnings.append(f"the program moves {', '.join(sorted(hidden))}: the plot shows X, Y and Z "
                               f"only, without {'that axis' if len(hidden) == 1 else 'those axes'}")
+    if skipped:
+        scene.warnings.append(f"{len(skipped)} move(s) with a non-finite coordinate not drawn "
+                              f"(first at line {skipped[0]})")
     for f in findings:
         if isinstance(f, Finding):
             scene.findings.append(f)
