@@ -97,7 +97,7 @@ def render(scene: Scene, view: str = "top", comparison: Optional[Comparison] = N
         x, y = (c * k for c in lay.page(f.position))
         r = 7 * k
         draw.polygon([(x, y - r), (x + r, y), (x, y + r), (x - r, y)],
-                     outline=_rgb(P.SEVERITY_COLOURS.get(f.severity, "#888888")), width=2 * k)
+                     outline=_rgb(P.SEVERITY_COLOURS.get(f.severity, "#8a8a8a")), width=2 * k)
     if comparison is not None:
         for i, mark in enumerate(comparison.marks):
             for side in (mark.a, mark.b):

@@ -209,11 +209,11 @@ def triad(view: str) -> list[tuple[str, float, float]]:
 
 
 # colours: one per tool in order of first use (Tableau 10, distinguishable and print-safe)
-PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22",
+PALETTE = ("#1f77b4", "#2ca02c", "#a066c8", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22",
            "#7f7f7f", "#d62728")
 COMPARE_COLOURS = ("#1f5fbf", "#e8590c")     # A, B in --compare
 DIFF_COLOUR = "#d00000"
-SEVERITY_COLOURS = {"error": "#d00000", "warning": "#e0a000", "info": "#2080d0"}
+SEVERITY_COLOURS = {"error": "#d00000", "warning": "#e0a000", "info": "#2a80d0"}
 
 
 def tool_colours(scene: Scene) -> dict:

@@ -83,7 +83,7 @@ def _findings(out: list, scene: Scene, lay: P.Layout) -> None:
     out.append('<g id="findings">')
     for f in scene.findings:
         x, y = lay.page(f.position)
-        colour = P.SEVERITY_COLOURS.get(f.severity, "#888")
+        colour = P.SEVERITY_COLOURS.get(f.severity, "#8a8a8a")
         tip = f"{f.file}:{f.line}: {f.severity}[{f.code}] {f.message}"
         out.append(f'<g class="finding {escape(f.severity)}" data-line="{f.line}">'
                    f'<title>{escape(tip)}</title>'
