@@ -371,7 +371,12 @@ def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], d
             for f in files:
                 ld = _load(f, dialect, stream=True, file=file)
                 m = _machine(machine, ld.dialect)
-                out.extend(d for d in pipeline.lint(ld, m) if keep(d))
+                if machine is None:
+                    diags = pipeline.lint(ld, m)
+                else:                   # a machine given: the machine check's findings too
+                    from nctrans.check import check_loaded
+                    diags = check_loaded(ld, m)[0]
+                out.extend(d for d in diags if keep(d))
     _raise_on_errors(out, error_level)
     return out
 

@@ -24,7 +24,7 @@ from nctrans.diagnostics import SEVERITY_RANK, Diagnostic
 # use them: start-up time is a large share of a `toolpath` or `lint` run on one file.
 
 EXIT_OK, EXIT_DIAGNOSTICS, EXIT_USAGE = 0, 1, 2
-NOT_IMPLEMENTED = ("check", "audit", "fuzz", "lsp")
+NOT_IMPLEMENTED = ("audit", "fuzz", "lsp")
 
 
 class UsageError(Exception):
@@ -294,6 +294,58 @@ def cmd_toolpath(args) -> int:
     return EXIT_DIAGNOSTICS if _at_or_above(ld.diagnostics, args.fail_on) else EXIT_OK
 
 
+# --------------------------------------------------------------------------- check
+
+def cmd_check(args) -> int:
+    """Findings (and the program's own errors) as diagnostics, then the cycle time per file."""
+    import json
+
+    from nctrans import check as _check
+    _check_dialect(args.from_)
+    base_machine = pipeline.load_machine(args.machine, args.from_) if args.machine else None
+    files = list(pipeline.iter_inputs(args.paths))
+    if not files:
+        raise UsageError("no NC files found in " + " ".join(args.paths))
+    if files.count(_source.STDIN) > 1:
+        raise UsageError("'-' (stdin) can be given once")
+    all_diags: list[Diagnostic] = []
+    times: dict[str, dict] = {}
+    findings: list[dict] = []
+    text_times: list[str] = []
+    status = EXIT_OK
+    for f in files:
+        try:
+            ld = pipeline.load(f, args.from_, stream=True)
+            m = _check.with_extra_solids(base_machine or pipeline.load_machine(None, ld.dialect),
+                                         args.fixture or [], args.stock)
+            diags, result = _check.check_loaded(ld, m)
+        except pipeline.PipelineError as e:
+            _err(str(e))
+            status = EXIT_USAGE
+            continue
+        all_diags.extend(d for d in diags if d.rule.startswith("NC3") or d.severity == "error")
+        if result is not None:
+            times[ld.label] = result.cycle.to_dict()
+            findings.extend(x.to_dict() for x in result.findings)
+            text_times.append(f"{ld.label}: {result.moves} moves checked on {m.name!r}; "
+                              f"estimated cycle time\n{result.cycle.report()}")
+    if args.format == "text":
+        _print_text_diags(all_diags, sys.stdout)
+        sys.stdout.write("".join(text_times))
+    elif args.format == "json":
+        doc = json.loads(_output.render("json", all_diags, len(times)))
+        doc["findings"] = findings          # with position and amount, for plots and scripts
+        doc["cycle_time"] = times
+        sys.stdout.write(json.dumps(doc, indent=2) + "\n")
+    else:
+        sys.stdout.write(_output.render(args.format, all_diags, len(times)))
+        sys.stderr.write("".join(text_times))
+    sys.stdout.flush()
+    if status == EXIT_OK and _at_or_above(all_diags, args.fail_on):
+        status = EXIT_DIAGNOSTICS
+    return status
+
+
 # --------------------------------------------------------------------------- equiv
 
 def cmd_equiv(args) -> int:
@@ -478,6 +530,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error")
     _add_search_path(p)
     p.set_defaults(func=cmd_lint)
+
+    p = sub.add_parser("check", help="check a program against a machine: limits, collisions, cycle time")
+    p.add_argument("paths", nargs="+", metavar="PATH", help="files or directories (recursed); '-' = stdin")
+    p.add_argument("--from", dest="from_", metavar="DIALECT")
+    p.add_argument("--machine", metavar="MACHINE.toml", help="machine model (default: the built-in machine)")
+    p.add_argument("--fixture", action="append", metavar="F.stl",
+                   help="a fixture mesh in machine coordinates (STL/OBJ/PLY; repeatable)")
+    p.add_argument("--stock", metavar="S.stl", help="the stock as a mesh in machine coordinates")
+    p.add_argument("--format", choices=_output.FORMATS, default="text")
+    p.add_argument("--fail-on", choices=("error", "warning", "info"), default="warning",
+                   help="exit 1 on findings at or above this severity (default: warning)")
+    _add_search_path(p)
+    p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("toolpath", help="print the canonical toolpath")
     p.add_argument("src", metavar="SRC")

@@ -24,12 +24,43 @@ class Axis:
     max: Optional[float] = None
     max_feed: Optional[float] = None
     rapid: Optional[float] = None
+    accel: Optional[float] = None           # mm/s² (deg/s² rotary): cycle time only
+
+    def __post_init__(self) -> None:
+        _check_range(self.min, self.max, "min", "max")
+        for name in ("max_feed", "rapid", "accel"):
+            _check_positive(getattr(self, name), name)
+
+
+def _check_range(lo: Optional[float], hi: Optional[float], lo_name: str, hi_name: str) -> None:
+    if lo is not None and hi is not None and lo > hi:
+        raise ValueError(f"{lo_name} ({lo:g}) is above {hi_name} ({hi:g})")
+
+
+def _check_positive(v: Optional[float], name: str) -> None:
+    if v is not None and not v > 0:
+        raise ValueError(f"{name} must be a positive number, not {v:g}")
 
 
 @dataclass
 class Spindle:
     __pydantic_config__ = _OPEN
     max_rpm: Optional[float] = None
+
+    def __post_init__(self) -> None:
+        _check_positive(self.max_rpm, "max_rpm")
+
+
+@dataclass
+class Cylinder:
+    """One cylinder of a tool holder, coaxial with the tool."""
+    __pydantic_config__ = {"extra": "forbid"}
+    radius: float
+    length: float
+
+    def __post_init__(self) -> None:
+        _check_positive(self.radius, "radius")
+        _check_positive(self.length, "length")
 
 
 @dataclass
@@ -42,13 +73,73 @@ class Tool:
     holder_length: Optional[float] = None
     cutting_length: Optional[float] = None
     name: Optional[str] = None              # Sinumerik tools are selected by name (T="DRILL")
+    # More holder geometry than holder_radius/holder_length: cylinders stacked upward from where
+    # the holder starts (see holder_cylinders), or a mesh with its origin at the tool tip and +Z
+    # pointing up the tool axis towards the spindle.
+    holder: list[Cylinder] = field(default_factory=list)
+    holder_mesh: Optional[str] = None
+
+    def __post_init__(self) -> None:
+        for name in ("length", "radius", "cutting_length", "holder_radius", "holder_length"):
+            v = getattr(self, name)
+            if v is not None and v < 0:
+                raise ValueError(f"{name} must not be negative, not {v:g}")
+        if (self.holder_radius is None) != (self.holder_length is None):
+            raise ValueError("holder_radius and holder_length go together")
+
+    def holder_cylinders(self) -> list[tuple[float, float, float]]:
+        """(radius, bottom, top) of each holder cylinder, heights above the tool tip. The holder
+        starts above the cutting length; without a cutting length, where the stack's top meets
+        the gauge line (tool length above the tip)."""
+        stack = ([Cylinder(self.holder_radius, self.holder_length)]
+                 if self.holder_radius is not None else []) + list(self.holder)
+        if not stack:
+            return []
+        total = sum(c.length for c in stack)
+        z = self.cutting_length if self.cutting_length is not None else max(self.length - total, 0.0)
+        out = []
+        for c in stack:
+            out.append((c.radius, z, z + c.length))
+            z += c.length
+        return out
+
+    def cutter_height(self) -> float:
+        """Height above the tip of the part that may touch material: the cutting length, else the
+        whole tool up to its holder (or its length)."""
+        if self.cutting_length is not None:
+            return self.cutting_length
+        cyl = self.holder_cylinders()
+        return cyl[0][1] if cyl else self.length
 
 
 @dataclass
 class Mesh:
+    """A fixture or the stock: a mesh file (STL/OBJ/PLY, path relative to the machine file) or a
+    box, in machine coordinates, or relative to work offset `frame` (e.g. "G54") when given;
+    `position` moves it further."""
     __pydantic_config__ = _OPEN
     mesh: Optional[str] = None
     box: Optional[dict[str, list[float]]] = None
+    name: Optional[str] = None
+    position: Optional[list[float]] = None
+    frame: Optional[str] = None
+    cell: Optional[float] = None            # stock: Z-map cell size in mm (default from its size)
+
+    def __post_init__(self) -> None:
+        if (self.mesh is None) == (self.box is None):
+            raise ValueError("give either mesh = \"file\" or box = { min = [x, y, z], max = [x, y, z] }")
+        if self.box is not None:
+            if set(self.box) != {"min", "max"}:
+                raise ValueError("box needs exactly the keys min and max")
+            lo, hi = self.box["min"], self.box["max"]
+            if len(lo) != 3 or len(hi) != 3:
+                raise ValueError("box min and max are [x, y, z]")
+            for a, l, h in zip("xyz", lo, hi):
+                if not l < h:
+                    raise ValueError(f"box min {a} ({l:g}) must be below max {a} ({h:g})")
+        if self.position is not None and len(self.position) != 3:
+            raise ValueError("position is [x, y, z]")
+        _check_positive(self.cell, "cell")
 
 
 @dataclass
@@ -70,6 +161,7 @@ class Machine:
     # name (Fagor "V.MPA.MAXFEED.X", "V.MTB.P1"): what the machine model knows of them
     variables: dict[str, float] = field(default_factory=dict)
     source_dir: Optional[str] = None
+    tool_change_s: Optional[float] = None   # seconds per tool change (cycle time)
 
     def __post_init__(self) -> None:
         self.axes = {k.upper(): v for k, v in self.axes.items()}
@@ -129,6 +221,18 @@ def default_lathe() -> Machine:
     )
 
 
+def _explain(e) -> str:
+    """One line per problem: the key path as it is written in the TOML file, then what is wrong."""
+    lines = []
+    for err in e.errors():
+        loc = ""
+        for part in err["loc"]:
+            loc += f"[{part}]" if isinstance(part, int) else (f".{part}" if loc else str(part))
+        msg = err["msg"].removeprefix("Value error, ")
+        lines.append(f"  {loc or '(top level)'}: {msg}")
+    return "\n".join(lines)
+
+
 class MachineError(Exception):
     """A machine file that cannot be read or validated; carries a user-facing message."""
 
@@ -146,7 +250,7 @@ def load(path: str | Path) -> Machine:
         raise MachineError(f"{path}: invalid TOML: {e}") from None
     try:
         m = TypeAdapter(Machine).validate_python(data)
-    except ValidationError as e:   # keep pydantic's readable text
-        raise MachineError(f"{path}: invalid machine description:\n{e}") from None
+    except ValidationError as e:
+        raise MachineError(f"{path}: invalid machine description:\n{_explain(e)}") from None
     m.source_dir = str(path.parent)
     return m

@@ -9,7 +9,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Optional
 
-KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant", "stop")
+KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant", "stop", "limits")
+# "limits": programmable travel limits from here on (e.g. Fagor G198/G199), machine coordinates:
+# `start` holds the lower limits, `end` the upper ones, by axis; an axis absent from both is
+# unbounded, and a limits record with neither lifts every programmable limit.
 
 
 @dataclass(slots=True)
@@ -33,6 +36,11 @@ class ToolpathRecord:
     coolant: Optional[str] = None          # coolant events: "mist" | "flood" | "off"
     stop_kind: Optional[str] = None        # stop events: "stop" | "optional" | "end"
     pitch: Optional[float] = None          # spindle-synchronised feed (tapping): lead in mm/rev
+    # Constant surface speed, on moves while it is on: the surface speed (m/min) and the spindle
+    # speed limit in force (rpm, e.g. G50 S / LIMS); the radius is |X|. `spindle` stays the speed
+    # the dialect computed; `check` also works out the speed at the move's smallest radius.
+    css: Optional[float] = None
+    spindle_limit: Optional[float] = None
 
     def to_dict(self) -> dict:
         out = {}

@@ -156,6 +156,10 @@ def to_json_line(r: ToolpathRecord) -> str:
         s += f',"stop_kind":"{r.stop_kind}"'
     if r.pitch is not None:
         s += ',"pitch":' + _spell(r.pitch)
+    if r.css is not None:
+        s += ',"css":' + _spell(r.css)
+    if r.spindle_limit is not None:
+        s += ',"spindle_limit":' + _spell(r.spindle_limit)
     s += "}"
     if "nan" in s or "inf" in s:      # a non-finite number (or a file name containing the letters)
         return _safe_json_line(r)
