@@ -208,3 +208,33 @@ def test_flattened_iso_t_runs_in_rs274_with_the_same_xz_moves(path, rs274, rs274
     source = [h.Motion.of(r) for r in records if r.kind in ("rapid", "linear", "arc")]
     problem = h.compare(result.moves, source, path.name)
     assert problem is None, problem
+
+
+def test_radius_x_among_diameters_is_flagged_with_the_arc_as_evidence():
+    text = "G18 G21 G99\nT0101\nG00 X20. Z2.\nG01 Z0. F0.1\nG03 X15. Z-5. I5. K0.\nM30\n"
+    _, diags = run(Path("r.nc"), text)
+    assert {(d.rule, d.line) for d in diags} >= {("NC203", 5), ("NC234", 5)}
+    _, diags = run(Path("r.nc"), text.replace("X15.", "X30."))
+    assert not [d for d in diags if d.rule in ("NC203", "NC234")]
+
+
+def test_gcode_system_b_renames_onto_system_a():
+    from nctrans.dialects.iso_m import frontend as iso
+    from nctrans.dialects.iso_t.frontend import TurningLowering
+
+    class SystemB(TurningLowering):
+        def __init__(self, file, diags):
+            super().__init__(file, diags)
+            self.system = "B"
+            self.renames = dict(self.table.options["gcode_systems"]["B"])
+    text = ("G18 G21 G95\nT0101\nG97 S500 M03\nG00 X50. Z2.\nG77 X40. Z-30. F0.2\n"
+            "G00 X50. Z2.\nG91 G00 X-10.\nG90 G78 X29.2 Z-20. F1.5\nM30\n")
+    prog = iso.parse_program(text, "b.nc", SystemB).program
+    prog.meta["defaults"]["diameter"] = "diameter"
+    recs = list(interpret(prog, default_lathe(), diagnostics=[]))
+    # G77 = system A's G90; G95 = G99 (per revolution); G91 X-10. is incremental in diameter
+    assert moves(recs, 5) == [("rapid", 20.0, 2.0), ("linear", 20.0, -30.0), ("linear", 25.0, -30.0),
+                              ("rapid", 25.0, 2.0)]
+    assert [r.feed_mode for r in recs if r.line == 5 and r.kind == "linear"] == ["per_rev"] * 2
+    assert moves(recs, 7) == [("rapid", 20.0, 2.0)]
+    assert moves(recs, 8)[1] == ("linear", 14.6, -20.0)

@@ -1207,6 +1207,8 @@ class Interpreter(LatheMixin):
                     raise arcs.ArcError(err)
         except arcs.ArcError as ex:
             self.diag("NC203", "error", str(ex))    # the controller alarms: no motion
+            if st.diameter:
+                self._radius_x_check(vals, center, radius, cw)
             return
         self._move("arc", end, (c1, c2), cw, nturns)
 

@@ -57,7 +57,7 @@ class LatheMixin:
         if limit is not None:
             rpm = min(rpm, limit)
         if math.isinf(rpm):
-            self.diag("NC231", "warning", "constant surface speed at X0 with no maximum spindle "
+            self.diag("NC233", "warning", "constant surface speed at X0 with no maximum spindle "
                       "speed (G50 S / LIMS=) and no machine max_rpm: the speed is unbounded; "
                       "analysed as the last speed")
             return self.st.spindle_speed or 0.0
@@ -70,7 +70,10 @@ class LatheMixin:
 
     def _css_mode(self, value: str) -> None:
         st = self.st
-        if value == "css" and self._css_applies():
+        if value == "css" and not self._css_applies():
+            self.diag("NC220", "warning", "constant surface speed is not modelled on a mill (no "
+                      "radius to derive the speed from): spindle speeds are the programmed S values")
+        elif value == "css":
             if st.spindle_speed is not None and self.css_surface is None:
                 self.css_surface = st.spindle_speed * (0.3048 if st.scale != 1.0 else 1.0)
         elif value == "rpm":
@@ -95,6 +98,36 @@ class LatheMixin:
         self.css_limit = v
         if self.css_surface is not None:
             self._css_move(self.pos)
+
+    # ------------------------------------------------------------------ radius among diameters
+    def _radius_x_check(self, vals, center, radius, cw) -> None:
+        """An arc that fails in diameter mode but closes with its X word read as a radius: the
+        word was most likely written as a radius among diameters (NC234, with the evidence)."""
+        from nctrans.interp import arcs
+        xs = [(a, v, m) for a, v, m in vals if a == "X"]
+        if not xs or xs[0][2] == "inc":
+            return
+        as_radius = [(a, v * 2 if a == "X" else v, m) for a, v, m in vals]
+        end = self._target(as_radius)
+        s1, s2 = self.pos.get("Z", 0.0), self.pos.get("X", 0.0)
+        e1, e2 = end.get("Z", 0.0), end.get("X", 0.0)
+        inch = self.st.scale != 1.0
+        try:
+            if radius is not None:
+                r = self._value(radius, "arc radius")
+                if r is None:
+                    return
+                arcs.center_from_radius(s1, s2, e1, e2, r * self.st.scale, cw, inch)
+            else:
+                cd = {a: v for a, v, _ in self._eval_words(center)}
+                c1, c2 = s1 + cd.get("K", 0.0), s2 + cd.get("I", 0.0)
+                if arcs.check_center(s1, s2, e1, e2, c1, c2, inch):
+                    return
+        except arcs.ArcError:
+            return
+        written = xs[0][1] * 2 / self.st.scale
+        self.diag("NC234", "warning", f"X{written:g} reads as a radius among diameters: the arc closes "
+                  f"with X{2 * written:g} (diameter), not with X{written:g}")
 
     # ------------------------------------------------------------------ cycles
     def _turning_cycle(self, s: n.CycleCall):

@@ -73,9 +73,9 @@ NO_EFFECT_PREFIX = "no motion effect"
 MILL_ONLY = "no motion effect on a mill"
 
 # Modal values the interpreter records but does not model: selecting one is reported (NC220) with
-# what it leaves out. A value leaves this table when the interpreter models it.
+# what it leaves out. A value leaves this table when the interpreter models it: diameter programming
+# and constant surface speed are modelled by nctrans.interp.lathe (CSS on a lathe or in diameter mode;
+# on a mill it reports NC220 itself).
 UNMODELLED_MODES: dict[tuple[str, str], str] = {
     ("polar", "on"): "polar coordinate mode: axis words are read as Cartesian coordinates",
-    ("spindle_mode", "css"): "constant surface speed: spindle speeds are the programmed S values",
-    ("diameter", "diameter"): "diameter programming: X words are read as radius values",
 }
