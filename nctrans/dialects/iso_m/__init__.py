@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 
 from nctrans.dialects.base import Dialect, EmitResult, Marker, ParseResult
+from nctrans.lower.loops import for_to_while
 
 _I = re.IGNORECASE
 
@@ -82,6 +83,7 @@ class IsoFamily(Dialect):
     comment_evidence = {"paren_comment": (1.0, 3)}
     subprogram_endings = (".nc", ".NC", ".tap", ".TAP", ".ngc", ".cnc", ".iso", ".eia", ".txt")
     streams = True
+    lowering_passes = (for_to_while,)     # macro B has WHILE..DO..END but no FOR
 
     def lowering(self):
         """The front end's Lowering class (imported here so that registering stays light)."""
