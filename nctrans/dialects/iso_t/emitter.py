@@ -64,6 +64,17 @@ class TurningEmitter(iso.IsoEmitter):
         self.pos = {}
         return [("G:0", "G50")] + self._axes(s.target)
 
+    def w_HomeReturn(self, s):
+        """G28 U0 W0: an incremental via point is written with U/W (system A has no G91); a
+        zero incremental Y (a mill's G74 X1=0 Y1=0 Z1=0) names no lathe axis and is left out."""
+        self.pos = {}
+        via = {k: av for k, av in s.via.items()
+               if not (k == "Y" and av.mode == "inc" and type(av.value) is n.Num and av.value.value == 0)}
+        if any(k not in _INC and av.mode == "inc" for k, av in via.items()):
+            raise iso.NotExpressible("an incremental reference-point via point on an axis without "
+                                     "an incremental address")
+        return [("G:0", "G28" if s.ref == 1 else "G30")] + self._ref_index(s) + self._axes(via)
+
     def w_SpindleLimit(self, s):
         return [("G:0", "G50"), ("S", self.addr("S", s.value))]
 

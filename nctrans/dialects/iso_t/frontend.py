@@ -150,8 +150,9 @@ class TurningLowering(iso.Lowering):
         s = b.vals.pop("S", None)
         if s is not None:
             b.out.append((iso.B_SPEED, SpindleLimit(self.num("S", s))))
-        b.owner = "set_position"
-        b.owner_rule = rule
+        if any(k in b.vals for k in "XZUWC"):      # G50 S alone sets no position
+            b.owner = "set_position"
+            b.owner_rule = rule
 
     def _g_turning(self, b, rule, text: str) -> None:
         """A turning cycle block: its words become the CycleCall's parameters."""

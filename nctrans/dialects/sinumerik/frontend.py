@@ -434,6 +434,8 @@ class Lowerer:
             w.out.append(ir.OffsetSelect("radius", value))
         elif _RPARAM.match(name):
             w.out.append(ir.Assign(ir.Var("R", int(name[1:])), value))
+        elif name == "LIMS":                                  # the clamp of G96 (lathe.py)
+            w.out.append(ir.SpindleLimit(value))
         elif name in self.pass_words:
             w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
         elif re.fullmatch(r"M\d+", name) and name == "M1" and isinstance(value, ir.Num) and \
