@@ -7,7 +7,9 @@ the CLI end to end (subprocess wall time, output to /dev/null), LinuxCNC
 rs274 on the same file in the same run and the CLI/rs274 time ratio. Then peak memory (tracemalloc)
 for one program and for the same program repeated 10x: the full parse holds the IR (it grows with
 the text) and the interpreter's peak is measured above it; the streamed parse + run + serialisation
-(source text held by the caller) must stay flat. Plain-text table; no assertions.
+(source text held by the caller) must stay flat. Then lint as users run it (lines/s in-process
+and through the CLI) and the per-file start-up of `nctrans lint` on small ISO and Sinumerik programs.
+Plain-text table; no assertions.
 """
 from __future__ import annotations
 
@@ -242,9 +244,48 @@ def main(argv=None) -> int:
         print()
         print(f"start-up: CLI lint of {STARTUP_PROGRAM.name} ({read_text(STARTUP_PROGRAM).count(chr(10))} lines, "
               f"Sinumerik): {fmt(t, '.3f')} s (exit {rc})")
+    lint_table(paths, args.repeat, notes)
     for n in notes:
         print("note:", n)
     return 0
+
+
+# Small programs for per-file start-up: what pre-commit and editors pay on every file.
+STARTUP = (ROOT / "corpus" / "iso-m" / "sample-pocket.nc", ROOT / "corpus" / "sinumerik" / "variables.mpf")
+
+
+def lint_table(paths: list[Path], repeat: int, notes: list[str]) -> None:
+    """Lint as users run it (nctrans.api.lint: parse, interpreter, IR analyses, suppressions):
+    lines/s in-process and through the CLI on the largest programs, then per-file start-up."""
+    from nctrans import api as _api
+    print()
+    print("lint (nctrans.api.lint and `nctrans lint`, text output to /dev/null)")
+    print(f"{'program':34} {'lines':>6} {'diags':>6} {'lint l/s':>10} {'CLI lint s':>10} {'CLI lint l/s':>12}")
+    for path in paths:
+        lines = read_text(path).count("\n") or 1
+        try:
+            n = len(_api.lint(path, "iso-m"))
+            rate = lines / best_time(lambda: _api.lint(path, "iso-m"), repeat)
+        except Exception as e:
+            notes.append(f"{path.name}: api.lint: {type(e).__name__}: {e}")
+            n = rate = None
+        cli, rc = wall(NCTRANS + ["lint", str(path), "--from", "iso-m"], repeat)
+        if rc >= 2:
+            notes.append(f"{path.name}: CLI lint exit {rc}")
+            cli = None
+        print(f"{path.name[:34]:34} {lines:>6} {fmt(n):>6} {fmt(rate):>10} {fmt(cli, '.3f'):>10} "
+              f"{fmt(lines / cli if cli else None):>12}")
+    print()
+    print("per-file start-up: `nctrans lint FILE` wall time on a small program (ms, best of the runs)")
+    print(f"{'program':34} {'lines':>6} {'text ms':>8} {'sarif ms':>9}")
+    for path in STARTUP:
+        if not path.exists():
+            continue
+        lines = read_text(path).count("\n")
+        text_s, _ = wall(NCTRANS + ["lint", str(path)], repeat)
+        sarif_s, _ = wall(NCTRANS + ["lint", str(path), "--format", "sarif"], repeat)
+        print(f"{path.name[:34]:34} {lines:>6} {fmt(text_s * 1000 if text_s else None):>8} "
+              f"{fmt(sarif_s * 1000 if sarif_s else None):>9}")
 
 
 if __name__ == "__main__":

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Iterable, Iterator, Optional, Sequence, Union
 
 from nctrans import pipeline
+from nctrans import linting
 from nctrans import source as _source
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import DEFAULT_DIALECT
@@ -135,20 +136,21 @@ def _machine(machine: MachineLike, dialect: Optional[str]) -> Machine:
 
 
 def _load(source: Union[str, "os.PathLike[str]", _source.SourceText], dialect: Optional[str], *,
-          stream: bool = False, file: str = STRING_LABEL) -> pipeline.Loaded:
+          stream: bool = False, file: str = STRING_LABEL, fallback: Optional[str] = None) -> pipeline.Loaded:
     """Read and parse text (a str) or a file (a PathLike). The CLI also passes already decoded
     standard input (a SourceText)."""
     _check_dialect(dialect)
     with _api_errors():
         if isinstance(source, _source.SourceText):
-            return pipeline.load_source(source, _source.STDIN, dialect, stream)
+            return pipeline.load_source(source, _source.STDIN, dialect, stream, fallback)
         if isinstance(source, str):
-            return pipeline.load_source(_source.from_text(source, file), _source.STDIN, dialect, stream)
+            return pipeline.load_source(_source.from_text(source, file), _source.STDIN, dialect, stream,
+                                        fallback)
         if isinstance(source, os.PathLike):
             path = os.fspath(source)
             if os.path.isdir(path):
                 raise NCInputError(f"{path}: is a directory (lint takes directories)")
-            return pipeline.load(path, dialect, stream)
+            return pipeline.load(path, dialect, stream, fallback)
     raise NCInputError(f"source must be program text (str) or a path (os.PathLike), not {type(source).__name__}")
 
 
@@ -352,9 +354,14 @@ def rule_filter(select: Iterable[str] = (), ignore: Iterable[str] = ()):  # type
 def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], dialect: Optional[str] = None,
          machine: MachineLike = None, *, select: Iterable[str] = (), ignore: Iterable[str] = (),
          search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
-         error_level: ErrorLevel = ErrorLevel.IGNORE) -> list[Diagnostic]:
+         error_level: ErrorLevel = ErrorLevel.IGNORE, target: Optional[str] = None,
+         default_dialect: Optional[str] = None) -> list[Diagnostic]:
     """Diagnostics of program text, a file, a directory (recursed for NC file endings, as
-    `nctrans lint DIR`) or several paths, filtered by rule-code prefixes `select`/`ignore`."""
+    `nctrans lint DIR`) or several paths, filtered by rule-code prefixes `select`/`ignore`, after
+    the programs' own `nctrans: ignore` comments. `target`: also what converting to that dialect
+    would lower or refuse (NC4xx; nothing is written). `default_dialect`: the dialect of a file
+    when neither `dialect` nor the file's `nctrans: dialect=` pragma names one (before detection;
+    the CLI passes the project configuration's)."""
     if isinstance(source, (str, os.PathLike, _source.SourceText)):
         sources: list[Union[str, os.PathLike[str], _source.SourceText]] = [source]
     else:
@@ -368,14 +375,16 @@ def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], d
                     Path(f) for f in pipeline.iter_inputs([os.fspath(s)])]
             else:
                 files = [s]
+            if target is not None:
+                _check_dialect(target)
             for f in files:
-                ld = _load(f, dialect, stream=True, file=file)
+                ld = _load(f, dialect, stream=target is None, file=file, fallback=default_dialect)
                 m = _machine(machine, ld.dialect)
                 if machine is None:
-                    diags = pipeline.lint(ld, m)
+                    diags = linting.lint_loaded(ld, m, target)
                 else:                   # a machine given: the machine check's findings too
                     from nctrans.check import check_loaded
-                    diags = check_loaded(ld, m)[0]
+                    diags = linting.lint_loaded(ld, m, target, run=lambda l, mm: check_loaded(l, mm)[0])
                 out.extend(d for d in diags if keep(d))
     _raise_on_errors(out, error_level)
     return out

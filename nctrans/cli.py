@@ -223,8 +223,21 @@ def cmd_convert(args) -> int:
 # --------------------------------------------------------------------------- lint
 
 def cmd_lint(args) -> int:
+    from nctrans import linting as _lint
+    from nctrans.linting import config as _config
     _check_dialect(args.from_)
-    machine = pipeline.load_machine(args.machine, args.from_) if args.machine else None
+    if args.target:
+        _check_dialect(args.target)
+    try:
+        cfg = _config.discover(args.config)
+    except _config.ConfigError as e:
+        raise UsageError(str(e)) from None
+    machine_path = args.machine or (cfg.machine_path() if cfg else None)
+    machine = pipeline.load_machine(machine_path, args.from_) if machine_path else None
+    selection = _lint.Selection(
+        _lint.Selection.parse(args.select) or _lint.Selection.parse(cfg.select if cfg else ()),
+        _lint.Selection.parse(cfg.ignore if cfg else ()) + _lint.Selection.parse(args.ignore))
+    fail_on = args.fail_on or (cfg.fail_on if cfg else None) or "error"
     files = list(pipeline.iter_inputs(args.paths))
     if not files:
         _err("no NC files found in " + " ".join(args.paths))
@@ -232,7 +245,6 @@ def cmd_lint(args) -> int:
         return EXIT_OK
     if _source.STDIN in files and files.count(_source.STDIN) > 1:
         raise UsageError("'-' (stdin) can be given once")
-    keep = api.rule_filter(args.select or [], args.ignore or [])
     all_diags: list[Diagnostic] = []
     status = EXIT_OK
     bar = _progress(len(files), "lint")
@@ -240,7 +252,8 @@ def cmd_lint(args) -> int:
     try:
         for f in files:
             try:
-                diags = api.lint(_cli_source(f), args.from_, machine)
+                diags = api.lint(_cli_source(f), args.from_, machine, target=args.target,
+                                 default_dialect=cfg.dialect_for(f) if cfg else None)
                 done += 1
             except (api.NCError, pipeline.PipelineError) as e:
                 _err(str(e))
@@ -253,7 +266,8 @@ def cmd_lint(args) -> int:
             finally:
                 if bar is not None:
                     bar.advance(bar.task_ids[0])
-            all_diags.extend(d for d in diags if keep(d))
+            extra = cfg.ignored_for(f) if cfg else []
+            all_diags.extend(d for d in diags if selection.keeps(d.rule, extra))
     finally:
         if bar is not None:
             bar.stop()
@@ -262,7 +276,7 @@ def cmd_lint(args) -> int:
     else:
         sys.stdout.write(_output.render(args.format, all_diags, done))
         sys.stdout.flush()
-    if status == EXIT_OK and _at_or_above(all_diags, args.fail_on):
+    if status == EXIT_OK and _at_or_above(all_diags, fail_on):
         status = EXIT_DIAGNOSTICS
     return status
 
@@ -527,7 +541,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--machine", metavar="MACHINE.toml")
     p.add_argument("--select", action="append", metavar="RULES", help="only these rules (prefixes, comma-separated)")
     p.add_argument("--ignore", action="append", metavar="RULES", help="drop these rules (prefixes, comma-separated)")
-    p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error")
+    p.add_argument("--fail-on", choices=("error", "warning", "info"), default=None,
+                   help="lowest severity that makes the exit code 1 (default error)")
+    p.add_argument("--target", metavar="DIALECT",
+                   help="also report what converting to DIALECT would lower or refuse (NC4xx)")
+    p.add_argument("--config", metavar="FILE",
+                   help="project configuration (default: nctrans.toml or pyproject.toml [tool.nctrans] "
+                        "found from the working directory up)")
     _add_search_path(p)
     p.set_defaults(func=cmd_lint)
 

@@ -54,7 +54,9 @@ def format_github(diags: list[Diagnostic]) -> str:
     out = []
     for d in diags:
         cmd = _GITHUB_COMMAND.get(d.severity, "warning")
-        props = (f"file={_gh_prop(d.file)},line={d.line},col={d.column},"
+        # GitHub matches annotations to repository paths: "./a.nc" (a directory walk) as "a.nc"
+        file = d.file[2:] if d.file.startswith("./") else d.file
+        props = (f"file={_gh_prop(file)},line={d.line},col={d.column},"
                  f"endLine={d.end_line},endColumn={d.end_column},title={_gh_prop(d.rule)}")
         out.append(f"::{cmd} {props}::{_gh_data(d.message)}\n")
     return "".join(out)
@@ -96,16 +98,49 @@ def _sarif_rule(r: "_catalogue.Rule") -> dict:
     }
 
 
+class _Fingerprints:
+    """partialFingerprints for code scanning: a hash of the rule, the file and the text of the
+    diagnostic's line (not its number), plus which occurrence of that triple it is. A finding keeps
+    its fingerprint when lines are inserted above it, so code scanning tracks it across commits
+    instead of closing and reopening it."""
+    KEY = "nctransLineHash/v1"
+
+    def __init__(self) -> None:
+        self._lines: dict[str, list[str]] = {}
+        self._seen: dict[str, int] = {}
+
+    def _line_text(self, file: str, line: int) -> str:
+        if file not in self._lines:
+            try:
+                with open(file, "rb") as fh:
+                    self._lines[file] = [ln.strip().decode("latin-1") for ln in fh]
+            except (OSError, ValueError):      # stdin, a vanished file, a name the OS refuses
+                self._lines[file] = []
+        lines = self._lines[file]
+        return " ".join(lines[line - 1].split()) if 0 < line <= len(lines) else f"#{line}"
+
+    def of(self, d: Diagnostic, uri: str) -> dict[str, str]:
+        import hashlib
+        text = self._line_text(d.file, d.line)
+        digest = hashlib.sha256(f"{d.rule}\0{uri}\0{text}".encode("utf-8", "replace")).hexdigest()[:32]
+        n = self._seen.get(digest, 0) + 1
+        self._seen[digest] = n
+        return {self.KEY: f"{digest}:{n}"}
+
+
 def sarif_document(diags: list[Diagnostic], cat: Optional[_catalogue.Catalogue] = None) -> dict:
     from nctrans import catalogue as _catalogue    # pydantic: only SARIF needs the catalogue
     cat = cat or _catalogue.load()
     rules = [_sarif_rule(r) for r in cat.rule]
     index = {r.code: i for i, r in enumerate(cat.rule)}
     results = []
+    prints = _Fingerprints()
     for d in diags:
-        loc = {"physicalLocation": {"artifactLocation": {"uri": artifact_uri(d.file)}, "region": _region(d)}}
+        uri = artifact_uri(d.file)
+        loc = {"physicalLocation": {"artifactLocation": {"uri": uri}, "region": _region(d)}}
         res = {"ruleId": d.rule, "level": _SARIF_LEVEL.get(d.severity, "warning"),
-               "message": {"text": d.message}, "locations": [loc]}
+               "message": {"text": d.message}, "locations": [loc],
+               "partialFingerprints": prints.of(d, uri)}
         if d.rule in index:
             res["ruleIndex"] = index[d.rule]
         if d.fix is not None:

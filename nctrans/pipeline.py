@@ -79,14 +79,17 @@ _CHECK_HEAD = 4 * 1024
 
 
 def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Optional[str] = None,
-                stream: bool = False) -> Loaded:
-    """Parse already-read text: choose the dialect (given or detected), parse, collect diagnostics.
-    With `stream` the parse may be lazy (Dialect.streams): the program must then be run exactly
-    once, through toolpath_of or lint, which complete the diagnostics."""
+                stream: bool = False, fallback: Optional[str] = None) -> Loaded:
+    """Parse already-read text: choose the dialect (given, else the file's own `nctrans: dialect=`
+    pragma, else `fallback` (the project configuration's), else detected), parse, collect
+    diagnostics. With `stream` the parse may be lazy (Dialect.streams): the program must then be
+    run exactly once, through toolpath_of or lint, which complete the diagnostics."""
     label = src.file
     diags = list(src.diagnostics)
     if not src.ok:
         return Loaded(path, label, src, dialect, None, diags)
+    if dialect is None:
+        dialect = _pragma_dialect(src) or fallback
     # The head of a file tells its dialect; scanning a whole 20k-line CAM file would cost more
     # than parsing it.
     head = src.text[:_DETECT_HEAD if dialect is None else _CHECK_HEAD]
@@ -129,14 +132,30 @@ def _finish_stream(ld: Loaded, run_diags: list[Diagnostic]) -> None:
     ld.diagnostics.extend(run_diags)
 
 
-def load(path: str, dialect: Optional[str] = None, stream: bool = False) -> Loaded:
+def load(path: str, dialect: Optional[str] = None, stream: bool = False,
+         fallback: Optional[str] = None) -> Loaded:
     """Read, decode, detect and parse one file ('-' = stdin). PipelineError if it cannot be read.
-    `stream`: see load_source."""
+    `stream`, `fallback`: see load_source."""
     try:
         src = _source.read_source(path)
     except _source.SourceError as e:
         raise PipelineError(str(e)) from None
-    return load_source(src, path, dialect, stream)
+    return load_source(src, path, dialect, stream, fallback)
+
+
+def _pragma_dialect(src: _source.SourceText) -> Optional[str]:
+    """The dialect a `; nctrans: dialect=NAME` pragma in the first line names (see linting.suppress)."""
+    if "nctrans" not in src.text[:400]:
+        return None
+    from nctrans.linting.suppress import dialect_pragma
+    found = dialect_pragma(src.text)
+    if found is None:
+        return None
+    name, line, col = found
+    if name not in base.names():
+        raise PipelineError(f"{src.file}:{line}:{col}: the dialect pragma names {name!r}, "
+                            f"which is not a dialect (known: {', '.join(base.names())})")
+    return name
 
 
 def load_program(path_or_dash: str, dialect: Optional[str] = None

@@ -16,7 +16,7 @@ import marshal
 import os
 import sys
 from pathlib import Path
-from typing import Any, Callable, TypeVar
+from typing import Any, Callable, Optional, TypeVar
 
 T = TypeVar("T")
 
@@ -36,9 +36,11 @@ def cache_dir() -> Path:
     return Path(base) / "nctrans"
 
 
-def load(path, schema: type, build: Callable[[Any], T]) -> T:
+def load(path, schema: type, build: Callable[[Any], T], section: tuple[str, ...] = (),
+         prepare: Optional[Callable[[Any], Any]] = None) -> T:
     """build(validated data) for the TOML file at `path` (a Path or importlib.resources Traversable)
-    validated against the dataclass `schema`."""
+    validated against the dataclass `schema`. `section`: validate only that table (("tool",
+    "nctrans") in a pyproject.toml; missing = empty); `prepare`: applied to it before validation."""
     try:
         raw = path.read_bytes()
     except OSError as e:
@@ -52,12 +54,13 @@ def load(path, schema: type, build: Callable[[Any], T]) -> T:
     try:
         data = marshal.loads(cached.read_bytes())
     except (OSError, ValueError, EOFError, TypeError):
-        data = _validate(path, raw, schema)
+        data = _validate(path, raw, schema, section, prepare)
         _store(cached, data)
     return build(data)
 
 
-def _validate(path: Path, raw: bytes, schema: type) -> Any:
+def _validate(path: Path, raw: bytes, schema: type, section: tuple[str, ...] = (),
+              prepare: Optional[Callable[[Any], Any]] = None) -> Any:
     import tomllib
 
     from pydantic import TypeAdapter, ValidationError
@@ -65,6 +68,10 @@ def _validate(path: Path, raw: bytes, schema: type) -> Any:
         parsed = tomllib.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
         raise TableError(f"{path}: invalid TOML: {e}") from None
+    for name in section:
+        parsed = parsed.get(name, {}) if isinstance(parsed, dict) else {}
+    if prepare is not None:
+        parsed = prepare(parsed)
     adapter = TypeAdapter(schema)
     try:
         return adapter.dump_python(adapter.validate_python(parsed))

@@ -185,6 +185,12 @@ class Interpreter(LatheMixin):
         # runtime flags
         self.moved = False
         self.feed_reported = False
+        # NC209: the program itself stopped the spindle (M5), not the power-on state: programs
+        # that never mention the spindle (fragments, subprograms, machines without one) are not
+        # flagged. Moves then take the Python path, which reports the first feed move once.
+        self.spindle_stopped = False
+        self.spindle_reported = False
+        self.comp_d_reported = False      # NC208 once per G41/G42 without a D word
         self.last_from: Optional[dict] = None     # previous move (tangent of Sinumerik CT)
         self.last_arc = None
         self.comp = None
@@ -492,6 +498,10 @@ class Interpreter(LatheMixin):
                 self.st.comp_side != "off" and CutterCompensator is not None and self.comp_radius):
             if self._comp_move(kind, start, end, center, cw, turns):
                 return
+        elif self.st.comp_side != "off" and not self.st.radius_index and not self.comp_d_reported:
+            self.comp_d_reported = True
+            self.diag("NC208", "error", f"cutter compensation ({self.st.comp_side}) is on but no D word "
+                      "selects a radius offset: the tool runs on the programmed contour uncompensated")
         self._finish_move(kind, start, end, center, cw, turns, self._payload())
 
     def _payload(self) -> tuple:
@@ -619,6 +629,8 @@ class Interpreter(LatheMixin):
         elif g == "cutter_comp":
             prev = st.comp_side
             st.set(g, v)
+            if v != prev:
+                self.comp_d_reported = False
             if v == "off" and prev != "off" and self.comp is not None:
                 self.comp_exit = True
             elif v != "off" and self.comp is not None and prev != v:
@@ -626,6 +638,8 @@ class Interpreter(LatheMixin):
                 self.comp_exit = True
         elif g == "spindle":
             st.set(g, v)
+            self.spindle_stopped = v == "off"
+            self.spindle_reported = False
             self._record("spindle", spindle_dir=v, spindle=st.spindle_speed)
         elif g == "coolant":
             st.set(g, v)
@@ -904,7 +918,7 @@ class Interpreter(LatheMixin):
         if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
                 or self.comp_exit or st.comp_side != "off" or not self.frame.identity
                 or self.unmodelled_motion is not None or st.diameter
-                or self.css_surface is not None):
+                or self.css_surface is not None or self.spindle_stopped):
             return self._slow(d)
         motion = st.motion
         if motion == "rapid":
@@ -1005,6 +1019,10 @@ class Interpreter(LatheMixin):
         if not st.feed and not self.feed_reported:
             self.feed_reported = True
             self.diag("NC202", "error", "feed move with no feed rate programmed")
+        if self.spindle_stopped and not self.spindle_reported:
+            self.spindle_reported = True
+            self.diag("NC209", "warning", "feed move while the spindle is stopped (M5): the tool "
+                      "would rub or break; start the spindle (M3/M4) before cutting")
 
     def _polar(self, vals, polar):
         """Polar words (radius, angle in the active plane about the pole: program zero until
@@ -1884,7 +1902,7 @@ class Interpreter(LatheMixin):
                 or self.comp is not None or self.comp_exit or st.comp_side != "off"
                 or not self.frame.identity or self.modal_call is not None or self.hook is not None
                 or st.feed_mode not in ("per_min", "per_rev") or self.out
-                or self.unmodelled_motion is not None):
+                or self.unmodelled_motion is not None or self.spindle_stopped):
             return False
         axes = "".join(self.pos)
         return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)

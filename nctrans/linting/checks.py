@@ -1,0 +1,395 @@
+"""Analyses over the IR that the interpreter's run does not make: they look at the whole program
+text, including what never runs.
+
+- NC104 at the assignment: a value whose type the dialect cannot convert to the variable's
+  declared type (a STRING assigned to a REAL, where the dialect's table says so). The table is
+  `options.type_conversions` in rules/<dialect>.toml; a dialect without one is not checked.
+- NC110: a string literal longer than its variable's declared STRING[n].
+- NC111: a read of a variable that nothing in the file sets (a DEF without a value that is never
+  assigned; an ISO local #1-#33 in the main program or common #100-#199 never assigned).
+- NC112: blocks after the main program's end that no jump reaches.
+- --target DIALECT: the NC4xx the conversion to DIALECT would report, from its emitter (nothing
+  is written).
+Modal and motion logic (NC202-NC209) is checked by the interpreter as it runs.
+"""
+from __future__ import annotations
+
+from typing import Iterator, Optional
+
+from nctrans import pipeline
+from nctrans.diagnostics import Diagnostic, at_span
+from nctrans.ir import nodes as n
+
+_STRUCTURE = (n.Block, n.If, n.While, n.ForLoop, n.Loop, n.RepeatUntil, n.Case)
+# ISO macro variables a program itself must set before reading them (spec: locals are vacant at
+# program start, commons at power-on); #500+ persist across programs and are not flagged.
+_ISO_LOCALS = range(1, 34)
+_ISO_COMMONS = range(100, 200)
+
+
+def run(ld: pipeline.Loaded, machine, target: Optional[str] = None, runner=None) -> list[Diagnostic]:
+    """Parse, interpreter and IR diagnostics of one loaded file. The toolpath is run once by
+    `runner(ld, machine)` (default pipeline.lint, which drops the records)."""
+    tail = _watch_tail(ld)
+    diags = list((runner or pipeline.lint)(ld, machine))
+    program = ld.program
+    if program is None:
+        return diags
+    if tail is not None:
+        diags.extend(tail.report(ld.label))
+        return diags
+    diags.extend(type_checks(program, ld.dialect))
+    diags.extend(unset_reads(program))
+    diags.extend(unreachable(program))
+    if target is not None:
+        diags.extend(portability(ld, machine, target))
+    return diags
+
+
+# --------------------------------------------------------------------------- walking the IR
+
+def _children(node) -> Iterator:
+    if isinstance(node, n.Block):
+        return
+    for name in ("then", "orelse", "body"):
+        sub = getattr(node, name, None)
+        if sub:
+            yield from sub
+
+
+def blocks(body) -> Iterator[n.Block]:
+    """Every Block in a body, nested control flow included, in source order."""
+    for node in body:
+        if isinstance(node, n.Block):
+            yield node
+        else:
+            yield from blocks(_children(node))
+
+
+def _all_bodies(program: n.Program):
+    yield None, program.body
+    for name, sub in program.subprograms.items():
+        yield name, sub.body
+
+
+def _exprs(obj) -> Iterator:
+    """Every expression-tree object under a statement (values of its fields, recursively)."""
+    if isinstance(obj, (list, tuple)):
+        for x in obj:
+            yield from _exprs(x)
+    elif isinstance(obj, dict):
+        for x in obj.values():
+            yield from _exprs(x)
+    elif isinstance(obj, (n.Num, n.Str)) or obj is None or isinstance(obj, (str, int, float, bool)):
+        return
+    elif isinstance(obj, n.Var):
+        yield obj
+        if obj.indices:
+            yield from _exprs(obj.indices)
+    elif hasattr(obj, "__slots__") and not isinstance(obj, n.Span):
+        for k in obj.__slots__:
+            yield from _exprs(getattr(obj, k))
+
+
+def _reads(stmt) -> Iterator[n.Var]:
+    """Variables a statement reads (an assignment's target is written, its indices read)."""
+    if isinstance(stmt, n.Assign):
+        if stmt.target.indices:
+            yield from _exprs(stmt.target.indices)
+        yield from _exprs(stmt.value)
+    elif isinstance(stmt, n.VarDecl):
+        yield from _exprs(stmt.init)
+    else:
+        yield from _exprs(stmt)
+
+
+def _structure_reads(node) -> Iterator[n.Var]:
+    for name in ("cond", "subject", "start", "end", "step"):
+        yield from _exprs(getattr(node, name, None))
+
+
+# --------------------------------------------------------------------------- types (NC104, NC110)
+
+def _declarations(program: n.Program) -> dict[str, n.VarDecl]:
+    out: dict[str, n.VarDecl] = {}
+    for _, body in _all_bodies(program):
+        for b in blocks(body):
+            for s in b.body:
+                if isinstance(s, n.VarDecl):
+                    out.setdefault(s.name.upper(), s)
+    return out
+
+
+# neutral IR function names (nctrans.ir.nodes.Func) whose result is a number
+_NUMERIC_FUNCS = frozenset(("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "abs", "round",
+                            "fix", "fup", "trunc", "ln", "exp", "pow", "log", "minval", "maxval"))
+_COMPARISONS = {"==", "!=", "<", "<=", ">", ">="}
+
+
+def _type_of(e, decls: dict[str, n.VarDecl]) -> Optional[str]:
+    """The static type of an expression where the text alone tells it; None when unknown."""
+    if isinstance(e, n.Str):
+        return "STRING"
+    if isinstance(e, n.Num):
+        return "REAL"
+    if isinstance(e, n.Var):
+        if e.space == "R":
+            return "REAL"
+        if e.space == "name" and isinstance(e.key, str):
+            d = decls.get(e.key.upper())
+            return d.type.upper() if d is not None else None
+        return None
+    if isinstance(e, n.Binary):
+        if e.op == "concat":
+            return "STRING"
+        if e.op in _COMPARISONS or e.op in ("and", "or", "xor"):
+            return "BOOL"
+        return "REAL" if {_type_of(e.left, decls), _type_of(e.right, decls)} <= {"REAL", "INT"} else None
+    if isinstance(e, n.Func):
+        return "REAL" if e.name.lower() in _NUMERIC_FUNCS else None
+    return None
+
+
+def _conversions(dialect: Optional[str]) -> Optional[dict[str, list[str]]]:
+    """from-type -> the types it may be assigned to (rules/<dialect>.toml options.type_conversions)."""
+    from nctrans.rules import load_table
+    try:
+        d = pipeline.get_dialect(dialect)
+        table = load_table(getattr(d, "table", None) or dialect)
+    except Exception:       # a dialect without a table of its own: nothing to check against
+        return None
+    conv = table.options.get("type_conversions")
+    return {k.upper(): [t.upper() for t in v] for k, v in conv.items()} if isinstance(conv, dict) else None
+
+
+def type_checks(program: n.Program, dialect: Optional[str]) -> list[Diagnostic]:
+    decls = _declarations(program)
+    if not decls:
+        return []
+    conv = _conversions(dialect)
+    out: list[Diagnostic] = []
+    for _, body in _all_bodies(program):
+        for b in blocks(body):
+            for s in b.body:
+                if isinstance(s, n.Assign):
+                    target, values = s.target, [s.value]
+                    if target.space != "name" or not isinstance(target.key, str):
+                        continue
+                    decl = decls.get(target.key.upper())
+                elif isinstance(s, n.VarDecl) and s.init:
+                    decl, values = s, s.init
+                else:
+                    continue
+                if decl is None:
+                    continue
+                to = decl.type.upper()
+                for v in values:
+                    frm = _type_of(v, decls)
+                    if conv is not None and frm in conv and to in conv and to not in conv[frm]:
+                        out.append(at_span("NC104", "error",
+                                           f"{frm} value assigned to {decl.name}, declared {to}: "
+                                           f"{program.dialect} converts no {frm} to {to}", b.span))
+                    if (to == "STRING" and decl.length is not None and isinstance(v, n.Str)
+                            and len(v.value) > decl.length):
+                        out.append(at_span("NC110", "error",
+                                           f"string of {len(v.value)} characters assigned to "
+                                           f"{decl.name}, declared STRING[{decl.length}]", b.span))
+    return out
+
+
+# --------------------------------------------------------------------------- never-set reads (NC111)
+
+def unset_reads(program: n.Program) -> list[Diagnostic]:
+    decls = _declarations(program)
+    set_names: set[str] = set()
+    set_nums: set[int] = set()
+    passed: set[str] = set()
+    reads: list[tuple[n.Var, n.Span, bool]] = []     # (var, where, in the main program)
+
+    def note_write(v: n.Var) -> None:
+        if v.space == "name" and isinstance(v.key, str):
+            set_names.add(v.key.upper())
+        elif v.space == "num":
+            if isinstance(v.key, int):
+                set_nums.add(v.key)
+            elif v.key is None:           # #[expr]: could be any number
+                set_nums.update(_ISO_COMMONS)
+                set_nums.update(_ISO_LOCALS)
+
+    for sub, body in _all_bodies(program):
+        main = sub is None
+        for node in _walk_nodes(body):
+            if not isinstance(node, n.Block):
+                if isinstance(node, n.ForLoop):
+                    note_write(node.var)
+                reads.extend((v, node.span, main) for v in _structure_reads(node))
+                continue
+            for s in node.body:
+                if isinstance(s, n.Assign):
+                    note_write(s.target)
+                elif isinstance(s, n.VarDecl) and s.init:
+                    set_names.add(s.name.upper())
+                elif isinstance(s, n.SubCall):
+                    for v in _exprs(s):
+                        if isinstance(v, n.Var) and isinstance(v.key, str):
+                            passed.add(v.key.upper())   # may be a VAR (by reference) argument
+                reads.extend((v, node.span, main) for v in _reads(s))
+    out: list[Diagnostic] = []
+    seen: set = set()
+    for v, span, main in reads:
+        if v.space == "name" and isinstance(v.key, str):
+            key = v.key.upper()
+            d = decls.get(key)
+            if d is None or d.scope != "local" or key in set_names or key in passed or d.dims:
+                continue
+            what = f"{d.name} is read but nothing sets it (declared without a value: it reads as the type's default)"
+        elif v.space == "num" and isinstance(v.key, int):
+            key = v.key
+            if key in set_nums or not ((main and key in _ISO_LOCALS) or key in _ISO_COMMONS):
+                continue
+            what = f"#{key} is read but nothing in this file sets it (vacant unless another program did)"
+        else:
+            continue
+        if key in seen:
+            continue
+        seen.add(key)
+        out.append(at_span("NC111", "warning", what, v.span or span))
+    return out
+
+
+def _walk_nodes(body) -> Iterator:
+    for node in body:
+        yield node
+        if not isinstance(node, n.Block):
+            yield from _walk_nodes(_children(node))
+
+
+# --------------------------------------------------------------------------- unreachable (NC112)
+
+def _jump_targets(program: n.Program) -> set[str]:
+    targets: set[str] = set()
+    for _, body in _all_bodies(program):
+        for node in _walk_nodes(body):
+            if isinstance(node, n.Case):
+                targets.update(str(t) for _, t in node.branches)
+                if node.default:
+                    targets.add(str(node.default))
+            elif isinstance(node, n.Block):
+                for s in node.body:
+                    if isinstance(s, n.Goto):
+                        targets.add(str(s.target).upper().lstrip("N"))
+                    elif isinstance(s, n.Return) and s.to_label:
+                        targets.add(str(s.to_label).upper().lstrip("N"))
+    return targets
+
+
+def _is_target(b: n.Block, targets: set[str]) -> bool:
+    names = {str(x).upper().lstrip("N") for x in (b.number, b.label) if x is not None}
+    if b.number is not None:
+        try:
+            names.add(str(int(float(b.number))))
+        except ValueError:
+            pass
+    return bool(names & targets)
+
+
+def _ends(b: n.Block) -> bool:
+    return any(isinstance(s, n.ProgramEnd) and s.kind in ("end", "end_rewind") for s in b.body)
+
+
+def unreachable(program: n.Program) -> list[Diagnostic]:
+    body = program.body
+    end = next((i for i, node in enumerate(body) if isinstance(node, n.Block) and _ends(node)), None)
+    if end is None:
+        return []
+    targets = _jump_targets(program)
+    rest = body[end + 1:]
+    for i, node in enumerate(rest):
+        if isinstance(node, n.Block) and _is_target(node, targets):
+            return []
+        if not isinstance(node, n.Block) or node.body:
+            count = sum(1 for x in rest[i:] if not isinstance(x, n.Block) or x.body)
+            return [at_span("NC112", "warning",
+                            f"never runs: {count} block(s) after the program end at line "
+                            f"{body[end].span.line}, and no jump reaches them", node.span)]
+    return []
+
+
+class _Tail:
+    """For a streamed parse (the body is parsed as it runs, and the interpreter pulls it in
+    batches, past a program end): watch the blocks go by; those after the first block that ends
+    the program are NC112 (a streamed program has no jumps, so nothing reaches them)."""
+
+    def __init__(self, body):
+        self.first = None
+        self.count = 0
+        self._gen = self._watch(iter(body))
+
+    def _watch(self, items):
+        end_type, block_type = n.ProgramEnd, n.Block
+        for b in items:
+            if b.__class__ is block_type:
+                for st in b.body:
+                    if st.__class__ is end_type and st.kind in ("end", "end_rewind"):
+                        yield b
+                        break
+                else:
+                    yield b
+                    continue
+                break
+            yield b
+        for b in items:
+            if b.__class__ is not block_type or b.body:
+                if self.first is None:
+                    self.first = b
+                self.count += 1
+            yield b
+
+    def __iter__(self):
+        return self._gen
+
+    def drain(self) -> None:
+        for _ in self._gen:
+            pass
+
+    def report(self, label: str) -> list[Diagnostic]:
+        span = getattr(self.first, "span", None)
+        if self.first is None or span is None:
+            return []
+        return [at_span("NC112", "warning", f"never runs: {self.count} block(s) after the program end",
+                        span)]
+
+
+def _watch_tail(ld: pipeline.Loaded) -> Optional[_Tail]:
+    if ld.streamed is None or ld.program is None or not hasattr(ld.program.body, "drain"):
+        return None
+    tail = _Tail(ld.program.body)
+    ld.program.body = tail
+    return tail
+
+
+# --------------------------------------------------------------------------- portability (--target)
+
+def portability(ld: pipeline.Loaded, machine, target: str) -> list[Diagnostic]:
+    """What `nctrans convert --to TARGET` would report (lowerings NC401, refusals NC402)."""
+    from nctrans.convert import convert
+    from nctrans.lower.flatten import flatten
+    dialect = pipeline.get_dialect(target)
+    if target == ld.dialect:
+        return []
+
+    def flatten_with(into, p=ld.program):
+        return flatten(p, machine, diagnostics=into,
+                       resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
+    try:
+        result = convert(ld.program, dialect, flatten_with=flatten_with)
+    except Exception as e:          # the emitter's bug must not hide the lint report
+        return [Diagnostic("NC402", "error", f"--target {target}: the conversion failed: "
+                           f"{type(e).__name__}: {e}", ld.label)]
+    out = []
+    for d in result.diagnostics:
+        if d.rule.startswith("NC4"):
+            if d.file in ("<stdin>", "") and ld.label != d.file:
+                d.file = ld.label        # program-level notes carry no span of their own
+            out.append(d)
+    return out
