@@ -146,6 +146,16 @@ class _Stop(Exception):
     """Internal: end the whole run (program end, alarm)."""
 
 
+def _default_cutting_edge(dialect) -> int:
+    """The D number a tool brings when none is programmed (rules/<dialect>.toml
+    options.default_cutting_edge; 0: none, G41/G42 without D compensate by zero)."""
+    from nctrans.rules import load_table
+    try:
+        return int(load_table(dialect).options.get("default_cutting_edge", 0) or 0)
+    except Exception:       # no table of that name (a test dialect): no default edge
+        return 0
+
+
 class Interpreter(LatheMixin):
     def __init__(self, program: n.Program, machine=None, *, diagnostics: list, resolver=None,
                  max_steps: int = 2_000_000, flatten_hook=None, preload=(), fast_sink=None):
@@ -165,6 +175,7 @@ class Interpreter(LatheMixin):
         self.fast_sink = fast_sink if self.native is not None else None
         defaults = program.meta.get("defaults") if isinstance(program.meta, dict) else None
         self.st = ModalState(defaults if isinstance(defaults, dict) else None)
+        self.default_edge = _default_cutting_edge(program.dialect)
         self.ev = Evaluator()
         self.frame = ProgrammableFrame()
         self.off = Offsets()
@@ -498,7 +509,23 @@ class Interpreter(LatheMixin):
                 self.st.comp_side != "off" and CutterCompensator is not None and self.comp_radius):
             if self._comp_move(kind, start, end, center, cw, turns):
                 return
-        elif self.st.comp_side != "off" and not self.st.radius_index and not self.comp_d_reported:
+        elif self.st.comp_side != "off" and not self.st.radius_index:
+            self._comp_without_offset(kind, start, end, center, cw, turns)
+            return
+        self._finish_move(kind, start, end, center, cw, turns, self._payload())
+
+    def _comp_without_offset(self, kind, start, end, center, cw, turns) -> None:
+        """G41/G42 on with no D word. Where the dialect's table names the cutting edge a tool
+        brings by default (options.default_cutting_edge, Sinumerik D1), compensate with it as if
+        written; else the controller compensates by zero: NC208, and the move runs as programmed."""
+        edge = self.default_edge
+        if edge:
+            self.st.radius_index = edge
+            self.comp_radius = self.machine.radius_offset(edge)
+            if self.comp_radius and CutterCompensator is not None and self._comp_move(
+                    kind, start, end, center, cw, turns):
+                return
+        elif not self.comp_d_reported:
             self.comp_d_reported = True
             self.diag("NC208", "error", f"cutter compensation ({self.st.comp_side}) is on but no D word "
                       "selects a radius offset: the tool runs on the programmed contour uncompensated")

@@ -99,6 +99,8 @@ def _reads(stmt) -> Iterator[n.Var]:
         yield from _exprs(stmt.value)
     elif isinstance(stmt, n.VarDecl):
         yield from _exprs(stmt.init)
+    elif isinstance(stmt, n.SubCall):        # bindings are where the callee receives, not reads
+        yield from _exprs([stmt.args, stmt.named_args, stmt.repeat])
     else:
         yield from _exprs(stmt)
 
@@ -234,6 +236,10 @@ def unset_reads(program: n.Program) -> list[Diagnostic]:
                         if isinstance(v, n.Var) and isinstance(v.key, str):
                             passed.add(v.key.upper())   # may be a VAR (by reference) argument
                 reads.extend((v, node.span, main) for v in _reads(s))
+    # A file that does not end its main program (M30/M2) is itself a macro or subprogram (G65 P..,
+    # ending M99): its locals are the caller's arguments and its commons the caller's values.
+    complete = any(
+        isinstance(b, n.Block) and _ends(b) for b in program.body)
     out: list[Diagnostic] = []
     seen: set = set()
     for v, span, main in reads:
@@ -245,7 +251,7 @@ def unset_reads(program: n.Program) -> list[Diagnostic]:
             what = f"{d.name} is read but nothing sets it (declared without a value: it reads as the type's default)"
         elif v.space == "num" and isinstance(v.key, int):
             key = v.key
-            if key in set_nums or not ((main and key in _ISO_LOCALS) or key in _ISO_COMMONS):
+            if key in set_nums or not complete or not ((main and key in _ISO_LOCALS) or key in _ISO_COMMONS):
                 continue
             what = f"#{key} is read but nothing in this file sets it (vacant unless another program did)"
         else:
@@ -297,6 +303,11 @@ def _ends(b: n.Block) -> bool:
     return any(isinstance(s, n.ProgramEnd) and s.kind in ("end", "end_rewind") for s in b.body)
 
 
+def _does_something(b: n.Block) -> bool:
+    """A block with an effect: a second end (M30 then M2) or a stop after the end changes nothing."""
+    return any(not isinstance(s, (n.ProgramEnd, n.Stop)) for s in b.body)
+
+
 def unreachable(program: n.Program) -> list[Diagnostic]:
     body = program.body
     end = next((i for i, node in enumerate(body) if isinstance(node, n.Block) and _ends(node)), None)
@@ -307,8 +318,8 @@ def unreachable(program: n.Program) -> list[Diagnostic]:
     for i, node in enumerate(rest):
         if isinstance(node, n.Block) and _is_target(node, targets):
             return []
-        if not isinstance(node, n.Block) or node.body:
-            count = sum(1 for x in rest[i:] if not isinstance(x, n.Block) or x.body)
+        if not isinstance(node, n.Block) or _does_something(node):
+            count = sum(1 for x in rest[i:] if not isinstance(x, n.Block) or _does_something(x))
             return [at_span("NC112", "warning",
                             f"never runs: {count} block(s) after the program end at line "
                             f"{body[end].span.line}, and no jump reaches them", node.span)]
@@ -339,9 +350,13 @@ class _Tail:
                 break
             yield b
         for b in items:
-            if b.__class__ is not block_type or b.body:
+            if b.__class__ is not block_type:          # a run of plain blocks (nctrans.plainrun)
                 if self.first is None:
-                    self.first = b
+                    self.first = n.Span(b.file, b.line)
+                self.count += getattr(b, "blocks", 1)
+            elif _does_something(b):
+                if self.first is None:
+                    self.first = b.span
                 self.count += 1
             yield b
 
@@ -353,11 +368,10 @@ class _Tail:
             pass
 
     def report(self, label: str) -> list[Diagnostic]:
-        span = getattr(self.first, "span", None)
-        if self.first is None or span is None:
+        if self.first is None:
             return []
         return [at_span("NC112", "warning", f"never runs: {self.count} block(s) after the program end",
-                        span)]
+                        self.first)]
 
 
 def _watch_tail(ld: pipeline.Loaded) -> Optional[_Tail]:
