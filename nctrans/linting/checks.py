@@ -19,8 +19,8 @@ from typing import Iterator, Optional
 from nctrans import pipeline
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.ir import nodes as n
+from nctrans.ir.walk import blocks, program_jump_targets, units, walk
 
-_STRUCTURE = (n.Block, n.If, n.While, n.ForLoop, n.Loop, n.RepeatUntil, n.Case)
 # ISO macro variables a program itself must set before reading them (spec: locals are vacant at
 # program start, commons at power-on); #500+ persist across programs and are not flagged.
 _ISO_LOCALS = range(1, 34)
@@ -47,30 +47,7 @@ def run(ld: pipeline.Loaded, machine, target: Optional[str] = None, runner=None)
 
 
 # --------------------------------------------------------------------------- walking the IR
-
-def _children(node) -> Iterator:
-    if isinstance(node, n.Block):
-        return
-    for name in ("then", "orelse", "body"):
-        sub = getattr(node, name, None)
-        if sub:
-            yield from sub
-
-
-def blocks(body) -> Iterator[n.Block]:
-    """Every Block in a body, nested control flow included, in source order."""
-    for node in body:
-        if isinstance(node, n.Block):
-            yield node
-        else:
-            yield from blocks(_children(node))
-
-
-def _all_bodies(program: n.Program):
-    yield None, program.body
-    for name, sub in program.subprograms.items():
-        yield name, sub.body
-
+# (nctrans.ir.walk knows how structures nest; expressions are walked here)
 
 def _exprs(obj) -> Iterator:
     """Every expression-tree object under a statement (values of its fields, recursively)."""
@@ -114,7 +91,7 @@ def _structure_reads(node) -> Iterator[n.Var]:
 
 def _declarations(program: n.Program) -> dict[str, n.VarDecl]:
     out: dict[str, n.VarDecl] = {}
-    for _, body in _all_bodies(program):
+    for _, body in units(program):
         for b in blocks(body):
             for s in b.body:
                 if isinstance(s, n.VarDecl):
@@ -170,7 +147,7 @@ def type_checks(program: n.Program, dialect: Optional[str]) -> list[Diagnostic]:
         return []
     conv = _conversions(dialect)
     out: list[Diagnostic] = []
-    for _, body in _all_bodies(program):
+    for _, body in units(program):
         for b in blocks(body):
             for s in b.body:
                 if isinstance(s, n.Assign):
@@ -218,9 +195,9 @@ def unset_reads(program: n.Program) -> list[Diagnostic]:
                 set_nums.update(_ISO_COMMONS)
                 set_nums.update(_ISO_LOCALS)
 
-    for sub, body in _all_bodies(program):
+    for sub, body in units(program):
         main = sub is None
-        for node in _walk_nodes(body):
+        for node in walk(body):
             if not isinstance(node, n.Block):
                 if isinstance(node, n.ForLoop):
                     note_write(node.var)
@@ -263,30 +240,11 @@ def unset_reads(program: n.Program) -> list[Diagnostic]:
     return out
 
 
-def _walk_nodes(body) -> Iterator:
-    for node in body:
-        yield node
-        if not isinstance(node, n.Block):
-            yield from _walk_nodes(_children(node))
-
-
 # --------------------------------------------------------------------------- unreachable (NC112)
 
 def _jump_targets(program: n.Program) -> set[str]:
-    targets: set[str] = set()
-    for _, body in _all_bodies(program):
-        for node in _walk_nodes(body):
-            if isinstance(node, n.Case):
-                targets.update(str(t) for _, t in node.branches)
-                if node.default:
-                    targets.add(str(node.default))
-            elif isinstance(node, n.Block):
-                for s in node.body:
-                    if isinstance(s, n.Goto):
-                        targets.add(str(s.target).upper().lstrip("N"))
-                    elif isinstance(s, n.Return) and s.to_label:
-                        targets.add(str(s.to_label).upper().lstrip("N"))
-    return targets
+    """Every label and block number a jump can reach, spelt as _is_target compares them."""
+    return {t.upper().lstrip("N") for t in program_jump_targets(program)}
 
 
 def _is_target(b: n.Block, targets: set[str]) -> bool:
