@@ -52,7 +52,7 @@ def test_sinumerik_semicolon_suppression(shop, capsys):
 
 def test_file_wide_suppression_and_malformed_codes(shop, capsys):
     (shop / "a.nc").write_text("; nctrans: ignore-file NC501\ng1 x10 f100\ng1 x20 ; nctrans: ignore feed\nm30\n")
-    status, found = lint(capsys, "a.nc")
+    status, found = lint(capsys, "a.nc", "--from", "iso-m")
     assert found == [(3, "NC503")]
 
 
