@@ -21,6 +21,7 @@ from typing import Any, Optional
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.dialects.base import EmitResult
 from nctrans.ir import nodes as n
+from nctrans.ir import walk as ir_walk
 from nctrans.rules import load_table
 
 DIALECT = "fagor"
@@ -231,7 +232,7 @@ class _Emitter:
     # ---------------------------------------------------------------- program
     def run(self) -> str:
         p = self.program
-        for body in [p.body] + [s.body for s in p.subprograms.values()]:
+        for _, body in ir_walk.units(p):
             self.targets |= _goto_targets(body)
         for name in _sub_order(p):
             sub = p.subprograms[name]
@@ -677,40 +678,14 @@ def _program_header(p: n.Program) -> str:
 
 
 def _goto_targets(body: list) -> set:
-    out = set()
-    stack = list(body)
-    while stack:
-        x = stack.pop()
-        if isinstance(x, n.Block):
-            for s in x.body:
-                if isinstance(s, n.Goto):
-                    out.add(_key(s.target))
-        elif isinstance(x, n.Case):
-            out.update(_key(lab) for _, lab in x.branches)
-            if x.default is not None:
-                out.add(_key(x.default))
-        for attr in ("then", "orelse", "body"):
-            sub = getattr(x, attr, None)
-            if isinstance(sub, list) and not isinstance(x, n.Block):
-                stack.extend(sub)
-    return out
+    return {_key(t) for t in ir_walk.jump_targets(body)}
 
 
 def _sub_order(p: n.Program) -> list[str]:
     """Local subroutines with callees first (a local sub may only call one defined before it)."""
-    calls: dict[str, set] = {}
-    for name, sub in p.subprograms.items():
-        found = set()
-        stack = list(sub.body)
-        while stack:
-            x = stack.pop()
-            if isinstance(x, n.Block):
-                found.update(s.name for s in x.body if isinstance(s, n.SubCall) and s.name in p.subprograms)
-            for attr in ("then", "orelse", "body"):
-                sub_ = getattr(x, attr, None)
-                if isinstance(sub_, list) and not isinstance(x, n.Block):
-                    stack.extend(sub_)
-        calls[name] = found
+    calls = {name: {s.name for b in ir_walk.blocks(sub.body) for s in b.body
+                    if isinstance(s, n.SubCall) and s.name in p.subprograms}
+             for name, sub in p.subprograms.items()}
     order: list[str] = []
     seen: set = set()
 

@@ -33,6 +33,7 @@ from nctrans import resources
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import ParseResult
 from nctrans.ir import nodes as ir
+from nctrans.ir import walk as ir_walk
 from nctrans.rules import load_table, normalise_code
 
 from . import blocks
@@ -1088,18 +1089,17 @@ class Parser:
     # ---------------------------------------------------------------- checks and #RPT
     def _check_gotos(self, prog: ir.Program) -> None:
         """A $GOTO to a label that is not in its program or subroutine is NC102 (spec F024)."""
-        for body in [prog.body] + [s.body for s in prog.subprograms.values()]:
+        for _, body in ir_walk.units(prog):
             labels: set = set()
             gotos: list = []
-            for node in _walk(body):
-                if isinstance(node, ir.Block):
-                    if node.number is not None:
-                        labels.add(_key(node.number))
-                    if node.label is not None:
-                        labels.add(_key(node.label))
-                    for s in node.body:
-                        if isinstance(s, ir.Goto):
-                            gotos.append((s, node.span))
+            for node in ir_walk.blocks(body):
+                if node.number is not None:
+                    labels.add(_key(node.number))
+                if node.label is not None:
+                    labels.add(_key(node.label))
+                for s in node.body:
+                    if isinstance(s, ir.Goto):
+                        gotos.append((s, node.span))
             for s, span in gotos:
                 if _key(s.target) not in labels:
                     self.diags.append(Diagnostic("NC102", "error", f"$GOTO target {s.target} is not a "
@@ -1114,7 +1114,7 @@ class Parser:
             flat = [x for x in body]
             ia = next((i for i, x in enumerate(flat) if isinstance(x, ir.Block) and _has_label(x, a)), None)
             ib = next((i for i, x in enumerate(flat) if isinstance(x, ir.Block) and _has_label(x, b)), None)
-            host = next((blk for blk in _walk(body) if isinstance(blk, ir.Block) and marker in blk.body), None)
+            host = next((blk for blk in ir_walk.blocks(body) if marker in blk.body), None)
             n = _const(count)
             if ia is None or ib is None or ib < ia or host is None or n is None or n < 0:
                 self.diags.append(Diagnostic("NC415", "warning", "#RPT: the range is not a run of blocks "
@@ -1199,15 +1199,6 @@ def _has_label(b: ir.Block, name: str) -> bool:
 def _key(s: str):
     s = str(s).strip().upper()
     return int(s) if s.isdigit() else s
-
-
-def _walk(nodes):
-    for x in nodes:
-        yield x
-        for attr in ("then", "orelse", "body"):
-            sub = getattr(x, attr, None)
-            if isinstance(sub, list) and sub and not isinstance(x, ir.Block):
-                yield from _walk(sub)
 
 
 def _ends(body: list) -> bool:
