@@ -248,6 +248,7 @@ def test_conformance_program_survives_emit_and_parse(name):
     ("%T\n$GOTO [NOWHERE]\nM30\n", "NC102", 2),                      # jump to a missing label
     ("%T\n$GOTO N99\nN10: G00 X1\nM30\n", "NC102", 2),
     ("%T\nG01 X10\nM30\n", "NC202", 2),                              # cutting move, no feed
+    ("%T\nG01 XP5 F100\nM30\n", "NC101", 2),                          # P5 never assigned: not 0
     ("%T\n$ENDIF\nM30\n", "NC002", 2),
     ("%T\nG01 X[1+2 F100\nM30\n", "NC003", 2),
     ("%T\nG01 X10 (unclosed\nM30\n", "NC003", 2),

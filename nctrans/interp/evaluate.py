@@ -26,6 +26,7 @@ class _Unknown:
 
 
 UNKNOWN = _Unknown()
+_MISSING = object()
 
 
 class EvalError(Exception):
@@ -580,6 +581,15 @@ class Evaluator:
         if space == "arg":
             key = str(var.key).upper()
             return lambda: self.scope.args.get(key)
+        if space == "local":
+            key = str(var.key).upper()
+
+            def read_local():
+                v = self.scope.args.get(key, _MISSING)
+                if v is _MISSING:
+                    raise EvalError("NC101", f"local parameter {key} is read before it is assigned")
+                return v
+            return read_local
         return self._bad(f"unknown variable space {space!r}")
 
     def read_num(self, k: int) -> Any:
@@ -789,7 +799,7 @@ class Evaluator:
                 else:
                     store[name] = v
             return set_name
-        if space == "arg":
+        if space in ("arg", "local"):       # a local parameter lives with the call's arguments
             key = str(var.key).upper()
             return lambda v: self.scope.args.__setitem__(key, v)
         if space == "system":

@@ -1738,7 +1738,7 @@ class Interpreter(LatheMixin):
                     continue
                 if var.space == "num" and isinstance(var.key, int):
                     sc.num[var.key] = v
-                elif var.space in ("name", "arg"):
+                elif var.space in ("name", "arg", "local"):
                     (sc.names if var.space == "name" else sc.args)[str(var.key).upper()] = v
                 elif var.space == "R" and isinstance(var.key, int):
                     self.ev.R[var.key] = v

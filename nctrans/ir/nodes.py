@@ -76,7 +76,9 @@ class Var:
     """A variable reference.
 
     space: "num" (ISO macro #n, key int or `index` expr), "R" (R parameters), "name" (declared
-    user/GUD/LUD names), "system" ($-variables, key is the name), "arg" (call argument by letter).
+    user/GUD/LUD names), "system" ($-variables, key is the name), "arg" (call argument by letter),
+    "local" (a local parameter of the call frame: bound by a call, shared with calls that open no level
+    of their own, read before it is assigned is NC101).
     indices: array subscripts (Sinumerik A[1,2]) or the computed number of an ISO #[expr].
     """
     space: str

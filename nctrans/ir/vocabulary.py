@@ -56,7 +56,9 @@ SYSTEM_VARIABLES = (
 AXIS_MEANINGS = ("axis_position_work", "axis_position_machine")
 
 # Variable spaces of nodes.Var
-VAR_SPACES = ("num", "R", "name", "system", "arg")
+# "local": a local parameter of the call frame that exists once assigned (Fagor P0..P99, V.P.):
+# reading it before is an error (NC101), not a vacant value
+VAR_SPACES = ("num", "R", "name", "system", "arg", "local")
 
 # CycleCall kinds beyond the "cycle" modal values: hole patterns that run the modal cycle at each
 # position (Sinumerik HOLES1/HOLES2, parameters in rules/cycles.toml [[pattern]]).

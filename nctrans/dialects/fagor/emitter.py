@@ -131,7 +131,7 @@ class _Spell:
 
     def var(self, v: n.Var) -> str:
         sp, key = v.space, v.key
-        if sp == "arg":
+        if sp in ("arg", "local"):
             k = str(key).upper()
             if (k.startswith("P") and k[1:].isdigit() or k.startswith(("V.P.", "V.S."))) and not v.indices:
                 return k

@@ -6,7 +6,7 @@ structure pass nests `$IF/$WHILE/$DO/$FOR/$SWITCH` bodies and files `%L` local s
 Program.subprograms. Codes come from rules/fagor.toml, looked up by their neutral (group, value).
 
 How Fagor meets the IR (spec §20.2):
-- Local parameters P0..P99 live in the call frame (Var "arg" `P<n>`: LL / L / #CALL share the
+- Local parameters P0..P99 live in the call frame (Var "local" `P<n>`: LL / L / #CALL share the
   caller's frame, #PCALL / #MCALL / G180.. open a new one with A..Z = P0..P25); global P100.. are
   Var "R" n. `V.` variables: the neutral ones (positions, tool, feed, speed) read what the
   interpreter publishes; `V.P.` / `V.S.` user variables are names; anything else is read from the
@@ -170,10 +170,10 @@ _BINOPS = {"add": "+", "sub": "-", "mul": "*", "div": "/", "pow": "pow", "mod": 
 
 
 def param_var(n: int) -> ir.Var:
-    """P<n>: local parameters (P0..P99) in the call frame (the IR's call-argument space, which
-    a call binds and an LL / L / #CALL shares), global ones by number."""
+    """P<n>: local parameters (P0..P99) in the call frame (a call binds them, an LL / L / #CALL
+    shares them; reading one before it is assigned is NC101), global ones by number."""
     if n < LOCAL_PARAMS:
-        return ir.Var("arg", f"P{n}")
+        return ir.Var("local", f"P{n}")
     return ir.Var("R", n)
 
 
@@ -190,7 +190,7 @@ def v_variable(name: str, idx: list, tail: str, note) -> ir.Var:
     if len(parts) >= 3 and parts[1] in ("P", "S") and not idx:
         # user variables live with the local parameters (created by their first assignment);
         # V.S globals are analysed in the program's frame too (shared by LL, L and #CALL)
-        return ir.Var("arg", full.upper())
+        return ir.Var("local", full.upper())
     vocab = system_vocabulary()
     base = re.sub(r"^V\.\[\d+\]\.", "V.", name)
     meaning = vocab.get(base)

@@ -257,7 +257,7 @@ class IsoEmitter:
         if key not in self.var_map:
             if v.space == "R" and isinstance(v.key, int) and 0 <= v.key < 400:
                 self.var_map[key] = 500 + v.key
-            elif v.space in ("name", "R", "arg"):
+            elif v.space in ("name", "R", "arg", "local"):
                 while self.next_common in self.var_map.values():
                     self.next_common += 1
                 self.var_map[key] = self.next_common
