@@ -75,8 +75,9 @@ NUMBERED_AXIS = re.compile(r"^([XYZUVWABC])([1-9])$")
 
 @lru_cache(maxsize=1)
 def parser() -> Lark:
+    from nctrans.lark_cache import cache_option
     return Lark(GRAMMAR.read_text(encoding="utf-8"), parser="lalr", lexer="basic", start=STARTS,
-                propagate_positions=False, maybe_placeholders=False)
+                propagate_positions=False, maybe_placeholders=False, cache=cache_option("fagor"))
 
 
 @lru_cache(maxsize=1)
