@@ -92,6 +92,8 @@ ENDS = {
     "09-messages.nc": ("default", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (2, 1, 0), (2, 2, 0), (3, 2, 0), (3, 3, 0)]),
     "10-unmodelled.nc": ("default", [(10, 10, 10), (20, 10, 10), (0, 0, 10)]),
     "11-limits.nc": ("default", [(0, 0, 0), (90, 0, 0)]),
+    # V.E.DONE is unknown: the $WHILE condition is taken as false, the loop is not analysed
+    "13-interface.nc": ("default", [(0, 0, 50)]),
     "12-machine-test.nc": ("default", [(0, 0, 50), (0, 0, 10), (50, 0, 10), (0, 0, 10), (100, 0, 10),
                                        (0, 0, 10), (0, 0, 50)]),
 }
@@ -108,6 +110,8 @@ def test_conformance_program_parses_clean_and_ends_where_computed(name):
     syntax = [d for d in res.diagnostics + diags if d.rule.startswith("NC0") or d.severity == "error"]
     assert not syntax, "\n".join(d.format_text() for d in syntax)
     got = [_end(r) for r in _moves(recs)]
+    if name == "13-interface.nc":
+        assert {("NC135", 8), ("NC107", 8), ("NC103", 4)} <= {(d.rule, d.line) for d in res.diagnostics + diags}
     assert got == [tuple(float(v) for v in e) for e in ends]
 
 
@@ -131,6 +135,18 @@ def test_tangent_and_three_point_arcs():
     # G09 from (20,10) through (30,20) to (20,30): centre (20,20), counter-clockwise; G01 again after
     assert (round(arcs[1].center["X"], 6), round(arcs[1].center["Y"], 6), arcs[1].direction) == (20, 20, "ccw")
     assert recs[-2].kind == "linear" and _end(recs[-2]) == (0, 30, 0)
+
+
+def test_def_macros_expand_as_the_manual_shows():
+    """spec §16.12: P1=800 "START" F450 with #DEF "START"="SP1 M3" is S800 M3 F450; a macro may
+    name another with \\"NAME\\"; an undefined one is an error at its line."""
+    text = ('%M\n#DEF "START"="SP1 M3" "GO"="G01 X10 F100 \\"START\\""\nP1=800 "START" F450\n'
+            'G00 X0 Y0 Z0\n"GO"\n"NOPE"\nM30\n')
+    res, recs, _ = _run(text)
+    spindle = [r for r in recs if r.kind == "spindle"]
+    assert spindle[0].spindle == 800 and spindle[0].spindle_dir == "cw"
+    assert _end(_moves(recs)[-1]) == (10, 0, 0) and _moves(recs)[-1].feed == 100
+    assert ("NC102", 6) in {(d.rule, d.line) for d in res.diagnostics}
 
 
 def test_tool_facts():

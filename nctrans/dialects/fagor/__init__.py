@@ -21,9 +21,9 @@ MARKERS = (
                               r"ENDFOR|SWITCH|CASE|ENDSWITCH|GOTO|BREAK|CONTINUE)\b", _I)),
     Marker(4.0, 3, re.compile(r"#(?:MSG|WARNING|ERROR)[ \t]*\[", _I)),
     Marker(3.0, 3, re.compile(r"#(?:CALL|PCALL|MCALL|MDOFF|RET|TIME|SCALE|RPT|PATH|MCS|TOOL[ \t]+AX|CS|ACS|"
-                              r"KIN[ \t]+ID|RTCP|HSC|FLUSH|DGWZ|COMMENT)\b", _I)),
+                              r"KIN[ \t]+ID|RTCP|HSC|FLUSH|DGWZ|COMMENT|DEF)\b", _I)),
     Marker(5.0, 1, re.compile(r"^[ \t]*%L[ \t]+\w+", _I)),
-    Marker(3.0, 3, re.compile(r"\bV\.(?:\[\d\]\.)?(?:A|G|P|S|TM|SP|MPA|MPG|MTB|C|PLC)\.\w+", _I)),
+    Marker(3.0, 3, re.compile(r"\bV\.(?:\[\d\]\.)?(?:A|G|P|S|E|TM|SP|MPA|MPG|MTB|C|PLC)\.\w+", _I)),
     Marker(2.0, 3, re.compile(r"(?:^|[ \t])P\d+[ \t]*=", _I)),
     Marker(2.0, 2, re.compile(r"^[ \t]*N\d+:", _I)),
     Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+:?[ \t]*)?LL[ \t]+\w+", _I)),

@@ -66,7 +66,7 @@ NO_EFFECT = frozenset((  # no effect on the programmed path: kept verbatim, no d
     "#FLUSH", "#ESBLK", "#DSBLK", "#ESTOP", "#DSTOP", "#EFHOLD", "#DFHOLD", "#DGWZ", "#SLOPE",
     "#ROUNDPAR", "#HSC", "#SYNC", "#UNSYNC", "#TSYNC", "#SERVO", "#CD", "#MEET", "#WAIT", "#SIGNAL",
     "#CLEAR", "#SWTOUT", "#PWMOUT", "#DELETE", "#INIT", "#ABORT", "#SELECT", "#MASTER", "#TANGFEED",
-    "#CONTJOG", "#INCJOG", "#MPG", "#AXIS", "#KIN", "#ROTATEMZ", "#DEF"))
+    "#CONTJOG", "#INCJOG", "#MPG", "#AXIS", "#KIN", "#ROTATEMZ", "#DEF", "#INIT"))
 # Passthrough reason of constructs with no effect on the programmed path (dynamics, look-ahead,
 # software limits, search folders): the word the shared passes read as "no motion effect"
 NO_PATH_EFFECT = "directive"
@@ -96,6 +96,7 @@ class _Expr:
 
     def __init__(self, note):
         self.note = note
+        self.writing = False
 
     def __call__(self, t) -> ir.Expr:
         if type(t) is ir.Num:           # a word read without the grammar (_plain_items)
@@ -163,7 +164,7 @@ class _Expr:
         name = str(ch[0])
         idx = [self(c.children[0]) for c in ch[1:] if isinstance(c, Tree) and c.data == "index"]
         tail = "".join(str(c) for c in ch[1:] if isinstance(c, Token) and c.type == "VTAIL")
-        return v_variable(name, idx, tail, self.note)
+        return v_variable(name, idx, tail, (lambda *a, **k: None) if self.writing else self.note)
 
 
 _BINOPS = {"add": "+", "sub": "-", "mul": "*", "div": "/", "pow": "pow", "mod": "mod",
@@ -316,7 +317,11 @@ class Lowerer:
                 out.append((B_NONMODAL, ir.Passthrough(f"{ch[0]}={_text(ch[1])}", NO_PATH_EFFECT,
                                                        DIALECT)))
             elif d == "assign":
-                target = self.expr(ch[0])
+                self.expr.writing = True          # a write is not a read of an unknown value
+                try:
+                    target = self.expr(ch[0])
+                finally:
+                    self.expr.writing = False
                 op = next((str(c) for c in ch[1:-1] if isinstance(c, Token)), "=")
                 value = self.expr(ch[-1])
                 if op != "=":
@@ -330,8 +335,7 @@ class Lowerer:
             elif d == "l_call":
                 out.append((B_CALL, ir.SubCall(_program_name(_unquote(ch[0])), kind="shared")))
             elif d == "macro_ref":
-                self.note("NC415", "warning", "#DEF macro call: macro expansion is not modelled; kept "
-                          "verbatim")
+                self.note("NC102", "error", f"macro {ch[0]} is not defined by a #DEF before it")
                 out.append((B_NONMODAL, ir.Passthrough(str(ch[0]), "macro call", DIALECT)))
         return self._words(w, line)
 
@@ -725,6 +729,7 @@ class Parser:
         self.meta: dict = {"defaults": table().defaults()}
         self.labels = 0
         self.rpts: list = []
+        self.macros: dict[str, str] = {}       # #DEF table: name -> block text
         self.text = text
 
     def error(self, rule: str, message: str, line: int, col: int = 1, severity: str = "error") -> None:
@@ -804,6 +809,10 @@ class Parser:
         head, instr, tail = code, None, ""
         if found is not None:
             head, instr, tail = code[:found[0]], found[2], code[found[1]:]
+        if instr == "#DEF":
+            self._define(tail, line)
+        elif self.macros and '"' in head:
+            head = self._expand(head, line)
         body: list = []
         try:
             fast = _plain_items(head)
@@ -854,6 +863,27 @@ class Parser:
         else:
             msg = "unexpected input"
         self.error("NC002", msg, line.lineno, col)
+
+    # ---------------------------------------------------------------- #DEF macros
+    _MACRO = re.compile(r'"((?:[^"\\]|\\.)*)"\s*=\s*"((?:[^"\\]|\\.)*)"')
+
+    def _define(self, tail: str, line: blocks.Line) -> None:
+        """#DEF "NAME"="block text" ...: the macro table (spec §16.12), kept program-wide."""
+        pairs = self._MACRO.findall(tail)
+        if not pairs:
+            self.error("NC002", '#DEF needs "NAME"="text" pairs', line.lineno, line.col)
+        for name, text in pairs:
+            self.macros[name.upper()] = text.replace('\\"', '"')
+
+    def _expand(self, code: str, line: blocks.Line, depth: int = 0) -> str:
+        """A block's "NAME" macro references replaced by their text (nested ones too)."""
+        def sub(m):
+            key = m.group(1).upper()
+            if key not in self.macros:
+                return m.group(0)
+            text = blocks.upper_outside_strings(self.macros[key])
+            return " " + (self._expand(text, line, depth + 1) if depth < 10 else text) + " "
+        return re.sub(r'"([A-Za-z0-9_]+)"', sub, code)
 
     # ---------------------------------------------------------------- # instructions
     def instruction(self, name: str, tail: str, body: list, line: blocks.Line) -> list:
