@@ -216,6 +216,12 @@ CONSTRUCTS = [
     ("[START] G01 X1 F100\n$IF 0 $GOTO [START]\nX3", (3, 0, 0)),
     ("G01 X1 F100 ; comment\nX2 (comment) Y1 (another)", (2, 1, 0)),
     ("#MCS X5 Y6", (5, 6, 0)),                               # machine coordinates
+    ("G30 I10 J10\nG01 R5 Q0 F100", (15, 10, 0)),            # polar origin G30 I J
+    ("G01 X5 F100\nG30\nG01 R5 Q90", (5, 5, 0)),             # G30 alone: at the current point
+    ("G158 X10\nG01 X5 F100", (15, 0, 0)),                   # incremental zero offset
+    ("G158 X10\nG158 Y5\nG01 X0 Y0 F100", (10, 5, 0)),       # G158 replaces per axis
+    ("G158 X10\nG158\nG01 X1 F100", (1, 0, 0)),              # G158 alone cancels
+    ("G158 X10\nG53 G01 X1 F100", (1, 0, 0)),                # G53 cancels G158 too
     ("G54 G01 X5 F100", (5, 0, 0)),
     ("G159=1 G01 X5 F100", (5, 0, 0)),
 ]

@@ -36,9 +36,16 @@ _LOGICAL = frozenset(("and", "or"))
 _FUNCS = {"sin": "SIN", "cos": "COS", "tan": "TAN", "asin": "ASIN", "acos": "ACOS", "atan": "ATAN",
           "sqrt": "SQRT", "abs": "ABS", "round": "ROUND", "fix": "INT", "trunc": "INT", "fup": "FUP",
           "ln": "LN", "exp": "EXP", "bnot": "INV"}
-_SYSTEM = {"$P_TOOLNO": "V.G.TOOL", "$P_TOOL": "V.G.TOD", "$P_F": "V.G.FEED", "$P_S": "V.SP.SPEED"}
-_POSITION = {5001 + i: f"V.A.PPOS.{a}" for i, a in enumerate("XYZABC")}
-_POSITION.update({5021 + i: f"V.A.POS.{a}" for i, a in enumerate("XYZABC")})
+
+
+def _fagor_spelling(key) -> Optional[str]:
+    """The Fagor spelling of another dialect's system variable, through its neutral meaning."""
+    from nctrans.rules import system_meaning
+    meaning = system_meaning(key)
+    if meaning is None:
+        return None
+    own = load_table(DIALECT).system_variables
+    return next((sp for sp, m in own.items() if m == meaning), None)
 
 
 class NotExpressible(Exception):
@@ -160,13 +167,17 @@ class _Spell:
                 raise NotExpressible(f"macro variable {key}")
             if 1 <= key <= 33 or 100 <= key <= 999:
                 return f"P{key}"
-            if key in _POSITION:
-                return _POSITION[key]
+            spelling = _fagor_spelling(key)
+            if spelling is not None:
+                return spelling
             raise NotExpressible(f"system variable #{key}")
         if sp == "system":
             k = str(key).upper()
-            if k in _SYSTEM:
-                return _SYSTEM[k]
+            if not k.startswith("V."):
+                spelling = _fagor_spelling(k)
+                if spelling is None:
+                    raise NotExpressible(f"system variable {key}")
+                return spelling
             if k.startswith("V."):
                 idx = "".join(f"[{self.expr(i)}]" for i in v.indices or ())
                 if idx:
@@ -208,6 +219,7 @@ class _Emitter:
         self.targets: set = set()
         self.motion = "rapid"
         self.distance = "absolute"
+        self.plane = "XY"
         self.pending_motion: Optional[str] = None     # arc_3point / arc_tangent: one-shot G09/G08
         self.radius_index: Any = None
         self.length_on = False
@@ -454,6 +466,19 @@ class _Emitter:
             word("", f"#ERROR [{text}]", alone=True)
         elif t is n.FrameOp:
             self.frame(s, word)
+        elif t is n.PolarPole:
+            if s.relative_to == "last_point" and not s.target and not s.polar:
+                word("", "G30", alone=True)
+            elif s.relative_to == "zero" and not s.polar and len(s.target) <= 2:
+                a1, a2 = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}[self.plane]
+                if set(s.target) - {a1, a2}:
+                    raise NotExpressible("a polar pole outside the plane")
+                i = s.target.get(a1)
+                j = s.target.get(a2)
+                word("", f"G30 I{val(i.value if i else n.Num(0.0))} J{val(j.value if j else n.Num(0.0))}",
+                     alone=True)
+            else:
+                raise NotExpressible(f"a polar pole relative to the {s.relative_to.replace('_', ' ')}")
         elif t is n.SetPosition:
             words = " ".join(f"{a}{val(v.value)}" for a, v in s.target.items())
             word("", f"G92 {words}".strip(), alone=True)
@@ -486,6 +511,8 @@ class _Emitter:
             self.motion = v
         if g == "distance":
             self.distance = v
+        if g == "plane":
+            self.plane = v
         if g == "tool_length":
             if v == "minus":
                 raise NotExpressible("negative tool length compensation (G44)")
@@ -630,6 +657,13 @@ class _Emitter:
                 raise NotExpressible(f"mirror of {axes}")
             word("", "G10", alone=True)
             word("", "G14 " + " ".join(f"{a}-1" for a in axes), alone=True)
+        elif s.op == "trans" and s.local and not s.additive:
+            if s.clear or not s.values:
+                word("", "G158", alone=True)
+                return
+            # G158 replaces per axis: cancel first so axes left out of this one are 0 too
+            word("", "G158", alone=True)
+            word("", "G158 " + " ".join(f"{a}{_value(sp, e)}" for a, e in s.values.items()), alone=True)
         else:
             raise NotExpressible(f"the frame operation {s.op} (a translation)")
 

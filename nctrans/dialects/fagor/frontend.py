@@ -85,10 +85,6 @@ def table():
     return load_table(DIALECT)
 
 
-def system_vocabulary() -> dict[str, str]:
-    return dict(table().options.get("system_variables", {}))
-
-
 # ------------------------------------------------------------------ expressions
 
 class _Expr:
@@ -179,32 +175,21 @@ def param_var(n: int) -> ir.Var:
     return ir.Var("R", n)
 
 
-_WORK = {"X": 5001, "Y": 5002, "Z": 5003, "A": 5004, "B": 5005, "C": 5006}
-_NEUTRAL_SCALARS = {"tool": "$P_TOOLNO", "tool_offset": "$P_TOOL", "feed": "$P_F",
-                    "spindle_speed": "$P_S"}
-
-
 def v_variable(name: str, idx: list, tail: str, note) -> ir.Var:
-    """A V. variable as an IR variable: the neutral ones (spec §6.9, rules/fagor.toml
-    options.system_variables) read what the interpreter publishes; V.P./V.S. are user names."""
+    """A V. variable as an IR variable: V.P./V.S. user variables are local names; system variables
+    keep their Fagor spelling (the evaluator finds their neutral meaning through rules/fagor.toml
+    [system_variables]); one the table does not know is reported (NC135)."""
     full = name + tail
     parts = name.split(".")
     if len(parts) >= 3 and parts[1] in ("P", "S") and not idx:
         # user variables live with the local parameters (created by their first assignment);
         # V.S globals are analysed in the program's frame too (shared by LL, L and #CALL)
         return ir.Var("local", full.upper())
-    vocab = system_vocabulary()
-    base = re.sub(r"^V\.\[\d+\]\.", "V.", name)
-    meaning = vocab.get(base)
-    axis = tail[1:] if tail.count(".") == 1 else None
-    if meaning in ("work_position", "machine_position") and axis in _WORK and not idx:
-        key = _WORK[axis] + (20 if meaning == "machine_position" else 0)
-        return ir.Var("num", key)
-    if meaning in _NEUTRAL_SCALARS and not idx and not tail:
-        return ir.Var("system", _NEUTRAL_SCALARS[meaning])
-    note("NC135", "warning", f"{full} is not in the neutral system-variable vocabulary: it is read "
-         "from the machine model's `variables` table, else it is unknown (never taken as 0)")
-    return ir.Var("system", full.upper(), idx or None)
+    spelling = re.sub(r"^V\.\[\d+\]\.", "V.", full.upper())   # the channel selector does not change it
+    if idx or spelling not in table().system_variables:
+        note("NC135", "warning", f"{full} is not in the neutral system-variable vocabulary: it is read "
+             "from the machine model's `variables` table, else it is unknown (never taken as 0)")
+    return ir.Var("system", spelling, idx or None)
 
 
 # ------------------------------------------------------------------ lowering of one block
@@ -235,6 +220,8 @@ class Lowerer:
         self.mirror: set[str] = set()     # axes mirrored by G11-G14, in source order
         self.offset: ir.Expr = ir.Num(1.0, "1")   # the D in force (D1 is the default)
         self.distance = "absolute"                 # G90/G91 in source order (for G198/G199)
+        self.plane = "XY"                          # G17-G19 in source order (G30 I J letters)
+        self.local_shift: dict[str, ir.Expr] = {}  # G158 per axis, in source order
 
     def note(self, rule: str, severity: str, message: str, col: Optional[int] = None) -> None:
         self.diags.append(Diagnostic(rule, severity, message, self.file, self.line, col or self.col))
@@ -357,7 +344,7 @@ class Lowerer:
         motion_g = None
         arc_once = None
         frame = None
-        home = setpos = dwell = soft = False
+        home = setpos = dwell = soft = pole = shift = False
         unmodelled = []
         for rule, code, eq in w.gs:
             g, v = rule.group, rule.value
@@ -375,6 +362,11 @@ class Lowerer:
                 out.append((SIMPLE_GROUPS[g], ir.ModeChange(g, v, code)))
                 if g == "distance":
                     self.distance = v
+                elif g == "plane":
+                    self.plane = v
+                elif g == "work_offset" and v == "G53" and self.local_shift:
+                    self.local_shift = {}            # G53 cancels G158 too (spec §7.15)
+                    out.append((B_WCS + 1, ir.FrameOp("trans", clear=True, local=True)))
             elif g == "cycle":
                 if v == "off":
                     self.cycle = False
@@ -404,6 +396,10 @@ class Lowerer:
                 unmodelled.append(f"G263={_text_expr(eq)}")
             elif g == "soft_limit":
                 soft = True
+            elif g == "polar_pole":
+                pole = True
+            elif g == "incremental_offset":
+                shift = True
             elif g == "call":
                 pass
             elif g == "dynamics":
@@ -494,6 +490,26 @@ class Lowerer:
             out.append((B_NONMODAL, ir.SetPosition(target)))
         if frame is not None:
             self._frame(frame, vals, out)
+        if pole:
+            # G30 I J: the polar origin at (I, J) of the plane, absolute in work coordinates; G30
+            # alone: at the current point (spec §7.16)
+            if "I" in vals or "J" in vals:
+                a1, a2 = _PLANE_LETTERS[self.plane]
+                target = {a1: ir.AxisValue(vals.pop("I", ir.Num(0.0, "0"))),
+                          a2: ir.AxisValue(vals.pop("J", ir.Num(0.0, "0")))}
+                out.append((B_NONMODAL, ir.PolarPole("zero", target, code="G30")))
+            else:
+                out.append((B_NONMODAL, ir.PolarPole("last_point", {}, code="G30")))
+        if shift:
+            # G158 X Y: incremental zero offset, per axis (a new value replaces that axis'; G158
+            # alone cancels all); followed in source order and written whole, as G53 clears it
+            axes = {a: vals.pop(a) for a in list(vals) if a in AXES}
+            if not axes:
+                self.local_shift = {}
+            self.local_shift.update(axes)
+            self.local_shift = {a: e for a, e in self.local_shift.items() if _const(e) != 0}
+            out.append((B_WCS + 1, ir.FrameOp("trans", dict(self.local_shift), local=True)
+                        if self.local_shift else ir.FrameOp("trans", clear=True, local=True)))
 
         # numbered axes and spindles other than the first (X1=.., S2=..): not in the machine model
         for name, value in w.numbered.items():
@@ -641,6 +657,9 @@ class Lowerer:
             self.soft_limits.append(entry)
             out.append((B_NONMODAL, ir.Passthrough(code + " " + " ".join(
                 f"{a}{_text_expr(e)}" for a, e in axes.items()), NO_PATH_EFFECT, DIALECT)))
+
+
+_PLANE_LETTERS = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}
 
 
 def _const(e) -> Optional[float]:
