@@ -49,6 +49,7 @@ class Fagor(IsoFamily):
     comment_evidence = {"semicolon_line": (0.5, 2)}
     subprogram_endings = (".nc", ".NC", ".pim", ".fnc", ".fst")
     streams = False
+    lowering_passes = ()      # Fagor has $FOR, $WHILE, $DO and $SWITCH of its own
 
     def sniff(self, text: str) -> float:
         """0..1: share of Fagor markers found in the first 20 000 characters."""
