@@ -4,6 +4,11 @@
 - json:   `{"diagnostics": [...], "files": N, "summary": {"error": n, "warning": n, "info": n}}`
 - sarif:  SARIF 2.1.0 with the rule catalogue in tool.driver.rules
 - github: `::error file=F,line=L,col=C,title=RULE::message` workflow commands
+
+SARIF is written as plain dicts and held to the official 2.1.0 JSON schema by the tests (jsonschema).
+sarif-pydantic was tried (offline, from its wheel): its models are all-optional with extra fields
+allowed, so they accepted documents the schema rejects (startLine -5, startColumn 0, a bogus
+columnKind), and importing them cost about four times pydantic's own import on every SARIF run.
 """
 from __future__ import annotations
 
