@@ -31,6 +31,7 @@ bench: $(STAMP)
 	$(BIN)/python -m compileall -q nctrans
 	$(BIN)/python bench/bench.py
 	$(BIN)/python bench/bench_check.py
+	$(BIN)/python bench/bench_backplot.py
 
 fuzz: $(STAMP)
 	NCTRANS_FUZZ_PROFILE_SET=1 $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 tests/fuzz --hypothesis-profile=fuzz
