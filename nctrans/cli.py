@@ -394,6 +394,16 @@ def _plot_input(path: str, dialect: Optional[str], machine_path: Optional[str]):
     return ld, machine, records
 
 
+def _machine_check(records, machine) -> list:
+    """`backplot --check`: the machine check's findings (with their positions) over the records."""
+    from nctrans import check as _check
+    from nctrans.machine import MachineError
+    try:
+        return _check.check_records(records, machine).findings
+    except MachineError as e:
+        raise UsageError(str(e)) from None
+
+
 def cmd_backplot(args) -> int:
     from nctrans import backplot
     fmt = backplot.format_for(args.output)
@@ -414,7 +424,12 @@ def cmd_backplot(args) -> int:
         _print_text_diags(diags, sys.stderr)
         _err(f"{ld.label}: not plotted (errors above)")
         return EXIT_DIAGNOSTICS
-    scene = backplot.build_scene(records, ld.label, diags)
+    plotted = list(diags)       # lint findings, then the machine check's (which carry positions)
+    if args.check:
+        found = _machine_check(records, machine)
+        diags += [f.to_diagnostic() for f in found]
+        plotted += [f.to_dict() for f in found]
+    scene = backplot.build_scene(records, ld.label, plotted)
     sources = {ld.label: ld.source.text}
     comparison = None
     if args.compare:
@@ -596,6 +611,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="2D view for svg/png, first view of the html viewer (default top; front "
                         "when nothing moves in Y, as on a lathe)")
     p.add_argument("--machine", metavar="MACHINE.toml", help="machine (offsets, tools; stock and fixtures in glb)")
+    p.add_argument("--check", action="store_true",
+                   help="run the machine check (as `nctrans check`) and mark its findings on the plot")
     p.add_argument("--compare", metavar="B", help="overlay a second program and mark where the toolpaths differ")
     p.add_argument("--from-b", metavar="DIALECT", help="dialect of the --compare program")
     p.add_argument("--tol", type=float, default=None, metavar="MM", help="--compare tolerance in mm (default 0.001)")

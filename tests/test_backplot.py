@@ -372,3 +372,20 @@ def test_a_move_with_a_non_finite_coordinate_is_left_out_and_said():
     assert len(scene.moves) == 1 and "line 5" in scene.warnings[0]
     page = render("html", scene, sources={"p.nc": "G1 X5\nG1 X#1\n"}).decode()
     assert "NaN" not in page
+
+
+def test_check_findings_are_marked_at_their_position(tmp_path):
+    machine = tmp_path / "m.toml"
+    machine.write_text('name = "small"\n[axes.X]\nmin = -20.0\nmax = 45.0\n[axes.Y]\nmin = -20.0\nmax = 45.0\n'
+                       '[axes.Z]\nmin = -50.0\nmax = 30.0\n')
+    out = tmp_path / "chk.svg"
+    r = run("backplot", SAMPLE, "--machine", machine, "--check", "-o", out)
+    assert r.returncode == 1 and "NC301" in r.stderr          # X travel ends at 45; the pocket reaches X50
+    root = ET.parse(out).getroot()
+    marks = root.findall(f".//{SVG_NS}g[@class='finding error']")
+    assert marks and marks[0].get("data-line") == "12" and "NC301" in "".join(marks[0].itertext())
+    # N90 G03 (line 12) is the first move past X45: it ends at X50 Y10, where its path ends
+    ex, ey = _numbers(_move_paths(root)[6].get("d"))[-2:]
+    rect = marks[0].find(f"{SVG_NS}rect")
+    assert float(rect.get("x")) + 5 == pytest.approx(ex, abs=0.01)
+    assert float(rect.get("y")) + 5 == pytest.approx(ey, abs=0.01)
