@@ -36,11 +36,13 @@ class ToolpathRecord:
     coolant: Optional[str] = None          # coolant events: "mist" | "flood" | "off"
     stop_kind: Optional[str] = None        # stop events: "stop" | "optional" | "end"
     pitch: Optional[float] = None          # spindle-synchronised feed (tapping): lead in mm/rev
-    # Constant surface speed, on moves while it is on: the surface speed (m/min) and the spindle
-    # speed limit in force (rpm, e.g. G50 S / LIMS); the radius is |X|. `spindle` stays the speed
-    # the dialect computed; `check` also works out the speed at the move's smallest radius.
+    # Constant surface speed, on moves while it is on: the surface speed (m/min), the programmed
+    # spindle speed limit (rpm, G50 S / LIMS=; absent when none) and the machine X of the turning
+    # axis (the radius is |X - css_axis|). `spindle` stays the speed the interpreter derived;
+    # `check` works out what the surface speed demands at the move's smallest radius.
     css: Optional[float] = None
     spindle_limit: Optional[float] = None
+    css_axis: Optional[float] = None
 
     def to_dict(self) -> dict:
         out = {}

@@ -160,6 +160,8 @@ def to_json_line(r: ToolpathRecord) -> str:
         s += ',"css":' + _spell(r.css)
     if r.spindle_limit is not None:
         s += ',"spindle_limit":' + _spell(r.spindle_limit)
+    if r.css_axis is not None:
+        s += ',"css_axis":' + _spell(r.css_axis)
     s += "}"
     if "nan" in s or "inf" in s:      # a non-finite number (or a file name containing the letters)
         return _safe_json_line(r)

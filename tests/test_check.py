@@ -475,3 +475,24 @@ def test_what_the_check_does_not_model_is_said():
     lathe.fixtures = list(m.fixtures)
     [note] = only(check_records(recs[:1], lathe).findings, "NC306")
     assert "lathe" in note.message
+
+
+def test_constant_surface_speed_of_a_real_lathe_program(tmp_path):
+    """corpus/iso-t/u-w-g50-css.nc: G96 S200 (m/min) limited by G50 S2000. G50 X100 shifts X, so
+    the radius is program X, not machine X. Line 9 ends at radius 25 (200000 / (2 pi 25) = 1273 rpm),
+    line 10 at radius 5 (6366 rpm, held to 2000 by G50 S2000)."""
+    src = ROOT / "corpus" / "iso-t" / "u-w-g50-css.nc"
+    if not src.exists():
+        pytest.skip("iso-t conformance programs not present")
+
+    def findings(max_rpm):
+        (tmp_path / "lathe.toml").write_text(
+            f'kind = "lathe"\n[axes.X]\nmin = -300.0\nmax = 300.0\n[axes.Z]\nmin = -300.0\nmax = 300.0\n'
+            f'[spindle]\nmax_rpm = {max_rpm}\n')
+        machine = pipeline.load_machine(str(tmp_path / "lathe.toml"))
+        return only(check_loaded(pipeline.load(str(src), "iso-t", stream=True), machine)[1].findings, "NC304")
+    [f] = findings(1500)               # 2000 rpm allowed by G50 over a 1500 rpm spindle
+    assert f.line == 10 and f.amount == pytest.approx(500.0) and "surface speed" in f.message
+    [f] = findings(1200)               # 1273 rpm already at radius 25
+    assert f.line == 9 and f.amount == pytest.approx(200000 / (2 * math.pi * 25) - 1200, rel=1e-6)
+    assert not findings(2500)          # G50 S2000 keeps it under the spindle's maximum

@@ -193,12 +193,14 @@ def axis_travel(r: ToolpathRecord) -> dict[str, float]:
 
 
 def smallest_radius(r: ToolpathRecord) -> float:
-    """Smallest |X| along a move: the turning radius where constant surface speed peaks."""
+    """Smallest distance |X - css_axis| along a move: the turning radius where constant surface
+    speed peaks."""
+    axis = getattr(r, "css_axis", None) or 0.0
     s, e = r.start or {}, r.end or {}
-    xs = [abs(s.get("X", 0.0)), abs(e.get("X", 0.0))]
+    x0, x1 = s.get("X", 0.0) - axis, e.get("X", 0.0) - axis
+    xs = [abs(x0), abs(x1)]
     if r.kind == "arc" and r.center is not None:
-        for p, _ in arc_extremes(r):
-            xs.append(abs(p.get("X", 0.0)))
-    elif (s.get("X", 0.0) > 0) != (e.get("X", 0.0) > 0):
+        xs += [abs(p.get("X", 0.0) - axis) for p, _ in arc_extremes(r)]
+    elif (x0 > 0) != (x1 > 0):
         xs.append(0.0)                     # the move crosses the spindle axis
     return min(xs)

@@ -548,6 +548,9 @@ class Interpreter(LatheMixin):
         else:
             rec = ToolpathRecord(0, file, line, "linear" if kind == "linear" else "arc", mstart,
                                  mend, feed=feed, feed_mode=feed_mode, spindle=speed, tool=tool)
+        if self.css_surface is not None:    # constant surface speed, for `check` to judge
+            rec.css, rec.spindle_limit = self.css_surface, self.css_limit
+            rec.css_axis = mend.get("X", 0.0) - end.get("X", 0.0)
         mc = None
         if kind == "arc":
             a1, a2, an = PLANE_AXES[plane]
