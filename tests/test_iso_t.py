@@ -243,3 +243,19 @@ def test_gcode_system_b_renames_onto_system_a():
     assert [r.feed_mode for r in recs if r.line == 5 and r.kind == "linear"] == ["per_rev"] * 2
     assert moves(recs, 7) == [("rapid", 20.0, 2.0)]
     assert moves(recs, 8)[1] == ("linear", 14.6, -20.0)
+
+
+def test_g72_facing_levels_and_g73_pattern_passes():
+    recs, diags = run(CONF / "g72-g73.nc")
+    assert not [d for d in diags if d.severity == "error"], diags
+
+    def face(z):            # across to the level, cut X20 -> X10 (radius), 45-degree retract, back
+        return [("rapid", 20.0, z), ("linear", 10.0, z), ("rapid", 10.5, z + 0.5), ("rapid", 20.0, z + 0.5)]
+    assert moves(recs, 10) == (face(0.0) + face(-2.0) + face(-4.0)
+                               + [("rapid", 20.0, -6.0), ("linear", 10.0, -6.0), ("linear", 10.0, 2.0),
+                                  ("rapid", 20.0, 2.0)])
+    want = []
+    for od in (4.0, 2.0, 0.0):                      # relief 4 shrinking over 3 passes
+        want += [("rapid", 10.0 + od, 2.0), ("linear", 10.0 + od, -10.0), ("linear", 20.0 + od, -10.0)]
+        want += ([("rapid", 20.0, -10.0)] if od else []) + [("rapid", 20.0, 2.0)]
+    assert moves(recs, 16) == want
