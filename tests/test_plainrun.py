@@ -244,7 +244,7 @@ def test_kernel_spells_numbers_as_the_jsonl_writer(v):
 
 
 @pytest.mark.parametrize("budget", [1, 7, 50, 4100, 4400])
-def test_step_budget_stops_at_the_same_block_with_and_without_kernel(budget):
+def test_straight_blocks_do_not_spend_the_step_budget_with_or_without_kernel(budget):
     from nctrans.interp import interpret
     text = "%\nO1\nG0X0Y0Z5.\nG1F100.\n" + "\n".join(f"X{i}.Y{i % 7}." for i in range(4500)) + "\nM30\n%\n"
 
@@ -262,4 +262,6 @@ def test_step_budget_stops_at_the_same_block_with_and_without_kernel(budget):
             plainrun.native = saved
     fast, slow = go(True), go(False)
     assert fast == slow
-    assert any(d[0] == "NC205" for d in fast[1])
+    # the budget counts repeated execution only: all 4500 moves (+ the rapid, the stop) come out
+    assert not any(d[0] == "NC205" for d in fast[1])
+    assert fast[0].count("\n") == 4502

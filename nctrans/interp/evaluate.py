@@ -12,6 +12,7 @@ import math
 import re
 from typing import Any, Callable, Optional
 
+from nctrans import limits
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import literal
 from nctrans.rules import system_meaning
@@ -109,12 +110,13 @@ _TYPE_DEFAULTS = {"INT": 0, "REAL": 0.0, "BOOL": False, "CHAR": "", "STRING": ""
 
 class Scope:
     """One call level: ISO locals #1..#33, declared names, call arguments by letter."""
-    __slots__ = ("num", "names", "args")
+    __slots__ = ("num", "names", "args", "lengths")
 
     def __init__(self, num: Optional[dict] = None, args: Optional[dict] = None):
         self.num: dict[int, Any] = {} if num is None else num
         self.names: dict[str, Any] = {}
         self.args: dict[str, Any] = args or {}
+        self.lengths: dict[str, int] = {}     # declared STRING[n] lengths of `names`
 
 
 class Array:
@@ -303,6 +305,7 @@ class Evaluator:
         self.global_names: dict[str, Any] = {}
         # system variables by spelling (a name, or an int for a numbered one): filled from `meanings`
         # through the rules tables (rules.system_meaning) on first read, and by writes
+        self.global_lengths: dict[str, int] = {}   # declared STRING[n] lengths of global_names
         self.system: dict[Any, Callable[[], Any]] = {}
         # neutral meaning (vocabulary.SYSTEM_VARIABLES, "<meaning>.<axis>" per axis) -> reader and
         # writer; the interpreter registers them
@@ -679,6 +682,16 @@ class Evaluator:
         typ = decl.type.upper()
         default = _TYPE_DEFAULTS.get(typ, 0.0)
         store = self.global_names if (scope or decl.scope) != "local" else self.scope.names
+        lengths = self.global_lengths if store is self.global_names else self.scope.lengths
+        if decl.dims:
+            elements = math.prod(decl.dims)
+            if elements > limits.MAX_ARRAY_ELEMENTS:
+                raise EvalError("NC109", f"array {name} of {elements} elements is larger than "
+                                f"{limits.MAX_ARRAY_ELEMENTS}")
+        if typ == "STRING":
+            lengths[name] = min(decl.length or limits.MAX_STRING, limits.MAX_STRING)
+        else:
+            lengths.pop(name, None)
         init = decl.init or []
         rep = len(init) == 1 and type(init[0]) is n.Func and init[0].name.upper() == "REP"
         if rep:
@@ -701,7 +714,17 @@ class Evaluator:
             store[name] = arr
         else:
             store[name] = inits[0] if inits else default
+            if inits and typ == "STRING":
+                self._cap_string(store, lengths, name, store[name])
 
+    @staticmethod
+    def _cap_string(store: dict, lengths: dict, name: str, value: Any) -> None:
+        """Keep a declared STRING[n] within its n characters: longer values are cut (NC109)."""
+        cap = lengths.get(name)
+        if cap is not None and isinstance(value, str) and len(value) > cap:
+            store[name] = value[:cap]
+            raise EvalError("NC109", f"string of {len(value)} characters assigned to {name}, "
+                            f"declared STRING[{cap}]: cut to {cap} characters")
     @staticmethod
     def _typed(typ: str, v: Any) -> Any:
         """AXIS values are axis names (DEF AXIS A=(X) and DEF AXIS A="X" alike)."""
@@ -798,6 +821,10 @@ class Evaluator:
                     cur.set(self._indices(fns), v)
                 else:
                     store[name] = v
+                    if type(v) is str and len(v) > 0:
+                        lengths = (self.global_lengths if store is self.global_names
+                                   else self.scope.lengths)
+                        self._cap_string(store, lengths, name, v)
             return set_name
         if space in ("arg", "local"):       # a local parameter lives with the call's arguments
             key = str(var.key).upper()
@@ -826,4 +853,8 @@ def _concat(a: Any, b: Any) -> str:
         if isinstance(v, float) and v.is_integer():
             return str(int(v))
         return str(v)
-    return s(a) + s(b)
+    out = s(a) + s(b)
+    if len(out) > limits.MAX_STRING:
+        raise EvalError("NC109", f"string of {len(out)} characters: longer than the "
+                        f"{limits.MAX_STRING} a controller string holds")
+    return out

@@ -7,9 +7,11 @@ How it runs
   (conditional jump on a compiled expression), EXEC (a side effect such as a FOR step), CASE.
 - Calls keep an explicit stack of frames (no Python recursion), so the loop is one generator:
   records are built into a small buffer per instruction and yielded at once; nothing accumulates.
-- Every executed instruction costs one step; when `max_steps` is spent, NC205 names the line and
-  the stream ends. ISO M99 in a main program (ProgramEnd "restart") would loop for ever: the
-  interpreter analyses the one pass and stops with NC205 (choice documented here).
+- Every repeated instruction (a block run again by a loop, jump or call; every control
+  instruction) costs one step; straight-line blocks are free, so programs of any length run to
+  their end. When `max_steps` is spent, NC205 (an error) names the line and the stream ends.
+  ISO M99 in a main program (ProgramEnd "restart") would loop for ever: the interpreter analyses
+  the one pass and stops with NC205 (a warning: everything in the program was analysed).
 - Block-skip blocks (`/`) run, as with LinuxCNC's rs274 (block delete switch off).
 
 Coordinates (all mm): program point -> programmable frame (frames.py) -> work point -> + G92 +
@@ -409,7 +411,10 @@ class Interpreter(LatheMixin):
             return None
         if isinstance(v, str):
             raise EvalError("NC104", f"string used as {what}")
-        return float(v)
+        v = float(v)
+        if v - v != 0.0:                 # infinity or NaN: never let it reach a record
+            raise EvalError("NC108", f"{what} is {v} (out of range)")
+        return v
 
     def _words(self, d: Optional[dict]) -> tuple:
         """Pre-compile axis words: (axis, constant|None, closure, mode)."""
@@ -422,10 +427,13 @@ class Interpreter(LatheMixin):
                 expr, mode = av.value, av.mode
             else:
                 expr, mode = av, None
-            if type(expr) is Num:
-                out.append((axis.upper(), float(expr.value), None, mode))
+            c = float(expr.value) if type(expr) is Num else constant(expr)
+            if c is not None and c - c != 0.0:      # infinite/NaN constant: an error when it runs
+                out.append((axis.upper(), None, _non_finite(axis, c), mode))
                 continue
-            c = constant(expr)
+            if type(expr) is Num:
+                out.append((axis.upper(), c, None, mode))
+                continue
             out.append((axis.upper(), c, None if c is not None else self.ev.compile(expr), mode))
         return tuple(out)
 
@@ -913,7 +921,8 @@ class Interpreter(LatheMixin):
             fast = []
             AV, Num = n.AxisValue, n.Num
             for axis, av in s.target.items():
-                if type(av) is AV and type(av.value) is Num and av.mode in (None, "abs", "inc"):
+                if type(av) is AV and type(av.value) is Num and av.mode in (None, "abs", "inc") \
+                        and float(av.value.value) - float(av.value.value) == 0.0:
                     a = axis.upper()
                     fast.append((a, float(av.value.value), av.mode, a in LINEAR_AXES))
                 else:
@@ -1812,12 +1821,20 @@ class Interpreter(LatheMixin):
                     continue
                 ins = code[pc]
                 op = ins[0]
-                steps += 1
-                if steps > max_steps:
-                    sp = ins[3]
-                    diag("NC205", "warning", f"analysis truncated at line {sp.line if sp else 0}: "
-                         f"step budget of {max_steps} exhausted", sp)
-                    break
+                # The budget counts repeated execution (a block run again by a loop, a jump back
+                # or a call, and every control instruction), never a straight-line block (or a
+                # PlainRun of them, which only a streamed main body holds) running the first
+                # time: a 30 M-block CAM program runs to its end, an endless loop stops.
+                # Running out is an error: the analysis is incomplete.
+                if (op != BLOCK and op != PLAIN
+                        or op == BLOCK and (ins[1] is not None or unit.seen[pc])):
+                    steps += 1
+                    if steps > max_steps:
+                        sp = ins[3]
+                        diag("NC205", "error", f"analysis truncated at line {sp.line if sp else 0}: "
+                             f"step budget of {max_steps} repeated steps (loop iterations, jumps "
+                             "back, calls) exhausted", sp)
+                        break
                 if op == BLOCK:
                     self.span = ins[3]
                     stmts = ins[1]
@@ -1854,8 +1871,7 @@ class Interpreter(LatheMixin):
                         unit, code, pc, sidx = self._control(ctl, unit, pc, sidx)
                 elif op == PLAIN:
                     self.span = ins[3]
-                    done, rest = self._plain(ins[1], max_steps - steps + 1)
-                    steps += done - 1
+                    done, rest = self._plain(ins[1], KERNEL_BLOCKS + 1)   # straight blocks: free
                     pc += 1
                     if rest:
                         # What the kernel left (Blocks, and the rest of the run) replaces what has
@@ -1901,8 +1917,11 @@ class Interpreter(LatheMixin):
                     yield from self._release(out)
         except _Stop:
             pass
-        self._comp_flush()
-        yield from self._release(out)
+        try:
+            self._comp_flush()
+            yield from self._release(out)
+        except _Stop:
+            pass
 
     # ---------------------------------------------------------------- plain runs
     def _plain(self, run: PlainRun, budget: int) -> tuple[int, list]:
@@ -1990,6 +2009,13 @@ class Interpreter(LatheMixin):
                 self._seq += rec.count
                 yield rec
                 continue
+            end = rec.end
+            if end is not None and not _finite_point(end, rec.center):
+                out.clear()
+                self.diag("NC108", "error", f"a coordinate of this {rec.kind} move is out of range "
+                          f"(infinite or not a number): {end}; the analysis stops here",
+                          n.Span(rec.file, rec.line, 1))
+                raise _Stop()
             self._seq += 1
             rec.seq = self._seq
             if hook is not None:
@@ -2126,6 +2152,21 @@ def interpret(program: n.Program, machine=None, *, diagnostics: list, resolver=N
 
 
 _KERNEL_AXES = frozenset("XYZABCUVW")
+
+
+def _finite_point(end: dict, center: Optional[dict]) -> bool:
+    """No infinity or NaN in a record's end point or centre (a sum overflows only if a term is
+    ~1e308, which is out of any range anyway)."""
+    t = sum(end.values())
+    if center is not None:
+        t += sum(center.values())
+    return t - t == 0.0
+
+
+def _non_finite(axis: str, value: float) -> Callable[[], Any]:
+    def fail():
+        raise EvalError("NC108", f"{axis.upper()} word is {value} (out of range)")
+    return fail
 
 
 def _plain_entry(run: PlainRun) -> tuple:

@@ -18,7 +18,7 @@ import re
 from operator import itemgetter
 from typing import Any, Optional
 
-from nctrans import plainrun
+from nctrans import limits, plainrun
 from nctrans.diagnostics import Diagnostic
 from nctrans.ir.nodes import (
     Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
@@ -713,6 +713,24 @@ class _Frame:
         self.node, self.label, self.parent, self.line = node, label, parent, line
 
 
+def _hostile_block(code: str) -> Optional[tuple[str, int, str]]:
+    """(rule, index into code, message) for a block no real program holds and the grammar must
+    not see: stacked signs (`X1--5`), a number too large for a double, brackets or operator chains
+    deep enough to exhaust the recursion of the expression walkers (nctrans/limits.py)."""
+    if "--" in code or "-+" in code or "+-" in code or "++" in code:
+        idx, signs = limits.stacked_signs(code)
+        return ("NC002", idx, f"stacked signs {signs!r}: write one sign (X-5) or bracket the "
+                "operand (X[1-[-5]])")
+    huge = limits.huge_literal(code)
+    if huge is not None:
+        return ("NC108", huge[0], f"number of {len(huge[1])} digits is out of range (it would "
+                "read as infinity)")
+    deep = limits.too_complex(code, "[", "]")
+    if deep is not None:
+        return ("NC008", deep[0], deep[1])
+    return None
+
+
 def _raw_col(blanked: str, index: int) -> int:
     """1-based source column of the `index`-th (0-based) character of clean(blanked)."""
     kept = 0
@@ -953,7 +971,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
             code = raw.replace(" ", "")
             if code[-1:] == "\r":
                 code = code[:-1]
-            if code and code[0] != "O" and fast_plain(code) is not None:
+            if code and code[0] != "O" and len(code) < 309 and fast_plain(code) is not None:
                 words = fast_words(code)
                 done = hot(words)
                 if done is not None:
@@ -987,6 +1005,13 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
         code = code.upper()
         comment = " ".join(comments) if comments else None
         span = Span(file, lineno, 1, lineno, len(raw) + 1)
+        hostile = _hostile_block(code)
+        if hostile is not None:
+            rule, idx, message = hostile
+            diags.append(Diagnostic(rule, "error", message, file, lineno, _raw_col(blanked, idx)))
+            cur.append(_passthrough_block(raw, span, None, None, low, lineno))
+            seen_block = True
+            continue
 
         if code[0] != "O" and fast_plain(code) is not None:
             segments = ((None, code),)
@@ -1095,6 +1120,14 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                         node_label = it[1]
                     else:
                         node_label = it[2]
+                    if len(stack) >= limits.ISO_MAX_DO_NESTING:
+                        # the controller's limit; kept out of the IR so no walker recurses deeper
+                        diags.append(Diagnostic(
+                            "NC008", "error", f"DO{node_label} nested {len(stack) + 1} levels deep: "
+                            f"nesting too deep (at most {limits.ISO_MAX_DO_NESTING} DO levels)",
+                            file, lineno))
+                        stack.append(_Frame(node, node_label, cur, lineno))
+                        continue
                     cur.append(node)
                     stack.append(_Frame(node, node_label, cur, lineno))
                     cur = node.body

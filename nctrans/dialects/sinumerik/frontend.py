@@ -25,7 +25,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedInput, UnexpectedToken, UnexpectedCharacters, UnexpectedEOF
 from lark.lexer import Lexer
 
-from nctrans import resources
+from nctrans import limits, resources
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import ParseResult
 from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
@@ -882,6 +882,10 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
         # ---- parse the statement part (plain address words skip the LALR parser)
         try:
             fast = _plain_words(code)
+            if fast is None:
+                deep = limits.too_complex(code)
+                if deep is not None:
+                    raise LexError("NC008", deep[1], deep[0])
             tree = Tree("start", fast) if fast is not None else parser().parse(code)
         except LexError as e:
             low.error(e.rule, e.message, n, line.col + e.pos)
@@ -944,6 +948,8 @@ def _plain_words(code: str) -> Optional[list]:
     for m in _PAIR.finditer(code):
         letter = m.group(1).upper()
         a0, n0, n1 = m.start(1), m.start(2), m.end(2)
+        if n1 - n0 > 15 or "X" in m.group(2) or "x" in m.group(2):
+            return None                  # an exponent or a long number: the lexer checks its range
         out.append(Tree("word", [Token("ADDR", letter, a0, 1, a0 + 1, 1, a0 + 2, a0 + 1),
                                  Token("NUMBER", m.group(2), n0, 1, n0 + 1, 1, n1 + 1, n1)]))
     return out
@@ -1069,8 +1075,7 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
             node.then.append(ir.Block(span, low.statements(rest, line)))
             unit.current.append(node)
             return
-        unit.current.append(node)
-        unit.stack.append(_Open("IF", node, node.then, line.lineno))
+        _open(low, unit, "IF", node, node.then, line)
     elif d == "else_stmt":
         if unit.stack and unit.stack[-1].kind == "IF" and unit.stack[-1].body is unit.stack[-1].node.then:
             unit.stack[-1].body = unit.stack[-1].node.orelse
@@ -1078,23 +1083,19 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
             low.error("NC002", "ELSE without IF", line.lineno, line.col)
     elif d == "while_stmt":
         node = ir.While(span, expr(ch[1]), [])
-        unit.current.append(node)
-        unit.stack.append(_Open("WHILE", node, node.body, line.lineno))
+        _open(low, unit, "WHILE", node, node.body, line)
     elif d == "for_stmt":
         lv = ch[1].children[0]
         var = ir.Var("R", int(str(lv)[1:])) if _RPARAM.match(str(lv)) else (
             ir.Var("system", str(lv)) if lv.type == "SYSVAR" else ir.Var("name", str(lv)))
         node = ir.ForLoop(span, var, expr(ch[3]), expr(ch[5]), [])
-        unit.current.append(node)
-        unit.stack.append(_Open("FOR", node, node.body, line.lineno))
+        _open(low, unit, "FOR", node, node.body, line)
     elif d == "loop_stmt":
         node = ir.Loop(span, [])
-        unit.current.append(node)
-        unit.stack.append(_Open("LOOP", node, node.body, line.lineno))
+        _open(low, unit, "LOOP", node, node.body, line)
     elif d == "repeat_stmt":
         node = ir.RepeatUntil(span, [], ir.Num(1.0, "1"))
-        unit.current.append(node)
-        unit.stack.append(_Open("REPEAT", node, node.body, line.lineno))
+        _open(low, unit, "REPEAT", node, node.body, line)
     elif d in ("endif_stmt", "endwhile_stmt", "endfor_stmt", "endloop_stmt", "until_stmt"):
         want = {"endif_stmt": "IF", "endwhile_stmt": "WHILE", "endfor_stmt": "FOR",
                 "endloop_stmt": "LOOP", "until_stmt": "REPEAT"}[d]
@@ -1118,6 +1119,20 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
         unit.current.append(ir.Case(span, expr(ch[1]), branches, default))
     if rest and d not in ("if_stmt",):
         low.error("NC002", f"{_KW.get(d, d)} must stand in its own block", line.lineno, line.col)
+
+
+def _open(low: Lowerer, unit: _Unit, kind: str, node, body: list, line: Line) -> None:
+    """Open a control structure. Past the controller's nesting limit it is an NC008 error and the
+    structure is kept out of the IR (its blocks stay in the enclosing body), so no walker of the
+    IR recurses deeper than the limit."""
+    if len(unit.stack) >= limits.SINUMERIK_MAX_NESTING:
+        low.error("NC008", f"{kind} nested {len(unit.stack) + 1} deep: nesting too deep (at most "
+                  f"{limits.SINUMERIK_MAX_NESTING} control structures per program level)",
+                  line.lineno, line.col)
+        unit.stack.append(_Open(kind, node, unit.current, line.lineno))
+        return
+    unit.current.append(node)
+    unit.stack.append(_Open(kind, node, body, line.lineno))
 
 
 def _zone(low: Lowerer, start: str, lines: list[Line]) -> dict:

@@ -9,6 +9,7 @@ Keywords are matched case-insensitively and names are upper-cased (strings keep 
 """
 from __future__ import annotations
 
+import math
 import re
 from typing import Iterator
 
@@ -67,6 +68,23 @@ def number_value(text: str) -> float:
     return float(t.replace("EX", "E"))
 
 
+_BARE_EXPONENT = re.compile(r"E[+-]?\d", re.IGNORECASE)
+_BARE_EXPONENT_WORD = re.compile(r"E[+-]?\d+", re.IGNORECASE)
+
+
+def _check_number(text: str, m: "re.Match", start: int, standalone: bool = False) -> None:
+    """A numeric literal must be finite (NC108), and an exponent is written EX: `1E400` would
+    otherwise read as the number 1 and an address word E400."""
+    t = m.group()
+    if (len(t) > 15 or "X" in t or "x" in t) and not math.isfinite(number_value(t.strip())):
+        raise LexError("NC108", f"{m.group().strip()!r} is out of range (it would read as infinity)",
+                       start)
+    if standalone and _BARE_EXPONENT.match(text, m.end()):
+        e = _BARE_EXPONENT_WORD.match(text, m.end()).group()
+        raise LexError("NC002", f"'{t}{e}': a Sinumerik exponent is written EX ({t}EX{e[1:]})",
+                       m.end())
+
+
 def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
     """Tokens of `text`; columns are 1-based and offset by `col0 - 1` (the statement's place in the line)."""
     i, n = 0, len(text)
@@ -116,6 +134,7 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
             continue
         if ch in _DIGITS or (ch == "." and i + 1 < n and text[i + 1] in _DIGITS):
             m = _NUMBER.match(text, i)
+            _check_number(text, m, i, standalone=True)
             yield tok("NUMBER", m.group(), i, m.end())
             i = m.end()
             continue
@@ -154,6 +173,7 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
                     yield tok("RPARAM", upper, i, end)
                     i = end
                     continue
+                _check_number(text, m2, i + 1)
                 yield tok("ADDR", letter, i, i + 1)
                 yield tok("NUMBER", m2.group(), i + 1, m2.end())
                 i = m2.end()
@@ -162,6 +182,7 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
                 m2 = _SIGNED.match(text, end)
                 if m2:
                     num = m2.group().strip()
+                    _check_number(text, m2, m2.end() - len(num))
                     yield tok("ADDR", upper, i, end)
                     yield tok("NUMBER", num, m2.end() - len(num), m2.end())
                     i = m2.end()

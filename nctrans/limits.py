@@ -1,0 +1,94 @@
+"""Bounds that keep hostile or broken input from exhausting memory, stack or time.
+
+One place for every limit nctrans puts on its input, so each is documented once (README "Limits")
+and tests/test_hostile.py can hold the program to it. Where a controller manual states a limit the
+same limit applies here (the seeds: Fanuc 3 nested DO levels, Sinumerik STRING of at most 200
+characters; Sinumerik control structures: see SINUMERIK_MAX_NESTING); the rest are far beyond any real part
+program and only stop runaway input.
+"""
+from __future__ import annotations
+
+import math
+import re
+from typing import Optional
+
+# Largest input file read (bytes). Five-axis mould programs run to tens of millions of blocks:
+# 2 GiB holds ~80 M blocks. Larger inputs are refused with exit 2 before anything is read.
+MAX_INPUT_BYTES = 2 * 1024 ** 3
+
+# Bracket / parenthesis nesting inside one block (Fanuc allows 5 levels of [ ]; the limit here
+# leaves room for generated Sinumerik expressions and still keeps every recursive walk shallow).
+MAX_BRACKET_DEPTH = 32
+# Operators in one block: a left-deep chain of N operators is an expression tree N deep.
+MAX_OPERATORS = 200
+
+# Nesting of control structures, as the controllers themselves limit it.
+ISO_MAX_DO_NESTING = 3                 # Fanuc macro B: DO1..DO3, "nesting up to 3 levels"
+# The SW 6 manual (seeds) allows 8 check structures per program level, but a real 840D sl program
+# in the corpus (nie11kun-MK6120-C_PAR_INI.SPF) nests 10 deep and runs: the later limit, 16, holds.
+SINUMERIK_MAX_NESTING = 16
+
+# Strings (Sinumerik STRING[n]; n at most 200 characters on the 840D): an undeclared string
+# (a concatenation result, a CHAR/STRING parameter) is capped at the same length.
+MAX_STRING = 200
+# Elements of one declared array (DEF REAL A[n,m]): REP() and SET() walk them all.
+MAX_ARRAY_ELEMENTS = 1_000_000
+
+# Diagnostics kept per file; past it one closing NC009 note says how many more there were.
+MAX_DIAGNOSTICS_PER_FILE = 1000
+
+_OPERATOR_CHARS = re.compile(r"[-+*/<>=]|\b(?:AND|OR|XOR|MOD|NOT|B_AND|B_OR|B_XOR|B_NOT|DIV)\b",
+                             re.IGNORECASE)
+_STACKED_SIGNS = re.compile(r"[-+]{2,}")
+_HUGE_INTEGER = re.compile(r"(?<![\d.])0*[1-9]\d{308,}")
+
+
+def bracket_depth(code: str, opening: str = "[(", closing: str = "])") -> tuple[int, int]:
+    """(deepest nesting, 0-based index where it is first reached) of brackets in `code`."""
+    depth = deepest = 0
+    where = 0
+    for i, ch in enumerate(code):
+        if ch in opening:
+            depth += 1
+            if depth > deepest:
+                deepest, where = depth, i
+        elif ch in closing:
+            depth -= 1
+    return deepest, where
+
+
+def too_complex(code: str, opening: str = "[(", closing: str = "])") -> Optional[tuple[int, str]]:
+    """(0-based index, message) when a block nests brackets or chains operators beyond what any
+    walker of its expression tree may recurse into; None for every real block."""
+    if len(code) <= MAX_BRACKET_DEPTH * 2 and len(code) <= MAX_OPERATORS:
+        return None
+    deepest, where = bracket_depth(code, opening, closing)
+    if deepest > MAX_BRACKET_DEPTH:
+        return where, (f"brackets nested {deepest} deep (at most {MAX_BRACKET_DEPTH}): "
+                       "nesting too deep")
+    ops = 0
+    for m in _OPERATOR_CHARS.finditer(code):
+        ops += 1
+        if ops > MAX_OPERATORS:
+            return m.start(), (f"more than {MAX_OPERATORS} operators in one block: "
+                               "expression nesting too deep; split the computation")
+    return None
+
+
+def stacked_signs(code: str) -> Optional[tuple[int, str]]:
+    """(0-based index, the signs) of two or more signs in a row (`X1--5`, `#1=1+-+5`)."""
+    m = _STACKED_SIGNS.search(code)
+    return None if m is None else (m.start(), m.group())
+
+
+def huge_literal(code: str) -> Optional[tuple[int, str]]:
+    """(0-based index, digits) of an integer literal too large for a double (more than 308
+    digits): it would read as infinity."""
+    if len(code) < 309:
+        return None
+    m = _HUGE_INTEGER.search(code)
+    return None if m is None else (m.start(), m.group())
+
+
+def finite(value: float) -> bool:
+    return not math.isinf(value) and not math.isnan(value)

@@ -1,0 +1,173 @@
+"""Hostile input: each case runs the real CLI in a child process held to 700 MiB of address space
+and 60 s of CPU (resource limits, not timing assertions). It must end with a located diagnostic
+or a clean result: never an internal error, a traceback, a crash or a silently wrong output.
+
+Families (issue 15): unbounded strings, diagnostic floods, devices and FIFOs, stacked signs, deep
+nesting, infinity and out-of-range numbers, long straight programs, corrupt caches.
+"""
+from __future__ import annotations
+
+import os
+import re
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+MEMORY_LIMIT = 700 * 1024 * 1024
+CPU_SECONDS = 60
+NCTRANS = [sys.executable, "-m", "nctrans"]
+
+
+def _limits() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
+    resource.setrlimit(resource.RLIMIT_CPU, (CPU_SECONDS, CPU_SECONDS))
+
+
+def run(*args, cwd=None, stdin=None, env=None) -> tuple[int, str, str]:
+    """(exit code, stdout, stderr) of one nctrans run under the limits."""
+    p = subprocess.run([*NCTRANS, *map(str, args)], cwd=cwd, input=stdin, capture_output=True,
+                       preexec_fn=_limits, env={**os.environ, "NCTRANS_DEBUG": "0", **(env or {})},
+                       timeout=CPU_SECONDS * 3)
+    out, err = p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
+    assert p.returncode >= 0, f"killed by signal {-p.returncode}: {err[-2000:]}"
+    assert "internal error" not in err and "Traceback" not in err, err[-2000:]
+    return p.returncode, out, err
+
+
+def located(text: str, rule: str, file: str, line: int, column: int | None = None) -> bool:
+    """Whether `text` holds a gcc-style diagnostic of `rule` at file:line(:column)."""
+    col = r"\d+" if column is None else str(column)
+    return re.search(rf"^{re.escape(file)}:{line}:{col}: (error|warning|info)\[{rule}\]", text,
+                     re.M) is not None
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+# --------------------------------------------------------------------------- strings (item 1)
+
+@pytest.mark.parametrize("program, line", [
+    # doubling a declared STRING forty times: ~1 TB of text without a cap
+    ("DEF STRING[200] TXT\nDEF INT I\nTXT=\"AB\"\nFOR I=1 TO 40\nTXT=TXT<<TXT\nENDFOR\nG0 X1\nM30\n", 5),
+    # an undeclared growth: concatenation into an R parameter-free string expression in a loop
+    ("DEF STRING[10] TXT\nDEF INT I\nFOR I=1 TO 1000000\nTXT=TXT<<\"ABCDEFGHIJ\"\nENDFOR\nM30\n", 4),
+    ("DEF STRING[5] TXT\nTXT=\"ABCDEFGH\"\nM30\n", 2),
+])
+def test_string_growth_is_capped_with_nc109(tmp_path, program, line):
+    f = write(tmp_path, "s.mpf", program)
+    rc, out, _ = run("lint", f.name, cwd=tmp_path)
+    assert rc == 1 and located(out, "NC109", "s.mpf", line)
+
+
+def test_declared_length_cuts_the_string(tmp_path):
+    """STRING[5] holds five characters: what the program reads back is cut, not the whole."""
+    from nctrans import pipeline
+    f = write(tmp_path, "s.mpf", 'DEF STRING[5] TXT\nTXT="ABCDEFGH"\nIF TXT=="ABCDE"\nG0 X1\nENDIF\nM30\n')
+    ld = pipeline.load(str(f))
+    recs = list(pipeline.toolpath_of(ld))
+    assert [r.kind for r in recs] == ["rapid", "stop"]
+    assert [d.rule for d in ld.diagnostics] == ["NC109"]
+
+
+def test_huge_array_declaration_is_refused(tmp_path):
+    f = write(tmp_path, "a.mpf", "DEF REAL ARR[100000,100000]\nARR[0,0]=REP(1)\nM30\n")
+    rc, out, _ = run("lint", f.name, cwd=tmp_path)
+    assert rc == 1 and located(out, "NC109", "a.mpf", 1)
+
+
+# --------------------------------------------------------------------------- stacked signs (5)
+
+@pytest.mark.parametrize("block, column", [
+    ("G0 X1--+5", 6), ("G0 X1+-+5", 6), ("#1=1--+5", 5), ("G0 X[1--+5]", 7), ("G0 X1--5", 6),
+    ("G0 X--5", 5), ("G1 X1 Y2 F++100", 11),
+])
+def test_stacked_signs_are_located_syntax_errors(tmp_path, block, column):
+    f = write(tmp_path, "s.nc", f"{block}\nM30\n")
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 1 and located(out, "NC002", "s.nc", 1, column), out
+    rc, _, err = run("convert", f.name, "--from", "iso-m", "--to", "sinumerik", cwd=tmp_path)
+    assert rc == 1 and "not converted" in err
+
+
+def test_one_sign_and_bracketed_negation_stay_valid(tmp_path):
+    f = write(tmp_path, "ok.nc", "#1=1-[-5]\nG0 X-5 Y+2\nG0 X#1\nM30\n")
+    rc, out, _ = run("toolpath", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 0 and '"X":-5.0' in out and '"X":6.0' in out
+
+
+# --------------------------------------------------------------------------- nesting (6)
+
+def test_five_hundred_nested_sinumerik_parentheses(tmp_path):
+    f = write(tmp_path, "p.mpf", "R1=" + "(" * 500 + "1" + ")" * 500 + "\nG0 X=R1\nM30\n")
+    rc, out, _ = run("lint", f.name, cwd=tmp_path)
+    assert rc == 1 and located(out, "NC008", "p.mpf", 1)
+
+
+def test_long_operator_chain(tmp_path):
+    f = write(tmp_path, "c.nc", "#1=" + "+".join(["1"] * 5000) + "\nG0 X#1\nM30\n")
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 1 and located(out, "NC008", "c.nc", 1)
+
+
+@pytest.mark.parametrize("opener, closer", [("IF R1==0", "ENDIF"), ("WHILE R1<1", "ENDWHILE"),
+                                            ("LOOP", "ENDLOOP"), ("FOR R2=1 TO 2", "ENDFOR")])
+def test_ten_thousand_nested_sinumerik_structures(tmp_path, opener, closer):
+    text = "\n".join([opener] * 10000) + "\nG0 X1\n" + "\n".join([closer] * 10000) + "\nM30\n"
+    f = write(tmp_path, "n.mpf", text)
+    rc, out, _ = run("lint", f.name, cwd=tmp_path)
+    assert rc == 1 and located(out, "NC008", "n.mpf", 17)     # the 17th level
+
+
+def test_ten_thousand_nested_iso_loops(tmp_path):
+    """Fanuc allows three nested DO levels: the fourth is the error, at its own line."""
+    n = 10000
+    text = ("\n".join(f"WHILE [#1 LT 1] DO{1 + i % 3}" for i in range(n)) + "\nG0 X1\n"
+            + "\n".join(f"END{1 + i % 3}" for i in reversed(range(n))) + "\nM30\n")
+    f = write(tmp_path, "n.nc", text)
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 1 and located(out, "NC008", "n.nc", 4)
+
+
+def test_three_nested_iso_loops_are_fine(tmp_path):
+    text = ("#1=0\nWHILE [#1 LT 2] DO1\n#2=0\nWHILE [#2 LT 2] DO2\n#3=0\nWHILE [#3 LT 2] DO3\n"
+            "G91 G0 X1\n#3=#3+1\nEND3\n#2=#2+1\nEND2\n#1=#1+1\nEND1\nM30\n")
+    f = write(tmp_path, "ok.nc", text)
+    rc, out, err = run("toolpath", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 0 and out.count('"rapid"') == 8, err
+
+
+# --------------------------------------------------------------------------- infinity (7)
+
+@pytest.mark.parametrize("name, text, rule, line", [
+    ("big.nc", "G0 X1" + "0" * 400 + "\nM30\n", "NC108", 1),
+    ("big2.nc", "G1 X1 F1" + "0" * 400 + "\nM30\n", "NC108", 1),
+    ("over.nc", "#1=9" + "9" * 300 + "\n#2=#1*#1\nG0 X#2\nM30\n", "NC108", 3),
+    ("nan.nc", "#1=9" + "9" * 300 + "\n#2=#1*#1-#1*#1\nG0 Y#2\nM30\n", "NC108", 3),
+    ("inc.nc", "#1=9" + "9" * 307 + "\nG91 G0 X#1\nG0 X#1\nG0 X#1\nM30\n", "NC108", 3),
+    ("ex.mpf", "G0 X1EX400\nM30\n", "NC108", 1),
+    ("ex2.mpf", "R1=1EX400\nG0 X=R1\nM30\n", "NC108", 1),
+    ("e.mpf", "G0 Y=1E400\nM30\n", "NC002", 1),
+    ("big.mpf", "G0 X1" + "0" * 400 + "\nM30\n", "NC108", 1),
+    ("mul.mpf", "R1=1EX300\nR2=R1*R1\nG0 X=R2\nM30\n", "NC108", 3),
+])
+def test_non_finite_values_are_errors_and_never_reach_a_record(tmp_path, name, text, rule, line):
+    f = write(tmp_path, name, text)
+    dialect = "sinumerik" if name.endswith(".mpf") else "iso-m"
+    rc, out, err = run("toolpath", f.name, "--from", dialect, cwd=tmp_path)
+    assert rc == 1 and located(err, rule, name, line), err
+    assert not re.search(r"null|Infinity|NaN|:-?inf", out), out
+    rc, out, err = run("convert", f.name, "--from", dialect, "--to",
+                       "iso-m" if dialect == "sinumerik" else "sinumerik", "--flatten", cwd=tmp_path)
+    assert rc == 1 and out == ""
+
+
+def test_sinumerik_exponent_still_reads(tmp_path):
+    f = write(tmp_path, "ok.mpf", "R1=1.5EX2\nG0 X=R1\nM30\n")
+    rc, out, _ = run("toolpath", f.name, cwd=tmp_path)
+    assert rc == 0 and '"X":150.0' in out
