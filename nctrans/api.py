@@ -21,7 +21,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterable, Iterator, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Optional, Sequence, Union
 
 from nctrans import pipeline
 from nctrans import linting
@@ -213,20 +213,32 @@ class Conversion:
 def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, write: str = DEFAULT_DIALECT, *,
               flatten: bool = False, strict: bool = False, machine: MachineLike = None,
               search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
-              error_level: ErrorLevel = ErrorLevel.IGNORE) -> Conversion:
+              error_level: ErrorLevel = ErrorLevel.IGNORE, out: Any = None) -> Conversion:
     """Convert a program from dialect `read` (detected when None) to dialect `write`.
 
     Constructs the target cannot express are lowered (NC401 infos, listed in `.lowered`) or the
     conversion is refused (`.text` is None, NC402 errors say why). `flatten` writes plain motion
     only; `strict` refuses every lowering; `machine` (used by flattening) is a Machine or a path to
-    MACHINE.toml; `search_path` lists directories for called subprograms."""
+    MACHINE.toml; `search_path` lists directories for called subprograms.
+
+    `out` (an object with write(str) and reset(), such as nctrans.outfile.OutputFile): the text is
+    handed to it as it is produced instead of returned (`.text` is then "" on success), and a
+    program that runs straight through is converted as it is parsed, so memory stays flat however
+    long it is. On refusal what was written must be discarded (reset() or OutputFile.discard())."""
     _check_dialect(write)
     with _search_path(search_path):
-        ld = _load(text, read, file=file)
+        ld = _load(text, read, file=file, stream=out is not None and not flatten)
         with _api_errors():
             target = pipeline.get_dialect(write)
+        if ld.streamed is not None:
+            streamed = _transpile_stream(ld, target, strict, out)
+            if streamed is not None:
+                _raise_on_errors(streamed.diagnostics, error_level)
+                return streamed
+            out.reset()                  # convert the whole program: parse it whole
+            ld = pipeline.load_source(ld.source, ld.path, ld.dialect)
         diags = ld.diagnostics
-        out: Optional[str] = None
+        out_text: Optional[str] = None
         if ld.program is not None and not any(d.severity == "error" for d in diags):
             from nctrans.convert import convert
             program = ld.program
@@ -240,14 +252,34 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
 
             result = convert(program, target, flatten=flatten, strict_mode=strict, flatten_with=flatten_with)
             diags.extend(result.diagnostics)
-            out = result.text
+            out_text = result.text
         elif strict:
             from nctrans.convert import strict as _strict
             diags[:] = _strict(diags)
         if any(d.severity == "error" for d in diags):
-            out = None
+            out_text = None
     _raise_on_errors(diags, error_level)
-    return Conversion(out, diags, ld.dialect or "", write)
+    if out is not None and out_text is not None:
+        out.write(out_text)
+        out_text = ""
+    return Conversion(out_text, diags, ld.dialect or "", write)
+
+
+def _transpile_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any) -> Optional[Conversion]:
+    """A streamed parse converted as it is read (convert_stream), or None when the whole program
+    must be converted instead (the target does not stream, or a construct it refused may still be
+    lowered to plain motion)."""
+    from nctrans.convert import convert_stream
+    result = convert_stream(ld.program, target, out.write, strict_mode=strict)
+    if result is None:
+        return None
+    pipeline.finish_stream(ld)
+    diags = ld.diagnostics
+    if result.retry_whole and not any(d.severity == "error" for d in diags):
+        return None
+    diags.extend(result.diagnostics)
+    text = None if result.text is None or any(d.severity == "error" for d in diags) else ""
+    return Conversion(text, diags, ld.dialect or "", target.name)
 
 
 # --------------------------------------------------------------------------- toolpath

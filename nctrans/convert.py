@@ -26,6 +26,8 @@ class Conversion:
     text: Optional[str]                 # None when the conversion was refused
     diagnostics: list[Diagnostic] = field(default_factory=list)
     flattened: bool = False
+    # convert_stream: refused for a construct that lowering the whole program may still carry
+    retry_whole: bool = False
 
 
 def _is_refusal(d: Diagnostic) -> bool:
@@ -112,3 +114,52 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
         diags = strict(diags)
     refused = any(d.severity == "error" for d in diags)
     return Conversion(None if refused else result.text, diags, flattened)
+
+
+# Blocks handed to a streaming emitter at a time: large enough that per-chunk costs vanish,
+# small enough that memory stays flat (~2 KiB of IR per block).
+STREAM_CHUNK = 4096
+
+
+def stream_chunks(body, size: int = STREAM_CHUNK):
+    """Lists of at most `size` Blocks from a streamed body; a PlainRun (a lazy run of plain
+    blocks) is taken apart `size` blocks at a time, never expanded whole."""
+    from nctrans.plainrun import PlainRun
+    batch: list = []
+    for node in body:
+        if type(node) is PlainRun:
+            run = node
+            while run is not None:
+                blocks, run = run.take(size - len(batch))
+                batch.extend(blocks)
+                if len(batch) >= size:
+                    yield batch
+                    batch = []
+            continue
+        batch.append(node)
+        if len(batch) >= size:
+            yield batch
+            batch = []
+    if batch:
+        yield batch
+
+
+def convert_stream(program: Program, target: Dialect, write: Callable[[str], None], *,
+                   strict_mode: bool = False) -> Optional[Conversion]:
+    """convert() for a program whose body is a streamed parse (it runs straight through): the
+    target's text goes to `write` as it is produced, so memory stays flat however long the
+    program. None when the target cannot stream (or must lower the program first): convert the
+    whole program instead. A Conversion whose text is None was refused (discard what was written);
+    `retry_whole` then says a refusal (NC402) might still be lowered to plain motion by converting
+    the whole program. Text, when not refused, is "" (everything was written)."""
+    if target.lowering_passes:
+        return None
+    found = target.emit_stream(program, stream_chunks(program.body), write)
+    if found is None:
+        return None
+    refusals = [d for d in found if _is_refusal(d)]
+    diags = strict(found) if strict_mode else list(found)
+    if refusals and not strict_mode:
+        return Conversion(None, diags, retry_whole=True)
+    refused = any(d.severity == "error" for d in diags)
+    return Conversion(None if refused else "", diags)

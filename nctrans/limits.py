@@ -12,9 +12,10 @@ import math
 import re
 from typing import Optional
 
-# Largest input file read (bytes). Five-axis mould programs run to tens of millions of blocks:
-# 2 GiB holds ~80 M blocks. Larger inputs are refused with exit 2 before anything is read.
-MAX_INPUT_BYTES = 2 * 1024 ** 3
+# Largest input read (bytes): 512 MiB holds ~20 M CAM blocks. The text is held in memory once
+# (streamed commands then keep memory flat beyond it), so the limit bounds memory too. Larger
+# inputs are refused with exit 2 before they are read; NCTRANS_MAX_INPUT_BYTES raises the limit.
+MAX_INPUT_BYTES = 512 * 1024 ** 2
 
 # Bracket / parenthesis nesting inside one block (Fanuc allows 5 levels of [ ]; the limit here
 # leaves room for generated Sinumerik expressions and still keeps every recursive walk shallow).

@@ -71,7 +71,7 @@ def _wrong_dialect(src: _source.SourceText, dialect: str, guess: _detect.Guess) 
                       src.file, line, col, line, col + max(len(text), 1))
 
 
-_DETECT_HEAD = 64 * 1024
+DETECT_HEAD = 64 * 1024
 # With --from given, detection only backs the NC005 check (a file that is wholly another
 # dialect): its first ~150 lines show that as well, and the marker scan costs ~1.5 ms per KiB
 # (16 KiB took 25 ms, a tenth of a streamed toolpath run of a 22k-line CAM file).
@@ -92,7 +92,7 @@ def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Opt
         dialect = _pragma_dialect(src) or fallback
     # The head of a file tells its dialect; scanning a whole 20k-line CAM file would cost more
     # than parsing it.
-    head = src.text[:_DETECT_HEAD if dialect is None else _CHECK_HEAD]
+    head = src.text[:DETECT_HEAD if dialect is None else _CHECK_HEAD]
     guess = _detect.detect(head, None if path == _source.STDIN else path)
     if dialect is None:
         if guess.ambiguous:
@@ -130,6 +130,12 @@ def _finish_stream(ld: Loaded, run_diags: list[Diagnostic]) -> None:
     ld.program.body.drain()
     _add_parse_diagnostics(ld.diagnostics, parsed, ld.source, ld.dialect, ld.guess)
     ld.diagnostics.extend(run_diags)
+
+
+def finish_stream(ld: Loaded) -> None:
+    """After a streamed parse was iterated by something other than the interpreter (a streamed
+    conversion): complete and order its diagnostics."""
+    _finish_stream(ld, [])
 
 
 def load(path: str, dialect: Optional[str] = None, stream: bool = False,
@@ -352,6 +358,8 @@ def iter_inputs(paths: Iterable[str]) -> Iterator[str]:
                 dirs[:] = sorted(d for d in dirs if not d.startswith("."))
                 for f in sorted(files):
                     if not f.startswith(".") and Path(f).suffix.lower() in exts:
-                        yield os.path.join(root, f)
+                        full = os.path.join(root, f)
+                        if _source.is_regular_file(full):   # never a FIFO or device in a walk
+                            yield full
         else:
             yield p

@@ -10,12 +10,15 @@ diagnostic with empty text. Files are only read, never written.
 from __future__ import annotations
 
 import bisect
+import os
 import re
+import stat
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
 
+from nctrans import limits
 from nctrans.diagnostics import Diagnostic
 
 STDIN = "-"
@@ -188,13 +191,54 @@ def from_text(text: str, file: str = STDIN_LABEL, encoding: str = "utf-8") -> So
     return src
 
 
-def read_bytes(path: str | Path) -> bytes:
-    """The file's bytes ('-' = standard input); SourceError with a readable message otherwise."""
+def is_regular_file(path: str | Path) -> bool:
+    """A regular file (through symlinks): what a directory walk takes."""
+    try:
+        return stat.S_ISREG(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+def _too_large(path: str, size: int) -> SourceError:
+    return SourceError(f"{path}: {size} bytes is more than the {limits.MAX_INPUT_BYTES} bytes "
+                       "nctrans reads (README \"Limits\"; NCTRANS_MAX_INPUT_BYTES raises it)")
+
+
+def max_input_bytes() -> int:
+    """The input size limit: limits.MAX_INPUT_BYTES, or NCTRANS_MAX_INPUT_BYTES when set."""
+    env = os.environ.get("NCTRANS_MAX_INPUT_BYTES", "")
+    return int(env) if env.isdigit() else limits.MAX_INPUT_BYTES
+
+
+def read_bytes(path: str | Path, limit: Optional[int] = None) -> bytes:
+    """The file's bytes ('-' = standard input); SourceError with a readable message otherwise.
+    Only regular files are read (a FIFO or device given by name is refused: it may never end),
+    and none larger than the input limit. `limit`: read at most this many bytes (a head)."""
+    cap = max_input_bytes()
     if str(path) == STDIN:
-        return sys.stdin.buffer.read()
+        data = sys.stdin.buffer.read(cap + 1 if limit is None else limit)
+        if limit is None and len(data) > cap:
+            raise _too_large("<stdin>", len(data))
+        return data
     p = Path(path)
     try:
-        return p.read_bytes()
+        with open(p, "rb", opener=_open_nonblocking) as fh:
+            st = os.fstat(fh.fileno())
+            if stat.S_ISDIR(st.st_mode):
+                raise IsADirectoryError
+            if not stat.S_ISREG(st.st_mode):
+                kind = "a FIFO" if stat.S_ISFIFO(st.st_mode) else (
+                    "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "not a file")
+                raise SourceError(f"{path}: is {kind}, not a regular file: nctrans reads program files "
+                                  "(use '-' to read a stream from standard input)")
+            if limit is not None:
+                return fh.read(limit)
+            if st.st_size > cap:
+                raise _too_large(str(path), st.st_size)
+            data = fh.read(cap + 1)
+            if len(data) > cap:
+                raise _too_large(str(path), len(data))
+            return data
     except FileNotFoundError:
         raise SourceError(f"{path}: no such file") from None
     except IsADirectoryError:
@@ -205,6 +249,12 @@ def read_bytes(path: str | Path) -> bytes:
         raise SourceError(f"{path}: cannot read: {e.strerror or e}") from None
 
 
+def _open_nonblocking(path, flags: int) -> int:
+    """Open without blocking: opening a FIFO with no writer would otherwise hang before fstat
+    can refuse it."""
+    return os.open(path, flags | getattr(os, "O_NONBLOCK", 0))
+
+
 def label_for(path: str | Path) -> str:
     """The name diagnostics use for a path ('<stdin>' for '-')."""
     return STDIN_LABEL if str(path) == STDIN else str(path)
@@ -213,3 +263,14 @@ def label_for(path: str | Path) -> str:
 def read_source(path: str | Path) -> SourceText:
     """Read and decode one program file ('-' = stdin). Raises SourceError only if it cannot be read."""
     return decode(read_bytes(path), label_for(path))
+
+
+def read_head(path: str | Path, size: int) -> SourceText:
+    """The first `size` bytes of a program, decoded, cut after their last whole line: what
+    detection needs, without reading a whole (or endless) input."""
+    data = read_bytes(path, limit=size)
+    if len(data) == size:
+        cut = data.rfind(b"\n")
+        if cut > 0:
+            data = data[:cut + 1]
+    return decode(data, label_for(path))

@@ -60,7 +60,9 @@ pos_int = st.integers(1, 99).map(str)
 var = st.sampled_from(["#1", "#24", "#100", "#500", "#[#1+1]"])
 atom = st.one_of(num, var)
 expr = st.recursive(atom, lambda e: st.one_of(
-    st.tuples(e, st.sampled_from(["+", "-", "*", "/", "OR", "AND"]), e).map(lambda t: f"[{t[0]}{t[1]}{t[2]}]"),
+    # a negative right operand is bracketed: two signs in a row (`1--5`) are an NC002 error
+    st.tuples(e, st.sampled_from(["+", "-", "*", "/", "OR", "AND"]), e).map(
+        lambda t: f"[{t[0]}{t[1]}{f'[{t[2]}]' if t[2].startswith('-') else t[2]}]"),
     st.tuples(st.sampled_from(["SIN", "COS", "SQRT", "ABS", "FIX", "FUP", "ROUND"]), e).map(lambda t: f"{t[0]}[{t[1]}]"),
     st.tuples(e, e).map(lambda t: f"ATAN[{t[0]}]/[{t[1]}]"),
 ), max_leaves=4)

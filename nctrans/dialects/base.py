@@ -111,6 +111,13 @@ class Dialect:
     def emit(self, program: Program) -> EmitResult:
         raise NotImplementedError(f"dialect {self.name} has no emitter")
 
+    def emit_stream(self, program: Program, chunks, write) -> Optional[list[Diagnostic]]:
+        """Emit a program that runs straight through, its body given as `chunks` (lists of Blocks
+        from a streamed parse), handing the text to `write` as it is produced: emit()'s text and
+        diagnostics without holding either whole. None when this dialect does not stream its
+        output (the caller then emits the whole program)."""
+        return None
+
     def parse_stream(self, text: str, file: str = "<stdin>") -> Optional[ParseResult]:
         """A lazy parse whose Program.body parses as it is iterated, or None when the text needs the
         whole IR (control flow, subprograms). Only called when `streams` is True."""

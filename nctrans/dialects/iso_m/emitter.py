@@ -95,12 +95,16 @@ def _expr(e: Any, ctx) -> tuple[str, int]:
         sym, prec = _OPS[op]
         lt, lp = _expr(e.left, ctx)
         rt, rp = _expr(e.right, ctx)
+        if rt[:1] in "+-" and sym in "+-":
+            rp = 0                          # `1--5` is two signs in a row (NC002): 1-[-5]
         if prec == 1:
             return f"{_wrap(lt, lp, 2)}{sym}{_wrap(rt, rp, 2)}", 1
         return f"{_wrap(lt, lp, prec)}{sym}{_wrap(rt, rp, prec + 1)}", prec
     if t is n.Unary:
         if e.op in ("-", "+"):
             ot, op_ = _expr(e.operand, ctx)
+            if ot[:1] in "+-":
+                op_ = 0                     # -[-5], never --5
             return f"{e.op}{_wrap(ot, op_, 4)}", 4
         if e.op == "not":
             ot, op_ = _expr(e.operand, ctx)

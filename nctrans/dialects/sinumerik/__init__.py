@@ -76,3 +76,7 @@ class Sinumerik(Dialect):
 
     def emit(self, program) -> EmitResult:
         return _emit(program)
+
+    def emit_stream(self, program, chunks, write):
+        from nctrans.dialects.sinumerik.emitter import emit_stream
+        return emit_stream(program, chunks, write)

@@ -777,18 +777,34 @@ class Emitter:
                 if group == "motion":
                     self.st.motion = value
         if codes:
+            self.span = ir.Span(self.p.file, 1)      # the note belongs to the program's file
             self.info("defaults", f"power-on modes of {self.p.dialect} written out: {' '.join(codes)}")
             self.lines.append(" ".join(codes))
 
     def program(self) -> str:
-        p = self.p
-        meta = p.meta or {}
+        self.head()
+        self.unit(self.p.body)
+        self.subprograms()
+        return "\n".join(self.lines) + "\n"
+
+    def head(self) -> None:
+        """What comes before the main body: archive header, path, power-on modes."""
+        meta = self.p.meta or {}
         if meta.get("header"):
             self.lines.append(f"%{meta['header']}")
         if meta.get("path"):
             self.lines.append(f";$PATH={meta['path']}")
         self.prologue(meta.get("defaults") or {})
-        self.unit(p.body)
+
+    def flush(self, write) -> None:
+        """Hand the lines written so far to `write` (a streamed conversion) and forget them."""
+        if self.lines:
+            write("\n".join(self.lines) + "\n")
+            self.lines.clear()
+
+    def subprograms(self) -> None:
+        p = self.p
+        meta = p.meta or {}
         entry = meta.get("entry")
         headers = meta.get("unit_headers", {})
         for name, sub in p.subprograms.items():
@@ -809,7 +825,6 @@ class Emitter:
                 self.lines.append(head)
             self.st = _State()
             self.unit(sub.body)
-        return "\n".join(self.lines) + "\n"
 
 
 def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
@@ -869,6 +884,28 @@ class _Line:
         if self.words:
             self.done.append(" ".join(self.words))
         return self.done
+
+
+def emit_stream(program: ir.Program, chunks, write) -> list[Diagnostic]:
+    """emit() for a program that runs straight through and arrives as lists of blocks (a streamed
+    parse; program.body is not read): the same text, handed to `write` chunk by chunk, so a
+    conversion's memory does not grow with the program."""
+    import copy
+    shell = copy.copy(program)
+    shell.body = []              # the emitter's look-ahead (jump targets) must not drain the stream
+    e = Emitter(shell)
+    chunks = iter(chunks)
+    first = next(chunks, None)  # a streamed parse fills program.meta (defaults) as it starts
+    e.head()
+    for chunk in ([first] if first is not None else []):
+        e.unit(chunk)
+        e.flush(write)
+    for chunk in chunks:
+        e.unit(chunk)
+        e.flush(write)
+    e.subprograms()
+    e.flush(write)
+    return e.diags
 
 
 def emit(program: ir.Program) -> EmitResult:
