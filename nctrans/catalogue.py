@@ -50,6 +50,9 @@ class Rule(BaseModel):
     example_files: dict[str, str] = {}
     example_machine: Optional[str] = None
     example_encoding: str = "utf-8"
+    # environment the examples run with: limits lowered (NCTRANS_MAX_DIAGNOSTICS=2) so an example
+    # of a limit stays a few lines long
+    example_env: dict[str, str] = {}
     # A rule kept for its stable code that no dialect reports yet: why. Its test then requires
     # that the bad example does NOT fire, so the day it does, the entry must be completed.
     reserved: Optional[str] = None

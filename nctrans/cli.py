@@ -662,10 +662,26 @@ def _main(argv: Optional[list[str]]) -> int:
         return EXIT_USAGE
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so the same unwinding removes temporary output files."""
+
+
+def _on_sigterm(signum, frame) -> None:
+    raise _Terminated()
+
+
 def main(argv: Optional[list[str]] = None) -> int:
     """Entry point: never lets a traceback out (unless NCTRANS_DEBUG=1)."""
+    import signal
+    import threading
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
         return _main(argv)
+    except _Terminated:
+        _err("terminated")
+        return 128 + 15
     except KeyboardInterrupt:
         _err("interrupted")
         return EXIT_USAGE
@@ -682,6 +698,9 @@ def main(argv: Optional[list[str]] = None) -> int:
     except Exception as e:
         _internal("", e)
         return EXIT_USAGE
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

@@ -57,6 +57,61 @@ def at_span(rule: str, severity: str, message: str, span) -> Diagnostic:
                       span.end_line or span.line, span.end_col or span.col + 1)
 
 
+# Diagnostics kept per list (one file's parse or run; NCTRANS_MAX_DIAGNOSTICS overrides it).
+MAX_PER_FILE = 1000
+
+
+class DiagnosticList(list):
+    """A list of one file's diagnostics that stays small whatever the input: one diagnostic per
+    block (line) and rule, the first found (its column and message), counting the rest ("(+3 more
+    in this block)"); past MAX_PER_FILE of those the rest are only counted, in one closing NC009
+    note. A 5 MB line of repeated X words gives one NC201, not 1.75 M of them."""
+
+    def __init__(self, items=(), limit: Optional[int] = None):
+        super().__init__()
+        if limit is None:
+            from nctrans.limits import setting
+            limit = setting("MAX_DIAGNOSTICS", MAX_PER_FILE)
+        self.limit = limit
+        self._seen: dict[tuple, list] = {}       # place -> [diagnostic, first message, count]
+        self._dropped = 0
+        self._note: Optional[Diagnostic] = None
+        self.extend(items)
+
+    def append(self, d: Diagnostic) -> None:
+        key = (d.rule, d.file, d.line)
+        seen = self._seen.get(key)
+        if seen is not None:
+            seen[2] += 1
+            seen[0].message = f"{seen[1]} (+{seen[2] - 1} more in this block)"
+            return
+        if len(self._seen) >= self.limit:
+            self._drop(1, d)
+            return
+        self._seen[key] = [d, d.message, 1]
+        super().append(d)
+
+    def _drop(self, count: int, d: Diagnostic) -> None:
+        self._dropped += count
+        if self._note is None:
+            self._note = Diagnostic("NC009", "info", "", d.file, d.line, d.column)
+            super().append(self._note)
+        self._note.message = (f"{self._dropped} more diagnostics in this file not listed "
+                              f"(at most {self.limit} are reported per file)")
+
+    def extend(self, ds) -> None:
+        note = getattr(ds, "_note", None)
+        for d in ds:
+            if d is not note:
+                self.append(d)
+        if note is not None:                 # another capped list: carry its count over
+            self._drop(ds._dropped, note)
+
+    def __iadd__(self, ds):
+        self.extend(ds)
+        return self
+
+
 @dataclass
 class Report:
     """Collects diagnostics for one run; `worst()` drives the exit code."""

@@ -9,6 +9,7 @@ program and only stop runaway input.
 from __future__ import annotations
 
 import math
+import os
 import re
 from typing import Optional
 
@@ -16,6 +17,11 @@ from typing import Optional
 # (streamed commands then keep memory flat beyond it), so the limit bounds memory too. Larger
 # inputs are refused with exit 2 before they are read; NCTRANS_MAX_INPUT_BYTES raises the limit.
 MAX_INPUT_BYTES = 512 * 1024 ** 2
+
+# Characters in one block (line). Controllers read a few hundred (the longest line in the shared
+# corpus has 619); a longer one is an NC010 error and is not analysed, so one line of many MB
+# cannot turn into millions of words. NCTRANS_MAX_BLOCK_CHARS overrides it.
+MAX_BLOCK_CHARS = 64 * 1024
 
 # Bracket / parenthesis nesting inside one block (Fanuc allows 5 levels of [ ]; the limit here
 # leaves room for generated Sinumerik expressions and still keeps every recursive walk shallow).
@@ -35,8 +41,13 @@ MAX_STRING = 200
 # Elements of one declared array (DEF REAL A[n,m]): REP() and SET() walk them all.
 MAX_ARRAY_ELEMENTS = 1_000_000
 
-# Diagnostics kept per file; past it one closing NC009 note says how many more there were.
-MAX_DIAGNOSTICS_PER_FILE = 1000
+
+def setting(name: str, default: int) -> int:
+    """A limit from the environment (NCTRANS_<NAME>, a whole number), else `default`: for a shop
+    whose programs need more, and for the catalogue's examples, which need less."""
+    env = os.environ.get(f"NCTRANS_{name}", "")
+    return int(env) if env.isdigit() else default
+
 
 _OPERATOR_CHARS = re.compile(r"[-+*/<>=]|\b(?:AND|OR|XOR|MOD|NOT|B_AND|B_OR|B_XOR|B_NOT|DIV)\b",
                              re.IGNORECASE)

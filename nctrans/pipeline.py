@@ -15,7 +15,7 @@ from typing import Callable, Iterable, Iterator, Optional
 
 from nctrans import detection as _detect
 from nctrans import source as _source
-from nctrans.diagnostics import Diagnostic
+from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.dialects import base
 from nctrans.ir.nodes import Program
 from nctrans.machine import Machine, MachineError, default_lathe, default_mill
@@ -85,7 +85,7 @@ def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Opt
     diagnostics. With `stream` the parse may be lazy (Dialect.streams): the program must then be
     run exactly once, through toolpath_of or lint, which complete the diagnostics."""
     label = src.file
-    diags = list(src.diagnostics)
+    diags = DiagnosticList(src.diagnostics)
     if not src.ok:
         return Loaded(path, label, src, dialect, None, diags)
     if dialect is None:
@@ -317,7 +317,7 @@ STREAM_GC_THRESHOLD = 100_000
 
 def _streamed_toolpath(ld: Loaded, machine: Optional[Machine],
                        fast_sink: Optional[str]) -> Iterator[ToolpathRecord]:
-    run_diags: list[Diagnostic] = []
+    run_diags: list[Diagnostic] = DiagnosticList()
     thresholds = gc.get_threshold()
     gc.set_threshold(max(thresholds[0], STREAM_GC_THRESHOLD), *thresholds[1:])
     try:

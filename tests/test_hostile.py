@@ -56,7 +56,7 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
     # doubling a declared STRING forty times: ~1 TB of text without a cap
     ("DEF STRING[200] TXT\nDEF INT I\nTXT=\"AB\"\nFOR I=1 TO 40\nTXT=TXT<<TXT\nENDFOR\nG0 X1\nM30\n", 5),
     # an undeclared growth: concatenation into an R parameter-free string expression in a loop
-    ("DEF STRING[10] TXT\nDEF INT I\nFOR I=1 TO 1000000\nTXT=TXT<<\"ABCDEFGHIJ\"\nENDFOR\nM30\n", 4),
+    ("DEF STRING[10] TXT\nDEF INT I\nFOR I=1 TO 10000\nTXT=TXT<<\"ABCDEFGHIJ\"\nENDFOR\nM30\n", 4),
     ("DEF STRING[5] TXT\nTXT=\"ABCDEFGH\"\nM30\n", 2),
 ])
 def test_string_growth_is_capped_with_nc109(tmp_path, program, line):
@@ -115,19 +115,20 @@ def test_long_operator_chain(tmp_path):
     assert rc == 1 and located(out, "NC008", "c.nc", 1)
 
 
-@pytest.mark.parametrize("opener, closer", [("IF R1==0", "ENDIF"), ("WHILE R1<1", "ENDWHILE"),
-                                            ("LOOP", "ENDLOOP"), ("FOR R2=1 TO 2", "ENDFOR")])
+@pytest.mark.parametrize("opener, closer", [("IF R1==0", "ENDIF"), ("WHILE R1>1", "ENDWHILE"),
+                                            ("REPEAT", "UNTIL R1==0"), ("FOR R2=1 TO 1", "ENDFOR")])
 def test_ten_thousand_nested_sinumerik_structures(tmp_path, opener, closer):
     text = "\n".join([opener] * 10000) + "\nG0 X1\n" + "\n".join([closer] * 10000) + "\nM30\n"
     f = write(tmp_path, "n.mpf", text)
     rc, out, _ = run("lint", f.name, cwd=tmp_path)
     assert rc == 1 and located(out, "NC008", "n.mpf", 17)     # the 17th level
+    assert "NC205" not in out
 
 
 def test_ten_thousand_nested_iso_loops(tmp_path):
     """Fanuc allows three nested DO levels: the fourth is the error, at its own line."""
     n = 10000
-    text = ("\n".join(f"WHILE [#1 LT 1] DO{1 + i % 3}" for i in range(n)) + "\nG0 X1\n"
+    text = ("\n".join(f"WHILE [#1 GT 1] DO{1 + i % 3}" for i in range(n)) + "\nG0 X1\n"
             + "\n".join(f"END{1 + i % 3}" for i in reversed(range(n))) + "\nM30\n")
     f = write(tmp_path, "n.nc", text)
     rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
@@ -171,3 +172,158 @@ def test_sinumerik_exponent_still_reads(tmp_path):
     f = write(tmp_path, "ok.mpf", "R1=1.5EX2\nG0 X=R1\nM30\n")
     rc, out, _ = run("toolpath", f.name, cwd=tmp_path)
     assert rc == 0 and '"X":150.0' in out
+
+
+# --------------------------------------------------------------------------- floods (2)
+
+def test_one_huge_line_is_one_located_error(tmp_path):
+    """A 5 MB line of repeated X1 words: one NC010, not 1.75 M warnings; SARIF stays small."""
+    f = tmp_path / "flood.nc"
+    f.write_text("G1 F100 " + "X1" * (5 * 1024 * 1024 // 2) + "\nM30\n")
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 1 and out.count("\n") == 1 and located(out, "NC010", "flood.nc", 1, 1)
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", "--format", "sarif", cwd=tmp_path)
+    assert rc == 1 and len(out) < 200_000 and out.count('"ruleId"') == 1
+
+
+def test_repeats_in_a_block_are_one_diagnostic_with_a_count_at_the_repeat(tmp_path):
+    f = write(tmp_path, "d.nc", "G1 F100 X1 X2 X3 X4\nM30\n")
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert out.count("NC201") == 1 and located(out, "NC201", "d.nc", 1, 12) and "+2 more" in out
+
+
+def test_diagnostics_per_file_are_capped_with_a_closing_note(tmp_path):
+    f = tmp_path / "many.nc"
+    f.write_text("G1 F100\n" + "G1 X1 X2\n" * 3000 + "M30\n")
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert out.count("[NC201]") == 1000 and "[NC009] 2000 more diagnostics" in out
+
+
+# --------------------------------------------------------------------------- reads (3)
+
+def test_devices_and_fifos_by_name_are_refused(tmp_path):
+    for args in (["lint", "/dev/zero"], ["detect", "/dev/urandom"], ["toolpath", "/dev/zero"],
+                 ["convert", "/dev/zero", "--to", "sinumerik"]):
+        rc, _, err = run(*args, cwd=tmp_path)
+        assert rc == 2 and "not a regular file" in err
+    os.mkfifo(tmp_path / "pipe.nc")
+    rc, _, err = run("lint", "pipe.nc", cwd=tmp_path)
+    assert rc == 2 and "FIFO" in err
+
+
+def test_directory_walks_take_regular_files_only(tmp_path):
+    (tmp_path / "shop").mkdir()
+    os.mkfifo(tmp_path / "shop" / "a-pipe.nc")
+    (tmp_path / "shop" / "part.nc").write_text("G0 X1\nM30\n")
+    rc, out, err = run("lint", "shop", "--from", "iso-m", "--format", "json", cwd=tmp_path)
+    assert rc == 0 and '"files": 1' in out, err
+
+
+def test_input_size_limit(tmp_path):
+    f = write(tmp_path, "p.nc", "G0 X1\n" * 100)
+    rc, _, err = run("lint", f.name, cwd=tmp_path, env={"NCTRANS_MAX_INPUT_BYTES": "100"})
+    assert rc == 2 and "NCTRANS_MAX_INPUT_BYTES" in err
+    rc, _, err = run("lint", "-", "--from", "iso-m", cwd=tmp_path, stdin=b"G0 X1\n" * 100,
+                     env={"NCTRANS_MAX_INPUT_BYTES": "100"})
+    assert rc == 2 and "more than the" in err
+
+
+def test_detect_reads_only_the_head(tmp_path):
+    f = tmp_path / "big.nc"
+    with f.open("w") as fh:
+        fh.write("%\nO1000\nG21 G90\n")
+        fh.write("G1 X1.5 Y2.5 F100\n" * 300_000)
+    rc, out, _ = run("detect", f.name, cwd=tmp_path, env={"NCTRANS_MAX_INPUT_BYTES": "100000"})
+    assert rc == 0 and "iso-m" in out        # the 5 MB file is over the limit: only the head is read
+
+
+# --------------------------------------------------------------------------- writes (4)
+
+def test_convert_writes_through_a_device_and_never_replaces_it(tmp_path):
+    f = write(tmp_path, "p.nc", "G0 X1\nM30\n")
+    before = os.stat("/dev/null")
+    rc, _, err = run("convert", f.name, "--to", "sinumerik", "-o", "/dev/null", cwd=tmp_path)
+    after = os.stat("/dev/null")
+    assert rc == 0, err
+    assert (before.st_ino, before.st_rdev) == (after.st_ino, after.st_rdev)
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_convert_through_a_symlink_writes_its_target(tmp_path):
+    f = write(tmp_path, "p.nc", "G0 X1\nM30\n")
+    (tmp_path / "real.mpf").write_text("old\n")
+    os.symlink("real.mpf", tmp_path / "link.mpf")
+    rc, _, err = run("convert", f.name, "--to", "sinumerik", "-o", "link.mpf", cwd=tmp_path)
+    assert rc == 0, err
+    assert (tmp_path / "link.mpf").is_symlink() and "X1" in (tmp_path / "real.mpf").read_text()
+
+
+def test_out_dir_never_replaces_a_file_that_is_not_an_output(tmp_path):
+    f = write(tmp_path, "p.nc", "G0 X1\nM30\n")
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "p.mpf").write_text("hand-edited\n")
+    rc, _, err = run("convert", f.name, "--to", "sinumerik", "--out-dir", "out", cwd=tmp_path)
+    assert rc == 2 and "--overwrite" in err and (tmp_path / "out" / "p.mpf").read_text() == "hand-edited\n"
+    rc, _, err = run("convert", f.name, "--to", "sinumerik", "--out-dir", "out", "--overwrite", cwd=tmp_path)
+    assert rc == 0 and "X1" in (tmp_path / "out" / "p.mpf").read_text()
+
+
+def test_sigterm_leaves_no_temporary_file(tmp_path):
+    """A long conversion killed with SIGTERM: exit 143, no output, no temporary file."""
+    import signal
+    import time
+    f = tmp_path / "long.nc"
+    f.write_text("G1 F100\n" + "".join(f"G1 X{i % 97}.5 Y{i % 89}.25\n" for i in range(1_000_000)) + "M30\n")
+    p = subprocess.Popen([*NCTRANS, "convert", f.name, "--to", "sinumerik", "-o", "out.mpf"],
+                         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_limits)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not any(x.name.endswith(".tmp") for x in tmp_path.iterdir()):
+        time.sleep(0.05)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 143, (p.returncode, err.decode()[-2000:])
+    assert not (tmp_path / "out.mpf").exists()
+    assert not [x for x in tmp_path.iterdir() if x.name.endswith(".tmp")]
+
+
+# --------------------------------------------------------------------------- scale (8)
+
+def test_long_straight_program_gives_all_its_moves_and_converts_streamed(tmp_path):
+    """3 M straight blocks: every move comes out (the step budget counts repetition only), and the
+    streamed conversion gives the text the whole-program conversion gives."""
+    n = 3_000_000
+    f = tmp_path / "long.nc"
+    with f.open("w") as fh:
+        fh.write("G21 G90 G1 F500\n")
+        for i in range(0, n, 10_000):
+            fh.write("".join(f"X{j % 1000}.5 Y{j % 7}\n" for j in range(i, i + 10_000)))
+        fh.write("M30\n")
+    p = subprocess.Popen([*NCTRANS, "toolpath", f.name, "--from", "iso-m"], cwd=tmp_path,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_limits)
+    lines = sum(1 for _ in p.stdout)
+    err = p.stderr.read().decode()
+    assert p.wait() == 0 and "NC205" not in err, err
+    assert lines == n + 1                     # every move, and the stop
+
+
+def test_streamed_conversion_equals_the_whole_one(tmp_path):
+    from nctrans import api
+    text = "%\nO1\nG21 G90 G17\nT1 M6\nS8000 M3\nG0 X0 Y0 Z5.\nG1 Z-1. F500.\n" + "".join(
+        f"G1 X{i % 97}.5 Y{i % 89}.25\n" + (f"G2 X{i % 97}.5 Y{i % 89}.25 I1. J0\n" if i % 50 == 0 else "")
+        for i in range(9000)) + "M30\n%\n"
+    whole = api.transpile(text, "iso-m", "sinumerik")
+
+    class Sink:
+        def __init__(self):
+            self.parts = []
+
+        def write(self, s):
+            self.parts.append(s)
+
+        def reset(self):
+            self.parts = []
+    sink = Sink()
+    streamed = api.transpile(text, "iso-m", "sinumerik", out=sink)
+    assert streamed.text == "" and len(sink.parts) > 2          # written in several pieces
+    assert "".join(sink.parts) == whole.text
+    assert [d.format_text() for d in streamed.diagnostics] == [d.format_text() for d in whole.diagnostics]

@@ -53,6 +53,8 @@ def _how(rule: catalogue.Rule) -> str:
 @pytest.mark.parametrize("rule", CATALOGUE.rule, ids=lambda r: r.code)
 def test_bad_example_reports_the_rule(rule, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
+    for name, value in rule.example_env.items():      # limits lowered for a short example
+        monkeypatch.setenv(name, value)
     assert rule.bad.strip() or rule.code == "NC004", f"{rule.code} has no failing example (`bad`)"
     codes, output = _run_example(rule, rule.bad, tmp_path, capsys, rule.example_encoding)
     if rule.reserved:
@@ -66,6 +68,8 @@ def test_bad_example_reports_the_rule(rule, tmp_path, capsys, monkeypatch):
 @pytest.mark.parametrize("rule", CATALOGUE.rule, ids=lambda r: r.code)
 def test_good_example_does_not_report_the_rule(rule, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
+    for name, value in rule.example_env.items():      # limits lowered for a short example
+        monkeypatch.setenv(name, value)
     assert rule.good.strip(), f"{rule.code} has no passing example (`good`)"
     codes, output = _run_example(rule, rule.good, tmp_path, capsys)
     assert rule.code not in codes, (f"{rule.code}'s passing example reports {rule.code} ({_how(rule)}).\n"

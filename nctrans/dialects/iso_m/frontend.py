@@ -19,7 +19,7 @@ from operator import itemgetter
 from typing import Any, Optional
 
 from nctrans import limits, plainrun
-from nctrans.diagnostics import Diagnostic
+from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.ir.nodes import (
     Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
     HomeReturn, If, Loop, ModalCallOff, ModeChange, Motion, Num, OffsetSelect, Passthrough,
@@ -139,6 +139,8 @@ class Lowering:
         opts = self.table.options
         self.file = file
         self.diags = diags
+        self.raw = ""                   # the current line, comments blanked (set by the parser)
+        self._dup_line = 0
         self.standard = opts.get("decimal_mode", "pocket") == "standard"
         self.factors = opts.get("standard_factors", {}).get(opts.get("increment_system", "IS-B"), {})
         self.prog8 = bool(opts.get("prog_number_8digit", False))
@@ -567,7 +569,8 @@ class Lowering:
                 number = v
             else:
                 if letter in vals and letter != "N":
-                    self._dup(line, f"address {letter} written twice in the block; the last one counts")
+                    self._dup(line, f"address {letter} written twice in the block; the last one counts",
+                              letter)
                 vals[letter] = v
             first = False
 
@@ -699,8 +702,18 @@ class Lowering:
         d = _digits(v)
         return d if d is not None else _word_text("", v)
 
-    def _dup(self, line: int, message: str) -> None:
-        self.diags.append(Diagnostic("NC201", "warning", message, self.file, line))
+    def _dup(self, line: int, message: str, letter: str = "") -> None:
+        """NC201 at the repeated word: the second occurrence of its address letter in the line
+        (comments blanked), so the report points at what to delete."""
+        col = 1
+        raw = self.raw
+        if letter and raw and line != self._dup_line:     # once per line: lines can be MBs long
+            self._dup_line = line
+            upper = raw.upper()
+            first = upper.find(letter)
+            second = upper.find(letter, first + 1) if first >= 0 else -1
+            col = second + 1 if second >= 0 else 1
+        self.diags.append(Diagnostic("NC201", "warning", message, self.file, line, col))
 
 
 # ---------------------------------------------------------------------- parse
@@ -801,7 +814,7 @@ def parse_program(text: str, file: str = "<stdin>", lowering: type[Lowering] = L
 def _parse_program(text: str, file: str, lowering: type[Lowering]):
     from nctrans.dialects.base import ParseResult
 
-    diags: list[Diagnostic] = []
+    diags: list[Diagnostic] = DiagnosticList()
     program = Program(file, lowering.dialect, [], {}, {}, None)
     for _ in _parse_lines(text, file, program, diags, program.body, False, lowering):
         pass
@@ -864,7 +877,7 @@ def parse_stream(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lo
     Memory then stays bounded by one batch of blocks instead of growing with the file."""
     from nctrans.dialects.base import ParseResult
 
-    diags: list[Diagnostic] = []
+    diags: list[Diagnostic] = DiagnosticList()
     program = Program(file, lowering.dialect, [], {}, {}, None)
     opts = load_table(lowering.table_name).options
     if _control_flow_at(text, opts.get("eob_semicolon", "comment") != "eob") is not None:
@@ -948,7 +961,12 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     hot = low.hot
     _block = Block
     _span = Span
+    max_block = limits.setting("MAX_BLOCK_CHARS", limits.MAX_BLOCK_CHARS)
     for lineno, raw in lines:
+        if len(raw) > max_block:
+            diags.append(Diagnostic("NC010", "error", f"block of {len(raw)} characters: longer than "
+                                    f"the {max_block} nctrans reads; not analysed", file, lineno))
+            continue
         if stream and main:
             main_seen = True
             yield from main
@@ -1101,6 +1119,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                     cur.append(_passthrough_block(raw, span, skip, unknown, low, lineno))
                     comment = None
                     continue
+            low.raw = blanked                   # for the columns of NC201 duplicates
             number, body, structure, unknown = lower(items, lineno)
             if unknown is not None:
                 cur.append(_passthrough_block(raw, span, skip, unknown, low, lineno))

@@ -26,7 +26,7 @@ from lark.exceptions import UnexpectedInput, UnexpectedToken, UnexpectedCharacte
 from lark.lexer import Lexer
 
 from nctrans import limits, resources
-from nctrans.diagnostics import Diagnostic
+from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.dialects.base import ParseResult
 from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
 from nctrans.ir import nodes as ir
@@ -321,7 +321,7 @@ class Lowerer:
 
     def __init__(self, file: str):
         self.file = file
-        self.diags: list[Diagnostic] = []
+        self.diags: list[Diagnostic] = DiagnosticList()
         self.meta: dict = {}
         t = table()
         self.axes = set(t.options.get("axes", []))
@@ -797,8 +797,13 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
     zones: list = []
     seen_code = False
 
+    max_block = limits.setting("MAX_BLOCK_CHARS", limits.MAX_BLOCK_CHARS)
     for n, raw in enumerate(raw_lines, 1):
         unit = units[-1]
+        if len(raw) > max_block:
+            low.error("NC010", f"block of {len(raw)} characters: longer than the {max_block} "
+                      "nctrans reads; not analysed", n, 1)
+            continue
         if not raw.strip():
             continue
         m = _HEADER.match(raw)
