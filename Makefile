@@ -33,7 +33,12 @@ bench: $(STAMP)
 	$(BIN)/python bench/bench_check.py
 	$(BIN)/python bench/bench_backplot.py
 
+# FUZZ_SECONDS: coverage-guided (atheris) time per front end; crashes are kept as regression cases
+# under tests/data/fuzz-crashes (run by tests/test_fuzz_crashes.py in `make test`).
+FUZZ_SECONDS ?= 120
 fuzz: $(STAMP)
+	$(BIN)/pip install --quiet -e '.[fuzz]'
+	$(BIN)/python fuzz/fuzz_frontends.py $(FUZZ_SECONDS)
 	NCTRANS_FUZZ_PROFILE_SET=1 $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 tests/fuzz --hypothesis-profile=fuzz
 
 clean:

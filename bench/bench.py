@@ -9,7 +9,8 @@ for one program and for the same program repeated 10x: the full parse holds the 
 the text) and the interpreter's peak is measured above it; the streamed parse + run + serialisation
 (source text held by the caller) must stay flat. Then lint as users run it (lines/s in-process
 and through the CLI) and the per-file start-up of `nctrans lint` on small ISO and Sinumerik programs.
-Plain-text table; no assertions.
+Last, the peak resident memory of the CLI's `convert` and `equiv` at 1x and 10x the
+program. Plain-text table; no assertions.
 """
 from __future__ import annotations
 
@@ -239,6 +240,8 @@ def main(argv=None) -> int:
             except ValueError:
                 print(f"{label[:40]:40} {'n/a':>7} {'n/a':>11} {'n/a':>12} {'n/a':>14}")
                 notes.append(f"memory: {(proc.stderr.strip().splitlines() or ['?'])[-1]}")
+        print()
+        cli_peaks(paths[0], tmp, notes)
     if STARTUP_PROGRAM.exists():
         t, rc = wall(NCTRANS + ["lint", str(STARTUP_PROGRAM)], args.repeat)
         print()
@@ -286,6 +289,36 @@ def lint_table(paths: list[Path], repeat: int, notes: list[str]) -> None:
         sarif_s, _ = wall(NCTRANS + ["lint", str(path), "--format", "sarif"], repeat)
         print(f"{path.name[:34]:34} {lines:>6} {fmt(text_s * 1000 if text_s else None):>8} "
               f"{fmt(sarif_s * 1000 if sarif_s else None):>9}")
+
+
+def peak_rss(cmd: list[str]) -> tuple[float, float, int]:
+    """(peak resident MiB, wall seconds, exit code) of one CLI run (os.wait4: that child only)."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    return usage.ru_maxrss / 1024, time.perf_counter() - t0, proc.returncode
+
+
+def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
+    """Peak memory of `convert` (ISO -> Sinumerik, streamed) and `equiv` (source against its
+    conversion) at 1x and 10x the program: convert must stay flat, equiv grows with the toolpath."""
+    print("CLI peak memory (max RSS of the process, MiB) and wall time: convert --to sinumerik, "
+          "then equiv source converted")
+    print(f"{'program':40} {'MB':>6} {'convert MiB':>12} {'s':>6} {'equiv MiB':>10} {'s':>6}")
+    text = read_text(base)
+    for times in (1, 10):
+        src = tmp / f"peak-x{times}.nc"
+        src.write_text(repeated(text, times) if times > 1 else text)
+        out = tmp / f"peak-x{times}.mpf"
+        cm, cs, crc = peak_rss(NCTRANS + ["convert", str(src), "--from", "iso-m", "--to", "sinumerik",
+                                          "-o", str(out)])
+        em, es, erc = peak_rss(NCTRANS + ["equiv", str(src), str(out), "--from-a", "iso-m",
+                                          "--from-b", "sinumerik"])
+        if crc >= 2 or erc >= 2:
+            notes.append(f"{src.name}: convert exit {crc}, equiv exit {erc}")
+        label = base.name + (f" x{times}" if times > 1 else "")
+        print(f"{label[:40]:40} {src.stat().st_size / 2**20:>6.1f} {cm:>12.1f} {cs:>6.2f} {em:>10.1f} {es:>6.2f}")
 
 
 if __name__ == "__main__":

@@ -257,6 +257,11 @@ static PyObject *scan(PyObject *self, PyObject *args)
     Text t;
     if (get_text(str, &t) < 0)
         return NULL;
+    /* validated at the boundary: the loops below index the text and tables with these */
+    if (pos < 0 || pos > t.len || motion < MOTION_RAPID || motion > MOTION_OTHER) {
+        PyErr_SetString(PyExc_ValueError, "scan: pos outside the text or motion not a MOTION_* code");
+        return NULL;
+    }
     char buf[MAX_LINE + 1];
     Block b;
     Py_ssize_t p = pos, lines = 0, blocks = 0, blanks = 0;
@@ -466,6 +471,19 @@ static PyObject *run(PyObject *self, PyObject *args)
     Text t;
     if (get_text(str, &t) < 0)
         return NULL;
+    /* validated at the boundary: the loop indexes the text, KIND[] and the tables with these */
+    if (pos < 0 || end < pos || end > t.len || lineno < 0 || max_blocks < 0
+        || motion < MOTION_RAPID || motion > MOTION_OTHER || !(scale > 0.0) || !isfinite(scale)
+        || !(center_tol >= 0.0) || !isfinite(center_tol)) {
+        PyErr_SetString(PyExc_ValueError, "run: pos/end outside the text, or lineno, max_blocks, "
+                        "motion, scale or center_tol out of range");
+        return NULL;
+    }
+    if (plane_len != 0 && !(strcmp(plane, "XY") == 0 || strcmp(plane, "ZX") == 0
+                            || strcmp(plane, "YZ") == 0)) {
+        PyErr_SetString(PyExc_ValueError, "run: plane must be XY, ZX, YZ or empty");
+        return NULL;
+    }
     Py_ssize_t axes_len;
     const char *axes = PyUnicode_AsUTF8AndSize(axes_obj, &axes_len);
     if (axes == NULL)

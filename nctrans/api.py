@@ -270,6 +270,8 @@ def _transpile_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any) 
     must be converted instead (the target does not stream, or a construct it refused may still be
     lowered to plain motion)."""
     from nctrans.convert import convert_stream
+    if ld.program is None:
+        return None
     result = convert_stream(ld.program, target, out.write, strict_mode=strict)
     if result is None:
         return None

@@ -216,10 +216,7 @@ def read_bytes(path: str | Path, limit: Optional[int] = None) -> bytes:
     and none larger than the input limit. `limit`: read at most this many bytes (a head)."""
     cap = max_input_bytes()
     if str(path) == STDIN:
-        data = sys.stdin.buffer.read(cap + 1 if limit is None else limit)
-        if limit is None and len(data) > cap:
-            raise _too_large("<stdin>", len(data))
-        return data
+        return _read_stream(sys.stdin.buffer, "<stdin>", cap, limit)
     p = Path(path)
     try:
         with open(p, "rb", opener=_open_nonblocking) as fh:
@@ -232,11 +229,11 @@ def read_bytes(path: str | Path, limit: Optional[int] = None) -> bytes:
                 raise SourceError(f"{path}: is {kind}, not a regular file: nctrans reads program files "
                                   "(use '-' to read a stream from standard input)")
             if limit is not None:
-                return fh.read(limit)
+                return _read_stream(fh, str(path), cap, limit)
             if st.st_size > cap:
                 raise _too_large(str(path), st.st_size)
-            data = fh.read(cap + 1)
-            if len(data) > cap:
+            data = fh.read()             # a regular file: one buffer of its size
+            if len(data) > cap:          # it grew while being read
                 raise _too_large(str(path), len(data))
             return data
     except FileNotFoundError:
@@ -247,6 +244,23 @@ def read_bytes(path: str | Path, limit: Optional[int] = None) -> bytes:
         raise SourceError(f"{path}: permission denied") from None
     except OSError as e:
         raise SourceError(f"{path}: cannot read: {e.strerror or e}") from None
+
+
+def _read_stream(fh, name: str, cap: int, limit: Optional[int]) -> bytes:
+    """Read to the end in pieces (never one buffer of the limit's size), refusing more than
+    `cap` bytes; with `limit`, only the first `limit` bytes."""
+    want = cap + 1 if limit is None else limit
+    parts: list[bytes] = []
+    got = 0
+    while got < want:
+        piece = fh.read(min(1 << 20, want - got))
+        if not piece:
+            break
+        parts.append(piece)
+        got += len(piece)
+    if limit is None and got > cap:
+        raise _too_large(name, got)
+    return parts[0] if len(parts) == 1 else b"".join(parts)
 
 
 def _open_nonblocking(path, flags: int) -> int:

@@ -20,7 +20,7 @@ from typing import Any, Callable, Optional, TypeVar
 
 T = TypeVar("T")
 
-CACHE_VERSION = 1
+CACHE_VERSION = 2     # 2: entries carry a checked header (_read_cached)
 
 
 class TableError(Exception):
@@ -51,12 +51,53 @@ def load(path, schema: type, build: Callable[[Any], T], section: tuple[str, ...]
     key = (f"{zlib.crc32(raw):08x}{len(raw):x}-{zlib.crc32(module):08x}{len(module):x}-"
            f"{CACHE_VERSION}{marshal.version}{sys.version_info[0]}{sys.version_info[1]}")
     cached = cache_dir() / f"{Path(path.name).stem}-{key}.marshal"
-    try:
-        data = marshal.loads(cached.read_bytes())
-    except (OSError, ValueError, EOFError, TypeError):
-        data = _validate(path, raw, schema, section, prepare)
-        _store(cached, data)
+    data = _read_cached(cached)
+    if data is not _MISS and _has_fields(data, schema):
+        try:
+            return build(data)
+        except Exception:            # a cached entry of the wrong shape: a miss, rebuilt below
+            pass
+    data = _validate(path, raw, schema, section, prepare)
+    _store(cached, data)
     return build(data)
+
+
+# The cache is trusted only as far as it is checked: an entry is a header (magic, CRC-32 and length
+# of the payload) and the marshal payload. Any entry larger than MAX_ENTRY, whose length or CRC
+# does not match (a truncated write, a flipped byte: marshal.loads of a corrupted byte once asked
+# for 15 GB), or that does not load or build, is a miss and is rebuilt from the TOML. What this
+# saves is ~80 ms per run (tomllib + pydantic imports and validation); what it risks is bounded by
+# these checks to one rebuild. A deliberately forged entry with a correct CRC needs write access to
+# the user's own cache directory, which is no boundary nctrans could defend.
+_MAGIC = b"NCTC"
+MAX_ENTRY = 4 * 1024 * 1024
+_MISS = object()
+
+
+def _has_fields(data: Any, schema: type) -> bool:
+    """The shape pydantic dumps: a dict with every field of the dataclass (defaults included)."""
+    import dataclasses
+    if not dataclasses.is_dataclass(schema):
+        return True
+    return isinstance(data, dict) and all(f.name in data for f in dataclasses.fields(schema))
+
+
+def _read_cached(cached: Path) -> Any:
+    try:
+        with open(cached, "rb") as fh:
+            blob = fh.read(MAX_ENTRY + 1)
+    except OSError:
+        return _MISS
+    if len(blob) > MAX_ENTRY or len(blob) < 12 or blob[:4] != _MAGIC:
+        return _MISS
+    crc, size = int.from_bytes(blob[4:8], "little"), int.from_bytes(blob[8:12], "little")
+    payload = blob[12:]
+    if size != len(payload) or zlib.crc32(payload) != crc:
+        return _MISS
+    try:
+        return marshal.loads(payload)
+    except (ValueError, EOFError, TypeError, MemoryError):
+        return _MISS
 
 
 def _validate(path: Path, raw: bytes, schema: type, section: tuple[str, ...] = (),
@@ -84,7 +125,9 @@ def _store(cached: Path, data: Any) -> None:
     try:
         cached.parent.mkdir(parents=True, exist_ok=True)
         tmp = cached.with_name(f"{cached.name}.{os.getpid()}.tmp")
-        tmp.write_bytes(marshal.dumps(data))
+        payload = marshal.dumps(data)
+        tmp.write_bytes(_MAGIC + zlib.crc32(payload).to_bytes(4, "little")
+                        + len(payload).to_bytes(4, "little") + payload)
         os.replace(tmp, cached)
     except (OSError, ValueError):
         pass

@@ -91,3 +91,41 @@ def test_streamed_iso_toolpath_does_not_import_pydantic(tmp_path):
         out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
                              text=True)
         assert out.stdout.strip() == expected, out.stderr
+
+
+def _entry(cache):
+    (entry,) = cache.iterdir()
+    return entry
+
+
+@pytest.mark.parametrize("damage", ["flip", "truncate", "huge", "wrong_type", "missing_keys"])
+def test_damaged_cache_entry_is_a_miss_and_is_rebuilt(cache, damage):
+    """Any load, shape or size failure of a cached entry is a miss: the table is validated again
+    from its TOML, gives the same table, and the entry is rewritten (not trusted again)."""
+    import marshal
+    import zlib
+    path = RULES_DIR / "iso-m.toml"
+    good = tables.load(path, RulesTable, RulesTable.from_data)
+    entry = _entry(cache)
+    original = entry.read_bytes()
+    blob = bytearray(original)
+
+    def forged(payload: bytes) -> bytes:       # a well-formed entry holding the wrong data
+        return tables._MAGIC + zlib.crc32(payload).to_bytes(4, "little") + \
+            len(payload).to_bytes(4, "little") + payload
+    if damage == "flip":
+        blob[len(blob) // 2] ^= 0x40
+        entry.write_bytes(bytes(blob))
+    elif damage == "truncate":
+        entry.write_bytes(bytes(blob[:len(blob) // 3]))
+    elif damage == "huge":
+        entry.write_bytes(bytes(blob) + b"\0" * tables.MAX_ENTRY)
+    elif damage == "wrong_type":
+        entry.write_bytes(forged(marshal.dumps([1, 2, 3])))
+    else:
+        data = marshal.loads(bytes(blob[12:]))
+        data.pop("codes", None)
+        entry.write_bytes(forged(marshal.dumps(data)))
+    again = tables.load(path, RulesTable, RulesTable.from_data)
+    assert again == good and again.lookup("G1").value == "linear"
+    assert entry.read_bytes() == original                 # rewritten whole
