@@ -49,7 +49,7 @@ def fuzz(dialect: str) -> None:
         except Exception:
             keep(dialect, data)
             raise
-    atheris.Setup(sys.argv[:1] + sys.argv[2:], test_one)
+    atheris.Setup(sys.argv, test_one)        # sys.argv: the script, then libFuzzer's options
     atheris.Fuzz()
 
 
@@ -77,6 +77,10 @@ def main() -> int:
                                     f"-max_total_time={seconds}", "-rss_limit_mb=700", "-timeout=60",
                                     f"-artifact_prefix={work}/", str(seeds)], cwd=work)
                 print(f"fuzz {dialect}: exit {r.returncode}", flush=True)
+                for art in Path(work).glob("*-*"):   # libFuzzer's crash-/timeout-/oom- artifacts
+                    if art.is_file() and art.name.split("-")[0] in ("crash", "timeout", "oom"):
+                        print(f"kept {keep(dialect, art.read_bytes())} ({art.name})", flush=True)
+                        art.unlink()
                 if r.returncode == 0:
                     break
                 status = 1                      # a crash was kept; fuzz on from the seeds
