@@ -427,9 +427,7 @@ def flatten(program: n.Program, machine=None, *, diagnostics: list,
         fl.blocks.append(n.Block(last, [n.ProgramEnd("end_rewind")]))
     diagnostics.extend(interp_diags)
     for d in interp_diags:
-        # an endless main program (ISO M99 at its end) is one pass of the toolpath: plain motion
-        # cannot repeat it for ever, so the conversion is refused rather than run once
-        if d.rule == "NC103" or (d.rule == "NC205" and ("budget" in d.message or "restarts" in d.message)):
+        if d.rule == "NC103" or (d.rule == "NC205" and "budget" in d.message):
             diagnostics.append(Diagnostic("NC402", "error", f"--flatten output would be incomplete: "
                                           f"{d.message}", d.file, d.line, d.column, d.end_line,
                                           d.end_column))
