@@ -16,6 +16,7 @@ from nctrans import limits
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import literal
 from nctrans.rules import system_meaning
+from nctrans.interp import strings as _strings
 
 
 class _Unknown:
@@ -438,6 +439,8 @@ class Evaluator:
                 return self._compile_frame(e)
             if e.name.upper() in ("SET", "REP"):
                 return self._bad(f"{e.name.upper()}() initialises an array or array element only")
+            if e.name.upper() in _strings.FUNCTIONS:
+                return self._compile_string_func(e)
             return self._bad(f"unknown function {e.name!r}")
         args = [self.compile(a) for a in e.args]
 
@@ -474,6 +477,29 @@ class Evaluator:
             except (TypeError, ValueError, OverflowError) as ex:
                 raise EvalError("NC106", f"{name}: {ex}") from None
         return call1 or call
+
+    def _compile_string_func(self, e: n.Func) -> Callable[[], Any]:
+        """STRLEN, INDEX, SUBSTR ... (nctrans.interp.strings); AXSTRING(X) takes the axis name."""
+        name = e.name.upper()
+        fn = _strings.FUNCTIONS[name]
+        args = []
+        for a in e.args:
+            if name == "AXSTRING" and type(a) is n.Var and a.space == "name" and not a.indices:
+                args.append(lambda k=str(a.key): k)
+            else:
+                args.append(self.compile(a))
+
+        def call():
+            vals = [a() for a in args]
+            if any(v is UNKNOWN for v in vals):
+                return UNKNOWN
+            try:
+                return fn(*vals)
+            except TypeError:
+                raise EvalError("NC104", f"{name}: wrong number of arguments") from None
+            except ValueError as ex:
+                raise EvalError("NC104", str(ex)) from None
+        return call
 
     # ---------------------------------------------------------------- frames
     def _compile_frame(self, e: n.Func) -> Callable[[], Any]:

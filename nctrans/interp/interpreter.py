@@ -41,7 +41,7 @@ from nctrans.interp.evaluate import (UNKNOWN, EvalError, Evaluator, FrameValue, 
 from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
 from nctrans.interp.state import LINEAR_AXES, ModalState
-from nctrans.interp import unmodelled
+from nctrans.interp import sysvars, unmodelled
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_MODES
 from nctrans import plainrun
@@ -866,12 +866,19 @@ class Interpreter(LatheMixin):
         self._record("stop", stop_kind="optional" if s.optional else "stop")
 
     def _h_alarm(self, s: n.Alarm):
+        """Sinumerik SETAL(n), Fanuc #3000=n (message): the control stops with alarm n (NC221)."""
         try:
             num = self.ev.compile(s.number)()
+            text = None if s.text is None else self.ev.compile(s.text)()
         except EvalError:
-            num = "?"
-        self.diag("NC205", "warning", f"analysis truncated at line {self.span.line}: the "
-                  f"program raises alarm {num}")
+            num, text = "?", None
+        if isinstance(num, float) and num == int(num):
+            num = int(num)
+        if num is UNKNOWN:
+            num = "(unknown number)"
+        what = f": {text}" if isinstance(text, str) and text else ""
+        self.diag("NC221", "error", f"the program raises alarm {num}{what}; the control stops "
+                  "here, so the analysis ends at this line")
         raise _Stop
 
     def _h_data(self, s):
@@ -1084,7 +1091,8 @@ class Interpreter(LatheMixin):
                        (a2, c2 + r * math.sin(math.radians(ang)), "abs")]
 
     def _c_passthrough(self, s: n.Passthrough):
-        if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")):
+        if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")) or \
+                s.reason in unmodelled.REPORTED_AS_ERROR:
             return (self._h_known, None)
         return (self._h_unmodelled, (s, unmodelled.takes_motion(s)))
 
@@ -1777,6 +1785,7 @@ class Interpreter(LatheMixin):
         values["spindle_speed"] = lambda: st.spindle_speed or 0.0
         for name, value in (getattr(self.machine, "variables", None) or {}).items():
             sysv[str(name).upper()] = lambda value=value: float(value)
+        sysvars.register(self, self.program.dialect)
 
     # ================================================================ the loop
     def run(self) -> Iterator[ToolpathRecord]:

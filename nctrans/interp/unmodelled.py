@@ -24,6 +24,10 @@ from nctrans.ir.vocabulary import MILL_ONLY, NO_EFFECT_PREFIX, NO_MOTION_EFFECT
 _CODE = re.compile(r"\s*([A-Za-z_$][A-Za-z_0-9.]*)")
 
 
+# reasons whose construct the front end has already reported as an error (NC002/NC007)
+REPORTED_AS_ERROR = frozenset(("syntax error", "invalid number"))
+
+
 def no_motion_effect(reason: str, machine_kind: str = "mill") -> bool:
     """True when a Passthrough with this reason changes nothing on the toolpath of this machine."""
     if reason in NO_MOTION_EFFECT:

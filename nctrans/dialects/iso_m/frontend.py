@@ -21,10 +21,10 @@ from typing import Any, Optional
 from nctrans import limits, plainrun
 from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.ir.nodes import (
-    Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
+    Alarm, Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
     HomeReturn, If, Loop, ModalCallOff, ModeChange, Motion, Num, OffsetSelect, Passthrough,
     Program, ProgramEnd, ResetSetPosition, Return, SetPosition, Span, SpindleSpeed, Stop,
-    SubCall, Subprogram, ToolChange, ToolSelect, Var, While,
+    Str, SubCall, Subprogram, ToolChange, ToolSelect, Var, While,
 )
 from nctrans.rules import load_table, normalise_code
 
@@ -64,6 +64,8 @@ ANGLE_LETTERS = frozenset("ABC")
 
 _G_IN_TEXT = re.compile(r"G(\d+(?:\.\d+)?)")
 _LEAD_N = re.compile(r"^\s*(?:/\d?\s*)?(?:[Nn]\s*\d+)?\s*")
+ALARM_VARIABLE = 3000          # Fanuc macro B: #3000=n (message) raises alarm n
+_EXTERNAL_OUTPUT = re.compile(r"^(?:N\d+\s*)?(?:POPEN|PCLOS|[DB]PRNT\s*\[.*\])\s*$")
 _O_WORDS = re.compile(r"O(\d+)(?=$|[A-Z][-+.\d#\[]|[,#\[/])")
 _O_NAME = re.compile(r"O([0-9A-Z_.]*)$")
 _SKIP = re.compile(r"/(\d?)")
@@ -283,7 +285,9 @@ class Lowering:
         self.nonmodal_handlers[rule.value](b, rule, text)
 
     def _g_passthrough(self, b: _Blk, rule, text: str) -> None:
-        b.out.append((B_NONMODAL, self._pass("G" + text, rule.meaning)))
+        # the code's own address words (rules table `args`, e.g. G103 P) stay with it
+        own = "".join(_word_text(k, b.vals.pop(k)) for k in rule.args if k in b.vals)
+        b.out.append((B_NONMODAL, self._pass("G" + text + own, rule.meaning)))
 
     def _nm_owner(self, b: _Blk, rule, text: str) -> None:
         b.owner = rule.value
@@ -588,7 +592,10 @@ class Lowering:
         for it in macro:
             tag = it[0]
             if tag == "=":
-                out.append((B_ASSIGN, Assign(it[1], it[2])))
+                if type(it[1]) is Var and it[1].space == "num" and it[1].key == ALARM_VARIABLE:
+                    out.append((B_END, Alarm(it[2])))     # #3000=n (MESSAGE): the control stops
+                else:
+                    out.append((B_ASSIGN, Assign(it[1], it[2])))
             elif tag == "GOTO":
                 out.append((B_END, Goto(self._target(it[1]))))
             elif tag == "IFGOTO":
@@ -1049,6 +1056,12 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 cur.append(Block(span, [Passthrough(raw.strip(), "directive", low.dialect)]))
                 seen_block = True
                 continue
+            if _EXTERNAL_OUTPUT.match(code):
+                # Fanuc macro B external output (Renishaw probing macros): a port, not motion
+                cur.append(Block(span, [Passthrough(raw.strip(), "no motion effect (external output)",
+                                                    low.dialect)]))
+                seen_block = True
+                continue
             if c0 in "O:" and not code.startswith("OR"):
                 m = _O_WORDS.match("O" + code[1:])
                 if m is not None:
@@ -1126,6 +1139,9 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 comment = None
                 continue
             if body or number is not None or comment is not None or not structure:
+                for st in body:
+                    if type(st) is Alarm and st.text is None and comment:
+                        st.text = Str(comment)      # the alarm message is the block's comment
                 cur.append(Block(span, body, number, None, skip, comment))
             comment = None
             for it in structure:

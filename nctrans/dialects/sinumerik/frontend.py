@@ -1064,9 +1064,14 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
     ch = head.children
     rest = stmts[1:]
     if d == "if_stmt" and ch[2] is not None:       # IF cond GOTOF label: a plain block
-        cond = expr(ch[1])
-        unit.current.append(ir.Block(span, [_goto(ch[2], ch[3], cond)], line.number, line.label,
-                                     line.skip, line.comment))
+        jumps = [_goto(ch[2], ch[3], expr(ch[1]))]
+        # several conditional jumps in one block run in order (real cycle code:
+        # IF DPR==0 GOTOF _MM1 IF RTP==RFP GOTOF _FEHL1)
+        while rest and rest[0].data == "if_stmt" and rest[0].children[2] is not None:
+            c = rest[0].children
+            jumps.append(_goto(c[2], c[3], expr(c[1])))
+            rest = rest[1:]
+        unit.current.append(ir.Block(span, jumps, line.number, line.label, line.skip, line.comment))
         if rest:
             low.error("NC002", "statement after the jump target", line.lineno, line.col)
         return

@@ -38,6 +38,8 @@ _NUMBER = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?", re.IGNORECASE)
 _SIGNED = re.compile(r"\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?", re.IGNORECASE)
 _WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _SYSVAR = re.compile(r"\$+[A-Za-z0-9_]+")
+_DEF_ATTRIBUTES = frozenset(("LLI", "ULI", "PHU", "APR", "APW"))
+_GLUED_CODE = re.compile(r"[GM](\d+)(?=[A-Z])")
 _HEXBIN = re.compile(r"'([HhBb])([0-9A-Fa-f]+)'")
 _OPS = [("==", "CMPOP"), ("<>", "CMPOP"), ("<=", "CMPOP"), (">=", "CMPOP"), ("=<", "CMPOP"),
         ("=>", "CMPOP"), ("<<", "CONCAT"), ("<", "CMPOP"), (">", "CMPOP"), ("=", "EQ"), ("+", "PLUS"),
@@ -147,9 +149,24 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
                 j += 1
             nxt = text[j] if j < n else ""
             nxt2 = text[j:j + 2]
+            if state["def"] and state["depth"] == 0 and upper in _DEF_ATTRIBUTES and last[0] in (
+                    "TYPE", "RSQB"):
+                m2 = _SIGNED.match(text, end)
+                if m2:
+                    # DEF CHAN INT LLI 0 ULI 4 NAME: limits, unit and access levels of a GUD
+                    # (spec 1.8); they constrain the HMI and later writes, not the motion
+                    i = m2.end()
+                    continue
             if upper in KEYWORDS and not (nxt == "=" and nxt2 not in ("==", "=<", "=>")):
                 yield tok(KEYWORDS[upper], upper, i, end)
                 i = end
+                continue
+            glued = _GLUED_CODE.match(upper) if nxt == "=" else None
+            if glued:
+                # G01G90X=R12: a G/M word glued before the assigned address (spec 2.2)
+                yield tok("ADDR", upper[0], i, i + 1)
+                yield tok("NUMBER", glued.group(1), i + 1, i + glued.end())
+                i += glued.end()
                 continue
             if nxt in "([" and nxt or (nxt == "=" and nxt2 not in ("==", "=<", "=>")):
                 yield tok("IDENT", upper, i, end)
@@ -168,10 +185,10 @@ def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
                 # glued address words: G0X.. / R1 / X100 / g18g500
                 letter = upper[0]
                 m2 = _NUMBER.match(text, i + 1)
-                if letter == "R" and m2 and "." not in m2.group() and "EX" not in m2.group().upper() \
-                        and m2.end() == end:
-                    yield tok("RPARAM", upper, i, end)
-                    i = end
+                if letter == "R" and m2 and "." not in m2.group() and "EX" not in m2.group().upper():
+                    # R12 alone, or glued to the next word (X=R12F800: R12, then F800)
+                    yield tok("RPARAM", upper[:m2.end() - i], i, m2.end())
+                    i = m2.end()
                     continue
                 _check_number(text, m2, i + 1)
                 yield tok("ADDR", letter, i, i + 1)
