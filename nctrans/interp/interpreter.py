@@ -877,6 +877,8 @@ class Interpreter(LatheMixin):
         if num is UNKNOWN:
             num = "(unknown number)"
         what = f": {text}" if isinstance(text, str) and text else ""
+        self.alarm = (n.Num(float(num)) if isinstance(num, (int, float)) else s.number,
+                      n.Str(text) if isinstance(text, str) and text else None, self.span)
         self.diag("NC221", "error", f"the program raises alarm {num}{what}; the control stops "
                   "here, so the analysis ends at this line")
         raise _Stop

@@ -422,6 +422,18 @@ def flatten(program: n.Program, machine=None, *, diagnostics: list,
     fl.interp = interp
     for _ in interp.run():
         pass
+    raised = getattr(interp, "alarm", None)
+    if raised is not None:
+        # the source stops with an alarm here: the flattened program raises the same alarm, so
+        # the run's NC221 becomes a lowering note (the conversion keeps the behaviour)
+        number, text, span = raised
+        fl.blocks.append(n.Block(span, [n.Alarm(number, text)]))
+        for i, d in enumerate(interp_diags):
+            if d.rule == "NC221":
+                interp_diags[i] = Diagnostic("NC401", "info", f"--flatten: the program raises an alarm "
+                                             f"here ({d.message.split(';')[0][len('the program raises '):]}"
+                                             "); the flattened program raises it too", d.file, d.line,
+                                             d.column, d.end_line, d.end_column)
     if not fl.ended:
         last = fl.blocks[-1].span if fl.blocks else n.Span(program.file, 1)
         fl.blocks.append(n.Block(last, [n.ProgramEnd("end_rewind")]))

@@ -1142,6 +1142,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 for st in body:
                     if type(st) is Alarm and st.text is None and comment:
                         st.text = Str(comment)      # the alarm message is the block's comment
+                        comment = None
                 cur.append(Block(span, body, number, None, skip, comment))
             comment = None
             for it in structure:
