@@ -1,5 +1,5 @@
 """Numbered system variables (Fanuc/Haas macro B #2001.., #4001.., #5201..) read from the machine
-model and the running state, as the dialect's rules table maps them (`[[options.system_variables]]`
+model and the running state, as the dialect's rules table maps them (`[[options.numbered_variables]]`
 of rules/<dialect>.toml; sources documented there).
 
 A number the table marks "unknown", or does not list, reads as UNKNOWN: the interpreter then says
@@ -19,7 +19,7 @@ def entries(dialect: str) -> list[dict]:
     """The dialect's system-variable map (empty for a dialect without one)."""
     try:
         from nctrans.rules import load_table
-        return list(load_table(dialect).options.get("system_variables", ()))
+        return list(load_table(dialect).options.get("numbered_variables", ()))
     except Exception:            # no table for this dialect
         return []
 
@@ -28,6 +28,8 @@ def register(interp, dialect: str) -> None:
     """Publish every mapped number in `interp.ev.system` (callables read at evaluation time)."""
     system = interp.ev.system
     for e in entries(dialect):
+        if not isinstance(e, dict) or "first" not in e:
+            continue
         first = int(e["first"])
         last = int(e.get("last", first))
         for k in range(first, last + 1):
