@@ -36,7 +36,7 @@ from typing import Any, Callable, Iterator, Optional
 
 from nctrans.diagnostics import at_span
 from nctrans.interp import arcs
-from nctrans.interp.evaluate import (UNKNOWN, EvalError, Evaluator, FrameValue, Scope,
+from nctrans.interp.evaluate import (UNKNOWN, AxisName, EvalError, Evaluator, FrameValue, Scope,
                                      constant)
 from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
@@ -443,6 +443,8 @@ class Interpreter(LatheMixin):
         diameter = self.st.diameter
         out = []
         for axis, c, f, mode in words:
+            if type(axis) is not str:
+                axis = self._indirect_axis(axis())
             v = c if c is not None else self._value(f, f"{axis} word")
             if v is None:
                 continue
@@ -452,6 +454,13 @@ class Interpreter(LatheMixin):
                 v *= 0.5
             out.append((axis, v, mode))
         return out
+
+    @staticmethod
+    def _indirect_axis(value: Any) -> str:
+        """The axis of AX[expr]: an axis name (a DEF AXIS variable, $P_AXN3, X)."""
+        if isinstance(value, str) and value.strip():
+            return value.strip().upper()
+        raise EvalError("NC104", f"AX[..] needs an axis name, not {value!r}")
 
     def _target(self, vals: list) -> dict[str, float]:
         """Program-coordinate target of evaluated words from the current point."""
@@ -926,7 +935,8 @@ class Interpreter(LatheMixin):
     # ---------------------------------------------------------------- motion
     def _c_motion(self, s: n.Motion):
         if (s.center is None and s.radius is None and s.turns is None and not s.polar
-                and not s.machine_coords and s.via is None and s.aperture is None):
+                and not s.machine_coords and s.via is None and s.aperture is None
+                and not s.indirect):
             fast = []
             AV, Num = n.AxisValue, n.Num
             for axis, av in s.target.items():
@@ -942,6 +952,9 @@ class Interpreter(LatheMixin):
 
     def _c_motion_full(self, s: n.Motion) -> tuple:
         words = self._words(s.target)
+        if s.indirect:
+            words += tuple((self.ev.compile(axis), None, self.ev.compile(av.value), av.mode)
+                           for axis, av in s.indirect)
         center = self._words(s.center)
         radius = None if s.radius is None else self.ev.compile(s.radius)
         turns = None if s.turns is None else self.ev.compile(s.turns)
@@ -1382,6 +1395,8 @@ class Interpreter(LatheMixin):
     def _h_cycle_call(self, s: n.CycleCall):
         if s.kind in TURNING_KINDS:
             return self._turning_cycle(s)
+        if s.name and s.kind != "swivel_plane" and self._find_unit(s.name) is not None:
+            return self._cycle_code(s)
         if s.kind in ("holes_line", "holes_circle"):
             self._hole_pattern(s)
             return
@@ -1392,6 +1407,22 @@ class Interpreter(LatheMixin):
             self.modal_cycle = s
             return
         self._run_cycle_call(s)
+
+    def _cycle_code(self, s: n.CycleCall):
+        """A cycle whose own code is in the program or beside it (CYCLE81.SPF on the search
+        path): the control runs that code, so the interpreter calls it with the call's
+        arguments in their places (omitted ones as the control passes them) instead of the
+        built-in model. MCALL makes it a modal call like any subprogram's."""
+        table = cycle_table()
+        spec = ({c.name: c for c in table.cycle} | {p.name: p for p in table.pattern}).get(s.name.upper())
+        params = list(spec.params) if spec is not None else []
+        args = [s.params.get(table.neutral(p), n.Num(0.0, "")) for p in params]
+        if s.modal:
+            call = n.SubCall(s.name, args, modal="after_move", kind="mcall")
+            self.modal_cycle = None
+            self.modal_call = (call, self._call_args(call), len(self.stack))
+            return None
+        return ("call", n.SubCall(s.name, args, kind="proc"))
 
     def _hole_pattern(self, s: n.CycleCall) -> None:
         """Sinumerik HOLES1/HOLES2: the modally called cycle at each position of the pattern
@@ -1785,6 +1816,8 @@ class Interpreter(LatheMixin):
         values["active_tool_edge"] = lambda: float(st.radius_index or 0)
         values["feed"] = lambda: st.feed or 0.0
         values["spindle_speed"] = lambda: st.spindle_speed or 0.0
+        for i in range(3):      # geometry axes of the plane: abscissa, ordinate, applicate
+            sysv[f"$P_AXN{i + 1}"] = (lambda i=i: AxisName(PLANE_AXES[st.plane][i]))
         for name, value in (getattr(self.machine, "variables", None) or {}).items():
             sysv[str(name).upper()] = lambda value=value: float(value)
         sysvars.register(self, self.program.dialect)

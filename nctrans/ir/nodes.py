@@ -149,6 +149,8 @@ class Motion:
     via: intermediate point of a 3-point arc (Sinumerik CIP).
     machine_coords: one-shot machine coordinates (ISO G53, Sinumerik SUPA/G53).
     polar: polar words (angle, radius) when the dialect programs them.
+    indirect: axis words whose axis is computed when the block runs (Sinumerik AX[expr]=value):
+    [(axis expression, AxisValue)].
     aperture: opening angle of an arc in degrees (Sinumerik AR=), with centre or end point.
     """
     target: dict[str, AxisValue] = field(default_factory=dict)
@@ -159,6 +161,7 @@ class Motion:
     machine_coords: bool = False
     polar: Optional[dict[str, Expr]] = None
     aperture: Optional[Expr] = None
+    indirect: Optional[list] = None
 
 
 @node

@@ -155,6 +155,8 @@ class _Walker:
                 self.note("frame", span)
             if s.radius is not None or s.via or s.polar or s.aperture is not None:
                 self.note("arcform", span)
+            if s.indirect:
+                self.note("expr", span)
         elif t is n.ModeChange:
             if s.group == "units" and s.value == "inch":
                 self.note("units", span)

@@ -694,6 +694,8 @@ class IsoEmitter:
         self._track(s)
         if s.polar:
             raise NotExpressible("polar motion words")
+        if s.indirect:
+            raise NotExpressible("axis words with a computed axis (AX[..]=)")
         words = []
         if s.machine_coords:
             words.append(("", "G53"))

@@ -401,6 +401,8 @@ class Emitter:
                 ws.append(f"RP={self.expr(m.polar['radius'])}")
         if m.turns is not None:
             ws.append(f"TURN={self.expr(m.turns)}")
+        for axis, v in m.indirect or ():
+            ws.append(f"AX[{self.expr(axis)}]={self.expr(v.value)}")
         out.words.extend(ws)
 
     def track(self, m: ir.Motion) -> None:

@@ -314,6 +314,7 @@ class _Words:
     fixed_point: Optional[ir.Expr] = None
     frame: Optional[str] = None
     pole: Optional[tuple[str, str]] = None   # G110/G111/G112: (relative_to, code)
+    indirect: list = field(default_factory=list)   # AX[expr]=value
 
 
 class Lowerer:
@@ -551,7 +552,10 @@ class Lowerer:
                     w.out.append(ir.Assign(ir.Var("system", str(lt), _index(idx) if idx else None), value))
                 elif idx is not None:
                     name = str(lt)
-                    if name in self.pass_words:
+                    if name == "AX" and len(_index(idx)) == 1:
+                        # indirect axis: the axis is a value (AX[_AXN]=RTP, spec 3.6)
+                        w.indirect.append((_index(idx)[0], _axis_value(value)))
+                    elif name in self.pass_words:
                         w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
                     elif name == "R":
                         w.out.append(ir.Assign(ir.Var("R", None, _index(idx)), value))
@@ -634,9 +638,10 @@ class Lowerer:
         for sp, v in w.speed:
             w.out.append(ir.SpindleSpeed(v, sp))
         if w.target or w.center or w.via or w.polar or w.radius is not None or w.aperture is not None \
-                or w.turns is not None:
+                or w.turns is not None or w.indirect:
             w.out.append(ir.Motion(dict(w.target), dict(w.center) or None, w.radius, w.turns,
-                                   dict(w.via) or None, w.machine, dict(w.polar) or None, w.aperture))
+                                   dict(w.via) or None, w.machine, dict(w.polar) or None, w.aperture,
+                                   list(w.indirect) or None))
         elif w.rpl is not None:
             w.out.append(ir.Passthrough("RPL=" + _expr_text(w.rpl), "plane rotation outside ROT", DIALECT))
         if w.repeat is not None:
