@@ -46,7 +46,7 @@ def test_parenthesis_form_prefixes_and_bare_ignore(shop, capsys):
 
 
 def test_sinumerik_semicolon_suppression(shop, capsys):
-    (shop / "a.mpf").write_text('DEF STRING[4] TXT\nTXT="ABCDEFGH" ; nctrans: ignore NC110\nM30\n')
+    (shop / "a.mpf").write_text('DEF STRING[4] TXT\nTXT="ABCDEFGH" ; nctrans: ignore NC110, NC109\nM30\n')
     assert lint(capsys, "a.mpf") == (0, [])
 
 
