@@ -3,7 +3,7 @@
 One place for every limit nctrans puts on its input, so each is documented once (README "Limits")
 and tests/test_hostile.py can hold the program to it. Where a controller manual states a limit the
 same limit applies here (the seeds: Fanuc 3 nested DO levels, Sinumerik STRING of at most 200
-characters; Sinumerik control structures: see SINUMERIK_MAX_NESTING); the rest are far beyond any real part
+characters; control structures: the dialect's rules table); the rest are far beyond any real part
 program and only stop runaway input.
 """
 from __future__ import annotations
@@ -29,11 +29,9 @@ MAX_BRACKET_DEPTH = 32
 # Operators in one block: a left-deep chain of N operators is an expression tree N deep.
 MAX_OPERATORS = 200
 
-# Nesting of control structures, as the controllers themselves limit it.
-ISO_MAX_DO_NESTING = 3                 # Fanuc macro B: DO1..DO3, "nesting up to 3 levels"
-# The SW 6 manual (seeds) allows 8 check structures per program level, but a real 840D sl program
-# in the corpus (nie11kun-MK6120-C_PAR_INI.SPF) nests 10 deep and runs: the later limit, 16, holds.
-SINUMERIK_MAX_NESTING = 16
+# Nesting of control structures: each dialect's table states its controller's own limit
+# (options.max_do_nesting / max_structure_nesting); this bound applies where a table is silent.
+MAX_STRUCTURE_NESTING = 16
 
 # Strings (Sinumerik STRING[n]; n at most 200 characters on the 840D): an undeclared string
 # (a concatenation result, a CHAR/STRING parameter) is capped at the same length.

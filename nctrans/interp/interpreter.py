@@ -1817,7 +1817,7 @@ class Interpreter(LatheMixin):
         values["feed"] = lambda: st.feed or 0.0
         values["spindle_speed"] = lambda: st.spindle_speed or 0.0
         for i in range(3):      # geometry axes of the plane: abscissa, ordinate, applicate
-            sysv[f"$P_AXN{i + 1}"] = (lambda i=i: AxisName(PLANE_AXES[st.plane][i]))
+            values[f"plane_axis_{i + 1}"] = (lambda i=i: AxisName(PLANE_AXES[st.plane][i]))
         for name, value in (getattr(self.machine, "variables", None) or {}).items():
             sysv[str(name).upper()] = lambda value=value: float(value)
         sysvars.register(self, self.program.dialect)

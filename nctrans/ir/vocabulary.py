@@ -52,6 +52,9 @@ SYSTEM_VARIABLES = (
     "active_tool_edge",          # active tool offset (edge / D number)
     "feed",                      # programmed feed rate
     "spindle_speed",             # programmed spindle speed
+    "plane_axis_1",              # geometry axes of the active plane, as axis names: abscissa,
+    "plane_axis_2",              # ordinate,
+    "plane_axis_3",              # applicate (the tool axis)
 )
 AXIS_MEANINGS = ("axis_position_work", "axis_position_machine")
 
@@ -68,7 +71,7 @@ CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle", "swive
 # give these; nctrans.interp.unmodelled and --flatten pass over them without a warning). A reason
 # starting with NO_EFFECT_PREFIX is such a construct too; one starting with MILL_ONLY only on a mill.
 NO_MOTION_EFFECT = frozenset((
-    "ISO dialect mode", "Siemens mode", "directive", "preprocessing stop", "data attribute",
+    "ISO dialect mode", "native dialect mode", "directive", "preprocessing stop", "data attribute",
     "macro definition", "declaration", "feedforward", "program attribute",
 ))
 NO_EFFECT_PREFIX = "no motion effect"

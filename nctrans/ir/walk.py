@@ -109,3 +109,16 @@ def constant(e) -> Optional[float]:
             return None
         return _FOLD[e.op](a, b)
     return None
+
+
+def ends_with_return(body: list) -> bool:
+    """True when the last block with statements in `body` returns or ends the program (a
+    subroutine that needs no return appended)."""
+    for node in reversed(body):
+        if not isinstance(node, n.Block):
+            return False
+        if any(isinstance(s, (n.Return, n.ProgramEnd)) for s in node.body):
+            return True
+        if node.body:
+            return False
+    return False

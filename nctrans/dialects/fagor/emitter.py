@@ -255,7 +255,7 @@ class _Emitter:
             self.in_sub = True
             self._reset()
             self.nodes(sub.body)
-            if not _ends(sub.body):
+            if not ir_walk.ends_with_return(sub.body):
                 self.out.append("M17")
         self.in_sub = False
         self._reset()
@@ -734,17 +734,6 @@ def _sub_order(p: n.Program) -> list[str]:
         visit(k)
     return order
 
-
-def _ends(body: list) -> bool:
-    for node in reversed(body):
-        if isinstance(node, n.Block):
-            if any(isinstance(s, (n.Return, n.ProgramEnd)) for s in node.body):
-                return True
-            if node.body:
-                return False
-        else:
-            return False
-    return False
 
 
 def _describe(s) -> str:

@@ -793,7 +793,7 @@ class Parser:
         while u.stack:
             op = u.stack.pop()
             self.error("NC006", f"{op.kind} is not closed (missing {_CLOSER[op.kind]})", op.line)
-        if u is not self.main and not _ends(u.body):
+        if u is not self.main and not ir_walk.ends_with_return(u.body):
             self.error("NC006", f"local subroutine {u.name} has no end (M17, M29 or #RET)", u.span.line,
                        severity="warning")
 
@@ -1250,17 +1250,6 @@ def _key(s: str):
     s = str(s).strip().upper()
     return int(s) if s.isdigit() else s
 
-
-def _ends(body: list) -> bool:
-    for node in reversed(body):
-        if isinstance(node, ir.Block):
-            if any(isinstance(s, (ir.Return, ir.ProgramEnd)) for s in node.body):
-                return True
-            if node.body:
-                return False
-        else:
-            return False
-    return False
 
 
 def parse(text: str, file: str = "<stdin>") -> ParseResult:

@@ -330,7 +330,7 @@ class IsoEmitter:
                     f"{prm.name}={letter} (#{pl.ARG_LOCALS[letter]})"
                     for prm, letter in zip(sub.params, unit.params)))
             self.nodes(sub.body)
-            if key in self.sub_numbers and not _ends(sub.body):
+            if key in self.sub_numbers and not walk.ends_with_return(sub.body):
                 self.out.append("M99")
         if percent:
             self.out.append("%")
@@ -1076,16 +1076,6 @@ class IsoEmitter:
         elif "value" in s.values:
             words.append(("R", self.addr("R", s.values["value"])))
         return words
-
-
-def _ends(body) -> bool:
-    """Whether a unit's last block returns or ends the program (else the O block needs M99)."""
-    for node in reversed(body):
-        if type(node) is not n.Block:
-            return False
-        if node.body:
-            return any(type(s) in (n.Return, n.ProgramEnd) for s in node.body)
-    return False
 
 
 def _same(values) -> bool:

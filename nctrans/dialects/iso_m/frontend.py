@@ -930,6 +930,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     low = lowering(file, diags)
     opts = low.table.options
     semicolon_comment = opts.get("eob_semicolon", "comment") != "eob"
+    max_do_nesting = int(opts.get("max_do_nesting", limits.MAX_STRUCTURE_NESTING))
     meta: dict = program.meta
     meta.update({"program_number": None, "percent": False, "defaults": low.table.defaults(),
                  "options": dict(opts)})
@@ -1156,11 +1157,11 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                         node_label = it[1]
                     else:
                         node_label = it[2]
-                    if len(stack) >= limits.ISO_MAX_DO_NESTING:
+                    if len(stack) >= max_do_nesting:
                         # the controller's limit; kept out of the IR so no walker recurses deeper
                         diags.append(Diagnostic(
                             "NC008", "error", f"DO{node_label} nested {len(stack) + 1} levels deep: "
-                            f"nesting too deep (at most {limits.ISO_MAX_DO_NESTING} DO levels)",
+                            f"nesting too deep (at most {max_do_nesting} DO levels)",
                             file, lineno))
                         stack.append(_Frame(node, node_label, cur, lineno))
                         continue

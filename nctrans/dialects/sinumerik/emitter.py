@@ -666,7 +666,7 @@ class Emitter:
             self.span = getattr(n, "span", None)
             if isinstance(n, ir.Block) and _mode_switch(n, "ISO dialect mode"):
                 j = i
-                while j < len(ns) and not (isinstance(ns[j], ir.Block) and _mode_switch(ns[j], "Siemens mode")):
+                while j < len(ns) and not (isinstance(ns[j], ir.Block) and _mode_switch(ns[j], "native dialect mode")):
                     j += 1
                 text = self.iso_section(ns[i:j]) if j > i and not all(
                     isinstance(x, ir.Block) and all(isinstance(s, ir.Passthrough) and s.dialect == "iso-m"

@@ -849,7 +849,7 @@ def parse(text: str, file: str = "<stdin>") -> ParseResult:
                 else:
                     unit.current.extend(blocks)
                 iso_lines = None
-                unit.current.append(_passthrough_block(file, line, code, "Siemens mode"))
+                unit.current.append(_passthrough_block(file, line, code, "native dialect mode"))
             else:
                 iso_lines.append(line)
             continue
@@ -1140,9 +1140,10 @@ def _open(low: Lowerer, unit: _Unit, kind: str, node, body: list, line: Line) ->
     """Open a control structure. Past the controller's nesting limit it is an NC008 error and the
     structure is kept out of the IR (its blocks stay in the enclosing body), so no walker of the
     IR recurses deeper than the limit."""
-    if len(unit.stack) >= limits.SINUMERIK_MAX_NESTING:
+    most = int(table().options.get("max_structure_nesting", limits.MAX_STRUCTURE_NESTING))
+    if len(unit.stack) >= most:
         low.error("NC008", f"{kind} nested {len(unit.stack) + 1} deep: nesting too deep (at most "
-                  f"{limits.SINUMERIK_MAX_NESTING} control structures per program level)",
+                  f"{most} control structures per program level)",
                   line.lineno, line.col)
         unit.stack.append(_Open(kind, node, unit.current, line.lineno))
         return
