@@ -56,7 +56,8 @@ def test_system_variables_are_read_by_their_neutral_meaning_from_each_rules_tabl
     assert system_meaning(5001) == system_meaning(5041) == "axis_position_work.X"
     assert system_meaning(5023) == "axis_position_machine.Z"
     assert system_meaning("$aa_iw") == system_meaning("$P_EP") == "axis_position_work"
-    assert system_meaning("$P_AXN1") is None and system_meaning(5100) is None
+    assert system_meaning("$P_AXN1") == "plane_axis_1"
+    assert system_meaning("$P_GG") is None and system_meaning(5100) is None
 
 
 def test_iso_position_numbers_and_sinumerik_names_read_the_same_position():
