@@ -78,6 +78,9 @@ class Tool:
     # pointing up the tool axis towards the spindle.
     holder: list[Cylinder] = field(default_factory=list)
     holder_mesh: Optional[str] = None
+    # turning tool: tip direction 0-9 of the nose radius (Fanuc/Haas imaginary tool tip, Sinumerik
+    # cutting edge position); `radius` is then the nose radius (nctrans.interp.nose)
+    tip: Optional[int] = None
 
     def __post_init__(self) -> None:
         for name in ("length", "radius", "cutting_length", "holder_radius", "holder_length"):
@@ -86,6 +89,8 @@ class Tool:
                 raise ValueError(f"{name} must not be negative, not {v:g}")
         if (self.holder_radius is None) != (self.holder_length is None):
             raise ValueError("holder_radius and holder_length go together")
+        if self.tip is not None and not 0 <= self.tip <= 9:
+            raise ValueError(f"tip (tool-nose tip direction) must be 0..9, not {self.tip}")
 
     def holder_cylinders(self) -> list[tuple[float, float, float]]:
         """(radius, bottom, top) of each holder cylinder, heights above the tool tip. The holder
@@ -157,6 +162,9 @@ class Machine:
     # When empty, H n / D n read tool n's length / radius from the tool table.
     length_offsets: dict[int, float] = field(default_factory=dict)
     radius_offsets: dict[int, float] = field(default_factory=dict)
+    # tool-nose tip directions (0-9) by offset register, stored with the radius on a lathe;
+    # when empty, offset n reads tool n's `tip`
+    tip_directions: dict[int, int] = field(default_factory=dict)
     # controller and machine-builder system variables the program may read, by the dialect's own
     # name (Fagor "V.MPA.MAXFEED.X", "V.MTB.P1"): what the machine model knows of them
     variables: dict[str, float] = field(default_factory=dict)
@@ -166,6 +174,9 @@ class Machine:
     def __post_init__(self) -> None:
         self.axes = {k.upper(): v for k, v in self.axes.items()}
         self.offsets = {k.upper(): {a.upper(): v for a, v in o.items()} for k, o in self.offsets.items()}
+        for i, tip in self.tip_directions.items():
+            if not 0 <= tip <= 9:
+                raise ValueError(f"tip_directions[{i}] must be 0..9, not {tip}")
 
     def copy(self) -> "Machine":
         """A deep copy (the interpreter's G10 writes offsets into its own copy)."""
@@ -190,6 +201,13 @@ class Machine:
             return self.radius_offsets[index]
         t = self.tool(index)
         return t.radius if t else 0.0
+
+    def tip_direction(self, index: int) -> Optional[int]:
+        """Tool-nose tip direction of offset register `index` (0-9); None when nothing is known."""
+        if index in self.tip_directions:
+            return self.tip_directions[index]
+        t = self.tool(index)
+        return t.tip if t else None
 
     @classmethod
     def from_toml(cls, path: "str | Path") -> "Machine":

@@ -609,7 +609,7 @@ class Interpreter(LatheMixin):
             if kind == "arc":
                 self.diag("NC204", "error", "cutter compensation starts on an arc; the first "
                           "move after G41/G42 must be a rapid or linear move")
-            self.comp = CutterCompensator(side, r, self.st.plane)
+            self.comp = self._compensator(side, r)     # lathe.py: the tool-nose tip
         self._comp_out(self.comp.push(pm))
         return True
 

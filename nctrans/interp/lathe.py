@@ -99,6 +99,25 @@ class LatheMixin:
         if self.css_surface is not None:
             self._css_move(self.pos)
 
+    # ------------------------------------------------------------------ tool-nose compensation
+    def _compensator(self, side: str, r: float):
+        """G41/G42: on a lathe in the ZX plane the tool nose (nctrans.interp.nose: the records hold
+        the imaginary tip of the offset's tip direction); elsewhere the cutter centre."""
+        from nctrans.interp.cutter_comp import CutterCompensator
+        plane = self.st.plane
+        if plane != "ZX" or not self._css_applies():
+            return CutterCompensator(side, r, plane)
+        from nctrans.interp.nose import NoseCompensator
+        index = self.st.radius_index or 0
+        finder = getattr(self.machine, "tip_direction", None)
+        tip = finder(index) if finder is not None else None
+        if tip is None:
+            self.diag("NC235", "warning", f"tool-nose radius compensation with offset {index} "
+                      f"(nose radius {r:g}) and no tip direction in the machine's tool table: "
+                      "the nose centre is taken as the programmed point (tip 0)")
+            tip = 0
+        return NoseCompensator(side, r, tip, plane)
+
     # ------------------------------------------------------------------ radius among diameters
     def _radius_x_check(self, vals, center, radius, cw) -> None:
         """An arc that fails in diameter mode but closes with its X word read as a radius: the
