@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from nctrans import pipeline, source
+from nctrans.machine import Machine
 from nctrans.dialects.iso_m.frontend import StreamedBody, parse_program, parse_stream
 
 ISO_MILL = Path(__file__).resolve().parents[1].parent / "shared" / "corpus" / "iso-mill"
@@ -55,6 +56,19 @@ def test_text_after_program_end_and_later_subprogram_give_the_same_diagnostics()
     assert ld.streamed is None          # completed by the run
     assert streamed == full
     assert any("NC003" in repr(d) for d in full[1])
+
+
+def test_streamed_program_starts_from_the_power_on_work_offset():
+    # G54 is the power-on work offset of iso-m; with the machine's G54 at X100 Y-50 the move to
+    # X1 Y1 ends at machine X101 Y-49, streamed or not (the streamed run once started from none).
+    machine = Machine(name="vmc", offsets={"G54": {"X": 100.0, "Y": -50.0, "Z": 0.0}})
+    src = source.decode(b"G1 X1 Y1 F100\nX2\n", "t.nc")
+    ends = []
+    for stream in (False, True):
+        ld = pipeline.load_source(src, "t.nc", "iso-m", stream=stream)
+        assert (ld.streamed is not None) == stream
+        ends.append([r.end for r in pipeline.toolpath_of(ld, machine)])
+    assert ends[0] == ends[1] == [{"X": 101.0, "Y": -49.0, "Z": 0.0}, {"X": 102.0, "Y": -49.0, "Z": 0.0}]
 
 
 def test_empty_program_reports_nc004_streamed_too():

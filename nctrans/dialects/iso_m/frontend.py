@@ -886,9 +886,14 @@ def parse_stream(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lo
 
     diags: list[Diagnostic] = DiagnosticList()
     program = Program(file, lowering.dialect, [], {}, {}, None)
-    opts = load_table(lowering.table_name).options
+    table = load_table(lowering.table_name)
+    opts = table.options
     if _control_flow_at(text, opts.get("eob_semicolon", "comment") != "eob") is not None:
         return None
+    # The interpreter reads the power-on modes when it starts, before the body is first iterated
+    # (which is when _parse_lines fills the rest of meta): without them a streamed program ran
+    # from no work offset while the full parse ran from G54.
+    program.meta["defaults"] = table.defaults()
     program.body = StreamedBody(_parse_lines(text, file, program, diags, [], True, lowering))
     return ParseResult(program, diags)
 
