@@ -163,6 +163,74 @@ def peaks(text: str, name: str) -> tuple[float, float]:
     return parse_peak / 2**20, interp_peak / 2**20
 
 
+# Issue #7 "Done when": the targets `targets()` prints its measurements against.
+TARGET_ISO_X10 = 0.35          # ISO program x10: CLI toolpath time / rs274 on the same file
+TARGET_SINUMERIK = 2.0         # the program as Sinumerik: CLI toolpath / rs274 on the ISO original
+TARGET_SINUMERIK_MEMORY = 1.5  # Sinumerik x10 / x1: peak resident memory of the CLI toolpath
+
+
+def conditions() -> str:
+    """What the machine was doing: the numbers are wall times on a shared machine."""
+    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    return f"{os.cpu_count()} cores, load average {load}"
+
+
+def targets(base: Path, repeat: int, tmp: Path) -> None:
+    """The issue #7 targets in one run, side by side with rs274: the ISO program repeated ten
+    times; the same program written as Sinumerik (nctrans convert --to sinumerik: `;` comments,
+    G74 homing, tool length from D) against rs274 on the ISO original; the Sinumerik program's
+    peak memory at 10x against 1x; and the per-file start-up of `lint` on a small Sinumerik file."""
+    text = read_text(base)
+    iso = {1: base, 10: tmp / "target-x10.nc"}
+    iso[10].write_text(repeated(text, 10))
+    sin = {}
+    for times, path in iso.items():
+        sin[times] = tmp / f"target-x{times}.mpf"
+        subprocess.run(NCTRANS + ["convert", str(path), "--from", "iso-m", "--to", "sinumerik", "-o",
+                                  str(sin[times]), "--overwrite"], stdout=subprocess.DEVNULL,
+                       stderr=subprocess.DEVNULL)
+    rows = []
+
+    def toolpath(path: Path, dialect: str):
+        t, rc = wall(NCTRANS + ["toolpath", str(path), "--from", dialect, "--format", "jsonl"], repeat)
+        return t if rc < 2 else None
+
+    def ratio(a, b):
+        return a / b if a is not None and b else None
+
+    iso10, rs10 = toolpath(iso[10], "iso-m"), rs274_time(iso[10], repeat, tmp)
+    rows.append((f"ISO x10 ({iso[10].read_text().count(chr(10))} lines): toolpath s", iso10, rs10,
+                 ratio(iso10, rs10), TARGET_ISO_X10))
+    rs1 = rs274_time(base, repeat, tmp)
+    iso1 = toolpath(base, "iso-m")
+    rows.append(("ISO x1: toolpath s", iso1, rs1, ratio(iso1, rs1), None))
+    if sin[1].exists():
+        s1 = toolpath(sin[1], "sinumerik")
+        rows.append(("Sinumerik x1: toolpath s (rs274: ISO x1)", s1, rs1, ratio(s1, rs1), TARGET_SINUMERIK))
+    mem = {}
+    for times, path in sin.items():
+        if path.exists():
+            peaks_ = [peak_rss(NCTRANS + ["toolpath", str(path), "--from", "sinumerik", "--format", "jsonl",
+                                          ])[0] for _ in range(max(1, min(repeat, 3)))]
+            mem[times] = min(peaks_)
+    if len(mem) == 2:
+        rows.append(("Sinumerik toolpath max RSS MiB: x10 vs x1", mem[10], mem[1], ratio(mem[10], mem[1]),
+                     TARGET_SINUMERIK_MEMORY))
+    small = STARTUP_PROGRAM
+    if small.exists():
+        t, rc = wall(NCTRANS + ["lint", str(small)], repeat)
+        floor, _ = wall([sys.executable, "-c", "pass"], repeat)
+        rows.append((f"lint start-up, {small.name} ({read_text(small).count(chr(10))} lines) s "
+                     "(vs python -c pass)", t if rc < 2 else None, floor, None, None))
+    print(f"issue #7 targets on {base.name} ({conditions()}; best of {repeat})")
+    print(f"{'measure':58} {'nctrans':>8} {'rs274':>8} {'ratio':>6} {'target':>7} {'met':>4}")
+    for label, ours, theirs, r, target in rows:
+        met = "" if target is None or r is None else ("yes" if r <= target else "NO")
+        print(f"{label[:58]:58} {fmt(ours, '.3f'):>8} {fmt(theirs, '.3f'):>8} {fmt(r, '.2f'):>6} "
+              f"{'' if target is None else '<=' + format(target, 'g'):>7} {met:>4}")
+    print()
+
+
 def fmt(v, spec=",.0f"):
     return "n/a" if v is None else format(v, spec)
 
@@ -171,6 +239,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="runs per measurement; the best is shown")
     ap.add_argument("--peak", nargs=2, metavar=("PROGRAM", "TIMES"), help=argparse.SUPPRESS)
+    ap.add_argument("--targets", action="store_true", help="only the issue #7 targets (first program)")
     ap.add_argument("programs", nargs="*", help="programs (default: the three largest iso-mill ones)")
     args = ap.parse_args(argv)
     if args.peak:                                   # child process of the memory measurement
@@ -189,7 +258,11 @@ def main(argv=None) -> int:
         print(f"no programs found (corpus expected at {CORPUS})")
         return 0
     print(f"python {sys.version.split()[0]}, rs274 {'found' if Path(RS274).exists() else 'missing'}, "
-          f"best of {args.repeat}; lines/s = source lines / seconds")
+          f"best of {args.repeat}; lines/s = source lines / seconds; {conditions()}")
+    with tempfile.TemporaryDirectory() as d:
+        targets(paths[0], args.repeat, Path(d))
+    if args.targets:
+        return 0
     head = (f"{'program':34} {'lines':>6} {'records':>8} {'lint l/s':>10} {'toolpath l/s':>12} {'stream l/s':>10} "
             f"{'py strm l/s':>11} "
             f"{'CLI lint s':>10} {'CLI tp s':>9} {'CLI tp l/s':>10} {'rs274 s':>8} {'CLI/rs274':>9}")
