@@ -259,3 +259,67 @@ def test_g72_facing_levels_and_g73_pattern_passes():
         want += [("rapid", 10.0 + od, 2.0), ("linear", 10.0 + od, -10.0), ("linear", 20.0 + od, -10.0)]
         want += ([("rapid", 20.0, -10.0)] if od else []) + [("rapid", 20.0, 2.0)]
     assert moves(recs, 16) == want
+
+
+def test_g71_type2_pockets_roughed_level_by_level_then_each_pocket():
+    """corpus/iso-t/g71-type2-pockets.nc, worked out in radius from its contour: the boundary X
+    (radius) at each Z is 10 to Z-5, 18 to Z-8, falls to 12 at Z-12, 12 to Z-15, 19 to Z-18, falls to
+    11 at Z-22, 11 to Z-25. A level passes where the boundary is at or below it."""
+    recs, diags = run(CONF / "g71-type2-pockets.nc")
+    assert [(d.rule, d.severity) for d in diags] == [("NC231", "info")]
+
+    def outer(x, z_stop):
+        return level(x, z_stop, 0.5, 2.0)
+
+    def pocket_level(x, z_from, z_to):     # plunge at the entry wall, cut, 45-degree retract
+        return [("linear", x, z_from), ("linear", x, z_to), ("rapid", x + 0.5, z_to + 0.5)]
+    want = outer(18.0, -15.0) + outer(16.0, -5.0) + outer(14.0, -5.0) + outer(12.0, -5.0)
+    # pocket 1: 18 - 1.5 * (-8 - z) = 16 at z = -9.333333, = 14 at -10.666667; X12 runs on its floor
+    want += [("rapid", 20.0, 2.0), ("rapid", 20.0, -9.333333), ("rapid", 18.5, -9.333333)]
+    want += pocket_level(16.0, -9.333333, -15.0) + [("rapid", 16.5, -10.666667)]
+    want += pocket_level(14.0, -10.666667, -15.0) + [("rapid", 14.5, -12.0)]
+    want += pocket_level(12.0, -12.0, -15.0)
+    # pocket 2: 19 - 2 * (-18 - z) = 18 at z = -18.5, 16 at -19.5, 14 at -20.5, 12 at -21.5
+    want += [("rapid", 20.0, -14.5), ("rapid", 20.0, -18.5)]
+    want += pocket_level(18.0, -18.5, -25.0) + [("rapid", 18.5, -19.5)]
+    want += pocket_level(16.0, -19.5, -25.0) + [("rapid", 16.5, -20.5)]
+    want += pocket_level(14.0, -20.5, -25.0) + [("rapid", 14.5, -21.5)]
+    want += pocket_level(12.0, -21.5, -25.0)
+    want += [("rapid", 20.0, -24.5), ("rapid", 20.0, 2.0)]
+    contour = [("rapid", 10.0, 2.0), ("linear", 10.0, -5.0), ("linear", 18.0, -5.0), ("linear", 18.0, -8.0),
+               ("linear", 12.0, -12.0), ("linear", 12.0, -15.0), ("linear", 19.0, -15.0),
+               ("linear", 19.0, -18.0), ("linear", 11.0, -22.0), ("linear", 11.0, -25.0),
+               ("linear", 20.0, -25.0)]
+    assert moves(recs, 12) == want + contour + [("rapid", 20.0, 2.0)]
+    # G70 runs the contour as programmed from the start point, then returns there
+    assert moves(recs, 24) == [("rapid", 20.0, 2.0)]
+
+
+def test_type2_contour_must_be_monotonic_in_z():
+    text = ("G18 G21 G99\nT0101\nG00 X40. Z2.\nG71 P10 Q20 U0 W0 D2. F0.2\nN10 G00 X20. Z2.\n"
+            "G01 Z-10.\nX30. Z-5.\nZ-20.\nN20 X40.\nM30\n")
+    recs, diags = run(Path("bad2.nc"), text)
+    bad = [d for d in diags if d.rule == "NC230"]
+    assert bad and bad[0].line == 7 and "monotonic in Z" in bad[0].message
+    assert not [r for r in recs if r.line == 4 and r.kind == "linear"]
+
+
+def test_g72_type2_face_groove_is_roughed_after_the_outer_levels():
+    """G72 type II: the levels step in Z, the passes run along X. Radius: start (X20, Z2); face at
+    Z-6 out to X16, a shoulder up to Z-2 from X16 to X13, a groove down to Z-5 from X13 to X11.
+    Levels Z0 and Z-2 pass over everything (Z-2 along the shoulder's top) to X11; Z-4 stops at the
+    shoulder (X16); the groove is then cut at Z-4 from X13 to X11."""
+    text = ("G18 G21 G99\nT0101\nG00 X40. Z2.\nG72 W2. R0.5\nG72 P10 Q20 U0 W0 F0.2\n"
+            "N10 G00 X40. Z-6.\nG01 X32.\nZ-2.\nX26.\nZ-5.\nX22.\nN20 Z2.\nM30\n")
+    recs, diags = run(Path("g72.nc"), text)
+    assert [(d.rule, d.line) for d in diags] == [("NC231", 10)]
+
+    def face(z, x_stop):
+        return [("rapid", 20.0, z), ("linear", x_stop, z), ("rapid", x_stop + 0.5, z + 0.5),
+                ("rapid", 20.0, z + 0.5)]
+    want = face(0.0, 11.0) + face(-2.0, 11.0) + face(-4.0, 16.0)
+    want += [("rapid", 20.0, 2.0), ("rapid", 13.0, 2.0), ("rapid", 13.0, -1.5), ("linear", 13.0, -4.0),
+             ("linear", 11.0, -4.0), ("rapid", 11.5, -3.5), ("rapid", 11.5, 2.0), ("rapid", 20.0, 2.0)]
+    want += [("rapid", 20.0, -6.0), ("linear", 16.0, -6.0), ("linear", 16.0, -2.0), ("linear", 13.0, -2.0),
+             ("linear", 13.0, -5.0), ("linear", 11.0, -5.0), ("linear", 11.0, 2.0), ("rapid", 20.0, 2.0)]
+    assert moves(recs, 5) == want

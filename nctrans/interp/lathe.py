@@ -366,7 +366,15 @@ class LatheMixin:
         contour = [conv(m) for m in rest]
         type2 = vals.get("type") == 1.0 or _both_axes(first_blk)
         bad = turning.first_non_monotonic(app[1], contour)
-        axis = "Z" if swap else "X"
+        axis, along = ("Z", "X") if swap else ("X", "Z")
+        if type2 and kind != "pattern_repeat":
+            inner = turning.inside_stock(a, app[1], contour)
+            back = turning.first_non_monotonic((app[1][1], app[1][0]), turning.swapped(inner))
+            if back is not None:
+                self.diag("NC230", "error", f"{code} type II contour turns back in {along} here: "
+                          f"the profile must be monotonic in {along}; the control alarms",
+                          rest[back][5])
+                return False
         if bad is not None and kind != "pattern_repeat":
             where = rest[bad][5]
             if not type2:
@@ -374,9 +382,9 @@ class LatheMixin:
                           "here: the control alarms (type II needs both X and Z in the P block)",
                           where)
                 return False
-            self.diag("NC231", "warning", f"{code} type II contour turns back in {axis}: its "
-                      "pockets are cut only by the final contour pass (nctrans does not model type II "
-                      "pocket roughing)", where)
+            self.diag("NC231", "info", f"{code} type II contour with pockets: each pocket is roughed "
+                      "level by level after the outer levels; the moves between pockets are nctrans's "
+                      "model", where)
         dd, dp_ = (allow_z, allow_x) if swap else (allow_x, allow_z)
         shifted_contour = turning.shifted(contour, dd, dp_)
         app_end = (app[1][0] + dd, app[1][1] + dp_)
@@ -402,7 +410,11 @@ class LatheMixin:
                 return False
             retract = first.get("retract")
             retract = retract * L if retract is not None else float(opts.get("rough_retract_mm", 0.5))
-            out.extend(turning.rough_levels(a, app_end, shifted_contour, depth * L, retract))
+            if bad is not None:                     # type II with pockets
+                inner = turning.inside_stock(a, app_end, shifted_contour)
+                out.extend(turning.rough_pockets(a, app_end, inner, depth * L, retract))
+            else:
+                out.extend(turning.rough_levels(a, app_end, shifted_contour, depth * L, retract))
             out.append((app[0] if app[0] != "arc" else "linear", app_end, None, None))
             out.extend(shifted_contour)
             out.extend(turning.return_to(a, out[-1][1]))

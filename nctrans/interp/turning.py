@@ -132,6 +132,150 @@ def rough_levels(start, approach_end, contour, depth: float, retract: float):
     return out
 
 
+def swapped(moves):
+    """The moves with d and p exchanged (a mirror: arcs turn the other way)."""
+    return [(k, (e[1], e[0]), None if c is None else (c[1], c[0]), None if cw is None else not cw)
+            for k, e, c, cw in moves]
+
+
+def _extreme(start, moves, sd: float) -> float:
+    """The d furthest in direction sd along the moves (arcs sampled)."""
+    best = start[0]
+    cur = start
+    for kind, end, center, cw in moves:
+        pts = arc_points(cur, end, center, cw, 64) if kind == "arc" and center is not None else [end]
+        for d, _ in pts:
+            if sd * (d - best) > 0:
+                best = d
+        cur = end
+    return best
+
+
+def inside_stock(start, approach_end, moves) -> list:
+    """The contour without its trailing moves that run on or outside the start side d = d0 (a
+    return along the stock line, as CAM output writes before Q): they bound no material."""
+    d0 = start[0]
+    sd = _sign(approach_end[0] - d0)
+    out = list(moves)
+    while len(out) > 1:
+        before = out[-2][1]
+        if sd * (out[-1][1][0] - d0) > 1e-9 or sd * (before[0] - d0) > 1e-9:
+            break
+        out.pop()
+    return out
+
+
+def material_intervals(start, boundary, level: float, sd: float) -> list[tuple[float, float]]:
+    """The p intervals where a pass along d = level stays out of the part: the boundary (approach +
+    contour, monotonic in p) is at the level or beyond it, from the start's p to the contour's end.
+    A level that runs along a shoulder or a pocket floor passes over it."""
+    p0 = start[1]
+    pb = boundary[-1][1][1]
+    sp = _sign(pb - p0)
+    cuts = {p0, pb}
+    cuts.update(p for p in hits(start, boundary, level) if sp * (p - p0) > EPS and sp * (pb - p) > EPS)
+    ordered = sorted(cuts, key=lambda p: sp * (p - p0))
+    across = swapped(boundary)
+    flipped = (start[1], start[0])
+    out: list[tuple[float, float]] = []
+    for u, v in zip(ordered, ordered[1:]):
+        if abs(v - u) < 1e-7:
+            continue
+        ds = hits(flipped, across, (u + v) / 2)
+        if not ds or sd * (ds[0] - level) < -1e-7:     # the part stands above the level here
+            continue
+        if out and abs(out[-1][1] - u) < 1e-7:
+            out[-1] = (out[-1][0], v)
+        else:
+            out.append((u, v))
+    return out
+
+
+def rough_pockets(start, approach_end, contour, depth: float, retract: float):
+    """G71/G72 type II roughing: a contour monotonic in p that may turn back in d (pockets).
+
+    Levels step from d0 by `depth` down to the contour's deepest point. At each level the material
+    is a set of p intervals (material_intervals); an interval at one level lies inside one interval
+    of the level before, so they form a tree. First the intervals that start at the start point's p
+    are cut level after level, exactly as type I. Then each pocket, nearest the start first: from
+    d0 down over its entry side to the level above it (cut air), plunge at the entry wall, cut to
+    the exit wall, retract 45 degrees by `retract`, and so on into the deeper intervals inside it,
+    each reached at the height of the retract above them (air just cut); back out to d0 between
+    pockets and finally to the start point. The approach and link moves are nctrans's model: the
+    cutting levels are the control's, its moves between them vary by make and parameter."""
+    d0, p0 = start
+    if not contour or depth <= 0:
+        return []
+    boundary = [("linear", approach_end, None, None)] + list(contour)
+    sd = _sign(approach_end[0] - d0)
+    sp = _sign(contour[-1][1][1] - p0)
+    bottom = _extreme(start, boundary, sd)
+    levels = []
+    k = 1
+    while sd * (d0 + sd * k * depth - bottom) < -1e-9:
+        level = d0 + sd * k * depth
+        levels.append((level, material_intervals(start, boundary, level, sd)))
+        k += 1
+
+    def height(i):                      # just above level i (i = -1: the start side d0)
+        return d0 if i < 0 else levels[i][0] - sd * retract
+
+    out: list = []
+
+    def rapid(pt):
+        here = out[-1][1] if out else start
+        if abs(here[0] - pt[0]) > EPS or abs(here[1] - pt[1]) > EPS:
+            out.append(("rapid", pt, None, None))
+
+    def cut(i, u, v):
+        level = levels[i][0]
+        out.append(("linear", (level, u), None, None))
+        out.append(("linear", (level, v), None, None))
+        back = min(retract, abs(v - u))          # the retract stays over the slab just cut
+        rapid((level - sd * retract, v - sp * back))
+
+    def inside(i, u, v):
+        return [iv for iv in levels[i][1] if sp * (iv[0] - u) > -1e-7 and sp * (v - iv[1]) > -1e-7]
+
+    main = []                           # (level index, end) of the intervals at the start side
+    for i, (level, ivs) in enumerate(levels):
+        if ivs and abs(ivs[0][0] - p0) < 1e-7:
+            main.append((i, ivs[0][1]))
+    for i, v in main:
+        rapid((levels[i][0], p0))
+        out.append(("linear", (levels[i][0], v), None, None))
+        rapid((levels[i][0] - sd * retract, v - sp * retract))
+        rapid((levels[i][0] - sd * retract, p0))
+
+    def descend(i, u, v):
+        for cu, cv in (inside(i + 1, u, v) if i + 1 < len(levels) else []):
+            rapid((height(i), out[-1][1][1]))
+            rapid((height(i), cu))
+            cut(i + 1, cu, cv)
+            descend(i + 1, cu, cv)
+
+    mains = dict(main)
+    roots = []
+    for i, (level, ivs) in enumerate(levels):
+        for u, v in ivs:
+            if abs(u - p0) < 1e-7:
+                continue
+            parent_main = i == 0 or (i - 1 in mains and sp * (mains[i - 1] - v) > -1e-7)
+            if parent_main:
+                roots.append((u, i, v))
+    for u, i, v in sorted(roots, key=lambda r: (sp * (r[0] - p0), r[1])):
+        here = out[-1][1] if out else start
+        rapid((d0, here[1]))
+        rapid((d0, u))
+        rapid((height(i - 1), u))
+        cut(i, u, v)
+        descend(i, u, v)
+    if roots:
+        rapid((d0, out[-1][1][1]))
+        rapid((d0, p0))
+    return out
+
+
 def return_to(point, current):
     """Back to the cycle start: across in d first (away from the part), then along p."""
     out = []
