@@ -508,7 +508,7 @@ static PyObject *run(PyObject *self, PyObject *args)
     }
     /* the plane's axes (first, second, normal) as positions in `axes`, and which centre word
      * (I J K index) belongs to each of the first two; -1 when the position lacks the axis */
-    int pa[3] = {-1, -1, -1}, pc[2] = {-1, -1};
+    int pa[3] = {-1, -1, -1}, pc[2] = {-1, -1}, pn = -1;
     if (plane_len == 2) {
         const char *normal = strcmp(plane, "XY") == 0 ? "Z" : strcmp(plane, "ZX") == 0 ? "Y" : "X";
         const char names[3] = {plane[0], plane[1], normal[0]};
@@ -518,6 +518,7 @@ static PyObject *run(PyObject *self, PyObject *args)
         }
         pc[0] = plane[0] - 'X';         /* X->I, Y->J, Z->K */
         pc[1] = plane[1] - 'X';
+        pn = normal[0] - 'X';           /* the centre word along the normal: the control rejects it */
     }
     int arcs_ok = pa[0] >= 0 && pa[1] >= 0 && pa[2] >= 0 && pc[0] >= 0 && pc[0] < 3 && pc[1] >= 0
                   && pc[1] < 3;
@@ -580,6 +581,8 @@ static PyObject *run(PyObject *self, PyObject *args)
                 break;                  /* another mode, or a feed move without feed */
             if (arc && (!b.nijk || !arcs_ok))
                 break;                  /* radius format, or an arc without centre: Python */
+            if (arc && pn >= 0 && pn < 3 && b.ijk_len[pn] != 0)
+                break;                  /* a centre word off the plane: Python reports it (NC210) */
             memcpy(tgt, prog, sizeof prog);
             for (int k = 0; k < MAX_AXES && !bail; k++) {
                 if (b.axis_len[k] == 0)

@@ -148,6 +148,16 @@ class Mesh:
 
 
 @dataclass
+class ToolChange:
+    """What the machine's tool change (its M6 macro) expects and does: lint NC213 reports a change
+    while something in `requires_stopped` runs; `stops_spindle` (None: the dialect's default) makes
+    a feed move before the spindle is started again NC209."""
+    __pydantic_config__ = {"extra": "forbid"}
+    requires_stopped: list[Literal["spindle", "coolant"]] = field(default_factory=list)
+    stops_spindle: Optional[bool] = None
+
+
+@dataclass
 class Machine:
     __pydantic_config__ = _OPEN
     name: str = "default"
@@ -170,6 +180,7 @@ class Machine:
     variables: dict[str, float] = field(default_factory=dict)
     source_dir: Optional[str] = None
     tool_change_s: Optional[float] = None   # seconds per tool change (cycle time)
+    tool_change: Optional[ToolChange] = None
 
     def __post_init__(self) -> None:
         self.axes = {k.upper(): v for k, v in self.axes.items()}

@@ -119,7 +119,8 @@ def test_config_machine_is_relative_to_the_file(shop, capsys):
         'name = "m"\nkind = "mill"\n[axes.X]\nkind = "linear"\nmin = 0.0\nmax = 1.0\n'
         '[[tools]]\nnumber = 1\nlength = 10.0\nradius = 3.0\n')
     (shop / "nctrans.toml").write_text('machine = "cfg/vmc.toml"\n')
-    (shop / "a.nc").write_text("G17 G0 X0 Y0\nT1 M6\nS1000 M3\nG41 D1 G2 X10 Y10 R10 F100\nG40 G1 X0 Y0\nM30\n")
+    # an entry move of 2 mm: too short only for a tool of radius 3, which the configured machine has
+    (shop / "a.nc").write_text("G17 G0 X0 Y0\nT1 M6\nS1000 M3\nG41 D1 G1 X2 Y0 F100\nG1 X20\nG40 G1 X30 Y-10\nM30\n")
     assert (4, "NC204") in lint(capsys, "a.nc")[1]            # the configured tool has a radius
     os.remove(shop / "cfg" / "vmc.toml")
     assert lint(capsys, "a.nc")[0] == 2

@@ -11,7 +11,7 @@ Behaviour is LinuxCNC 2.9 rs274 (the judge; tests/test_cutter_comp.py compares w
   the normal of the entry move itself; the entry move starts at the uncompensated position. The
   corner with the next move is then treated like any other corner. An arc as the first move is
   allowed by LinuxCNC (its centre is moved so that the arc starts at the current point); the ISO
-  spec (iso.md §4.20, L2098-2102) forbids it, which the interpreter reports itself (NC204).
+  spec (iso.md §4.20, L2098-2102) forbids it, which the interpreter reports itself (NC212).
 - Convex corners (angle > 0.05 rad, LinuxCNC TOLERANCE_CONCAVE_CORNER) get an arc of the tool
   radius around the programmed corner (like Sinumerik G450); for a rapid the arc is replaced by a
   straight rapid to the arc's end. The corner arc carries the later move's rotary-axis ends and the
@@ -116,9 +116,7 @@ class CutterCompensator:
     def finish(self, item=None) -> list:
         out = self._flush()
         if isinstance(item, PlannedMove):
-            if item.kind == "arc":
-                self._problem(item.payload, "The move just after exiting cutter compensation mode must "
-                                            "be straight, not an arc")
+            # an arc here is reported by the interpreter (NC212, run_checks), radius known or not
             start = dict(self._cur) if self._cur is not None else dict(item.start)
             out.append(replace(item, start=start, end=dict(item.end)))
         elif item is not None:

@@ -40,6 +40,7 @@ from nctrans.interp.evaluate import (UNKNOWN, AxisName, EvalError, Evaluator, Fr
                                      constant)
 from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
+from nctrans.interp.run_checks import RunChecks
 from nctrans.interp.state import LINEAR_AXES, ModalState
 from nctrans.interp import sysvars, unmodelled
 from nctrans.ir import nodes as n
@@ -158,7 +159,7 @@ def _default_cutting_edge(dialect) -> int:
         return 0
 
 
-class Interpreter(LatheMixin):
+class Interpreter(LatheMixin, RunChecks):
     def __init__(self, program: n.Program, machine=None, *, diagnostics: list, resolver=None,
                  max_steps: int = 2_000_000, flatten_hook=None, preload=(), fast_sink=None):
         if machine is None:
@@ -218,6 +219,7 @@ class Interpreter(LatheMixin):
         self._unmodelled_at = None                          # the span of the block that set it
         self.stack: list[Frame] = []
         self.span: Optional[n.Span] = None
+        self._rc_init()                 # run_checks: NC210-NC214
         self._register_system()
         for prog in preload or ():
             self._preload(prog)
@@ -513,6 +515,8 @@ class Interpreter(LatheMixin):
 
     def _move(self, kind: str, end: dict[str, float], center=None, cw=None, turns=None) -> None:
         """Emit a move from the current program point to `end` (program coords); update position."""
+        if self.watch and self.capture is None:
+            self._rc_move(kind, end)
         start = self.pos
         self.pos = end
         if self.capture is not None:            # reading a turning contour: no motion
@@ -606,9 +610,6 @@ class Interpreter(LatheMixin):
             r = self.comp_radius
             if r < 0:           # a negative stored radius swaps the side
                 side, r = ("right" if side == "left" else "left"), -r
-            if kind == "arc":
-                self.diag("NC204", "error", "cutter compensation starts on an arc; the first "
-                          "move after G41/G42 must be a rapid or linear move")
             self.comp = self._compensator(side, r)     # lathe.py: the tool-nose tip
         self._comp_out(self.comp.push(pm))
         return True
@@ -653,6 +654,7 @@ class Interpreter(LatheMixin):
     def _h_mode(self, s: n.ModeChange):
         st = self.st
         g, v = s.group, s.value
+        self._rc_mode(g, v)
         if g == "motion":
             if st.cycle != "off":
                 self._cycle_off()
@@ -737,6 +739,7 @@ class Interpreter(LatheMixin):
         st = self.st
         st.feed = v if st.feed_mode == "inverse_time" else v * st.scale
         self.feed_reported = False
+        self._rc_feed_set()
 
     def _c_speed(self, s: n.SpindleSpeed):
         return (self._h_speed, self.ev.compile(s.value))
@@ -785,6 +788,7 @@ class Interpreter(LatheMixin):
 
     def _h_toolchange(self, s):
         st = self.st
+        self._rc_tool_change()
         if st.tool_selected is None:
             self.diag("NC105", "warning", "tool change without a selected tool")
         st.tool = st.tool_selected
@@ -979,7 +983,7 @@ class Interpreter(LatheMixin):
         if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
                 or self.comp_exit or st.comp_side != "off" or not self.frame.identity
                 or self.unmodelled_motion is not None or st.diameter
-                or self.css_surface is not None or self.spindle_stopped):
+                or self.css_surface is not None or self.spindle_stopped or self.watch):
             return self._slow(d)
         motion = st.motion
         if motion == "rapid":
@@ -1082,7 +1086,7 @@ class Interpreter(LatheMixin):
             self.diag("NC202", "error", "feed move with no feed rate programmed")
         if self.spindle_stopped and not self.spindle_reported:
             self.spindle_reported = True
-            self.diag("NC209", "warning", "feed move while the spindle is stopped (M5): the tool "
+            self.diag("NC209", "warning", "feed move while the spindle is stopped (M5, or a tool change that stops it): the tool "
                       "would rub or break; start the spindle (M3/M4) before cutting")
 
     def _polar(self, vals, polar):
@@ -1229,6 +1233,8 @@ class Interpreter(LatheMixin):
         s1, s2 = start.get(a1, 0.0), start.get(a2, 0.0)
         e1, e2 = end.get(a1, 0.0), end.get(a2, 0.0)
         inch = st.scale != 1.0
+        if center:
+            self._rc_arc(center)
         nturns = 0
         if turns is not None:
             t = self._value(turns, "turns")
@@ -1318,6 +1324,7 @@ class Interpreter(LatheMixin):
         if missing:
             self.diag("NC206", "error", f"canned cycle without {' and '.join(missing)}")
             return
+        self._rc_cycle()
         initial = self.cycle_initial if self.cycle_initial is not None else self.pos.get(ax, 0.0)
         if st.incremental:
             zr = initial + p["r_plane"]
@@ -1461,6 +1468,7 @@ class Interpreter(LatheMixin):
             self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
             return
         approach, bottom, retract = plane_cycle_levels(params, current=self.pos.get(ax, 0.0))
+        self._rc_cycle()
         steps = None
         if hole is not None and any(abs(hole.get(a, 0.0) - self.pos.get(a, 0.0)) > 0
                                     for a in PLANE_AXES[st.plane][:2]):
@@ -1995,7 +2003,7 @@ class Interpreter(LatheMixin):
                 or self.comp is not None or self.comp_exit or st.comp_side != "off"
                 or not self.frame.identity or self.modal_call is not None or self.hook is not None
                 or st.feed_mode not in ("per_min", "per_rev") or self.out
-                or self.unmodelled_motion is not None or self.spindle_stopped):
+                or self.unmodelled_motion is not None or self.spindle_stopped or self.watch):
             return False
         axes = "".join(self.pos)
         return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)
@@ -2031,6 +2039,7 @@ class Interpreter(LatheMixin):
             if feed_seen:
                 st.feed = feed
                 self.feed_reported = False
+                self._rc_feed_scale = st.scale
             if records:
                 if write:
                     self.out.append(JsonChunk(chunk, records))
