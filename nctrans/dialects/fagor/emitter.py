@@ -20,6 +20,7 @@ from typing import Any, Optional
 
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.dialects.base import EmitResult
+from nctrans.dialects.base import get as get_dialect
 from nctrans.ir import nodes as n
 from nctrans.ir import walk as ir_walk
 from nctrans.rules import load_table
@@ -260,8 +261,42 @@ class _Emitter:
         self.in_sub = False
         self._reset()
         self.out.append(f"%{_program_header(p)}")
+        self.prologue()
         self.nodes(p.body)
         return "\n".join(self.out) + "\n"
+
+    def prologue(self) -> None:
+        """The source controller's power-on modes that change what the words mean, where Fagor's
+        differ (an ISO lathe: G18, G95 feed per revolution, diameter X). A lathe program says G151
+        or G152 whatever it relies on: a Fagor lathe starts in G151 on its DIAMPROG axes."""
+        p = self.program
+        if p.dialect == DIALECT:
+            return
+        source = dict((p.meta or {}).get("defaults") or {})
+        try:
+            lathe = get_dialect(p.dialect).machine_kind == "lathe"
+        except Exception:           # a dialect not registered here (a test's): no lathe defaults
+            lathe = False
+        if lathe:
+            source.setdefault("diameter", "radius")
+        mine = self.table.defaults()
+        words = []
+        # a flattened program selects its own modes in its first block (radius X, though)
+        groups = ("diameter",) if (p.meta or {}).get("flattened_from") else (
+            "units", "plane", "feed_mode", "diameter")
+        for group in groups:
+            value = source.get(group)
+            if value is None or (mine.get(group) == value and not (lathe and group == "diameter")):
+                continue
+            rule = self.table.code_for(group, value)
+            if rule is not None and rule.group == group:
+                words.append(_g(rule.code))
+                if group == "plane":
+                    self.plane = value
+        if words:
+            self.span = n.Span(p.file, 1)
+            self.lowered(f"power-on modes of {p.dialect} written out: {' '.join(words)}")
+            self.out.append(" ".join(words))
 
     def _reset(self) -> None:
         self.motion = None
@@ -409,6 +444,9 @@ class _Emitter:
                 word("", f"S{s.spindle}={sp.expr(s.value)}")
             else:
                 word("S", "S" + val(s.value))
+        elif t is n.SpindleLimit:
+            word("G192", "G192")
+            word("S", "S" + val(s.value))
         elif t is n.ToolSelect:
             word("T", "T" + val(s.tool))
         elif t is n.ToolChange:

@@ -53,7 +53,7 @@ SIMPLE_GROUPS = {
     "feed_mode": B_FEEDMODE, "spindle_mode": B_SPMODE, "spindle": B_SPINDLE, "coolant": B_COOLANT,
     "plane": B_PLANE, "units": B_UNITS, "cutter_comp": B_COMP, "path_mode": B_PATH,
     "exact_stop_once": B_PATH, "arc_distance": B_DIST, "distance": B_DIST,
-    "cycle_retract": B_RETRACT, "work_offset": B_WCS, "corner": B_PATH,
+    "cycle_retract": B_RETRACT, "work_offset": B_WCS, "corner": B_PATH, "diameter": B_UNITS,
 }
 # functions: Fagor name -> neutral IR name (SQR is the square, spec §6.6)
 FUNCS = {"SIN": "sin", "COS": "cos", "TAN": "tan", "ASIN": "asin", "ACOS": "acos", "ATAN": "atan",
@@ -344,7 +344,7 @@ class Lowerer:
         motion_g = None
         arc_once = None
         frame = None
-        home = setpos = dwell = soft = pole = shift = False
+        home = setpos = dwell = soft = pole = shift = limit = False
         unmodelled = []
         for rule, code, eq in w.gs:
             g, v = rule.group, rule.value
@@ -402,6 +402,8 @@ class Lowerer:
                 shift = True
             elif g == "call":
                 pass
+            elif g == "spindle_limit":
+                limit = True                      # G192 S<rpm>: the S word is the limit
             elif g == "dynamics":
                 out.append((B_NONMODAL, ir.Passthrough(code, NO_PATH_EFFECT, DIALECT)))
             else:        # unmodelled
@@ -447,6 +449,8 @@ class Lowerer:
             out.append((B_FEED, ir.Feed(vals.pop("F"))))
         if frame is not None and frame[1] == "scale" and "S" in vals:
             pass                                  # G72 S<f>: S is the factor
+        elif limit and "S" in vals:
+            out.append((B_SPEED, ir.SpindleLimit(vals.pop("S"))))
         elif "S" in vals:
             out.append((B_SPEED, ir.SpindleSpeed(vals.pop("S"))))
         for name in list(w.numbered):

@@ -31,6 +31,9 @@ class TurningEmitter(iso.IsoEmitter):
         if s.group == "distance":
             self.distance = s.value
             return []                   # system A: incremental words are U/W
+        if s.group == "tool_length" and s.value in ("plus", "off"):
+            self.lowered("tool length offset on/off: a lathe applies the offset the T word names")
+            return []
         return super().w_ModeChange(s)
 
     def _axes(self, target: dict) -> list:
