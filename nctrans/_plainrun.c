@@ -123,8 +123,32 @@ static int motion_g(const char *s, int len)
     return whole <= 3 ? (int)whole : -1;
 }
 
-/* Parse a cleaned line into words: 1 when the block is plain (what Lowering.hot takes), else 0. */
-static int parse_block(const char *buf, int n, Block *b)
+/* Strict scanning (dialects whose words are separated, such as Sinumerik: `X1 Y2`, never `X1Y2`):
+ * the raw line text[p:q) has no blank between an address letter and its number and no letter
+ * right after a number (`G1X10`), so cleaning it changes no word. 1 when it is so. */
+static int words_separated(const Text *t, Py_ssize_t p, Py_ssize_t q)
+{
+    Py_UCS4 prev = ' ';
+    for (Py_ssize_t i = p; i < q; i++) {
+        Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
+        int letter = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z');
+        if (c == ' ' && ((prev >= 'A' && prev <= 'Z') || (prev >= 'a' && prev <= 'z')))
+            return 0;
+        if (letter && ((prev >= '0' && prev <= '9') || prev == '.'))
+            return 0;
+        prev = c;
+    }
+    return 1;
+}
+
+/* Longest number strict scanning takes: longer ones go to the front end, whose lexer checks their
+ * range. */
+#define STRICT_NUMBER 15
+
+/* Parse a cleaned line into words: 1 when the block is plain (what Lowering.hot takes), else 0.
+ * strict: also G and N numbers are unsigned integers (no point) and no number is longer than
+ * STRICT_NUMBER characters (what the Sinumerik front end reads as plain words). */
+static int parse_block_as(const char *buf, int n, Block *b, int strict)
 {
     memset(b, 0, sizeof *b);
     b->gmode = -1;
@@ -139,6 +163,10 @@ static int parse_block(const char *buf, int n, Block *b)
         int at = i + 1;
         int len = number_len(buf + at);
         if (len == 0)
+            return 0;
+        if (strict && (len > STRICT_NUMBER || ((letter == 'G' || letter == 'N')
+                                               && (memchr(buf + at, '.', (size_t)len) != NULL
+                                                   || buf[at] == '-' || buf[at] == '+'))))
             return 0;
         const char *ax = strchr(AXIS_LETTERS, letter);
         if (ax != NULL) {
@@ -177,6 +205,8 @@ static int parse_block(const char *buf, int n, Block *b)
     }
     return 1;
 }
+
+static int parse_block(const char *buf, int n, Block *b) { return parse_block_as(buf, n, b, 0); }
 
 /* float() of a word's number (copied out: the next letter may be an E, which strtod would read
  * as an exponent). */
@@ -241,18 +271,19 @@ static int plain_in_state(const Block *b, int *motion, int *cycle_off, int arc_a
     return 1;
 }
 
-/* scan(text, pos, sep, motion, cycle_off, arc_abs) -> (end, lines, blocks, motion)
+/* scan(text, pos, sep, motion, cycle_off, arc_abs[, strict]) -> (end, lines, blocks, motion)
  * The run of plain lines starting at pos, given the front end's static motion mode (a MOTION_*
  * code), whether no canned cycle is active and whether centres are absolute (G90.1): `end` is where the next line starts (len(text) + 1
  * when the run reaches the end of the text), `lines` how many lines it spans, `blocks` how many of
  * them are blocks (blank lines inside the run are not), `motion` the last G word's mode (-1:
- * none). The run never starts with a blank line. */
+ * none). The run never starts with a blank line. strict: see words_separated and parse_block_as
+ * (run() needs no flag: it only reads runs scan() gave). */
 static PyObject *scan(PyObject *self, PyObject *args)
 {
     PyObject *str;
     Py_ssize_t pos;
-    int sepc, motion, cycle_off, arc_abs;
-    if (!PyArg_ParseTuple(args, "UnCipp", &str, &pos, &sepc, &motion, &cycle_off, &arc_abs))
+    int sepc, motion, cycle_off, arc_abs, strict = 0;
+    if (!PyArg_ParseTuple(args, "UnCipp|p", &str, &pos, &sepc, &motion, &cycle_off, &arc_abs, &strict))
         return NULL;
     Text t;
     if (get_text(str, &t) < 0)
@@ -274,7 +305,8 @@ static PyObject *scan(PyObject *self, PyObject *args)
             blanks++;                  /* counted only if a block follows */
         } else {
             int n = clean_line(&t, p, q, buf);
-            if (n <= 0 || !parse_block(buf, n, &b) || !plain_in_state(&b, &motion, &cycle_off, arc_abs))
+            if (n <= 0 || (strict && !words_separated(&t, p, q)) || !parse_block_as(buf, n, &b, strict)
+                || !plain_in_state(&b, &motion, &cycle_off, arc_abs))
                 break;
             if (b.gmode >= 0)
                 last_g = b.gmode;
@@ -761,7 +793,7 @@ static PyObject *spell_py(PyObject *self, PyObject *arg)
 static PyMethodDef methods[] = {
     {"spell", spell_py, METH_O, "spell(v) -> the JSON spelling of v, or None where only repr() spells it"},
     {"scan", scan, METH_VARARGS,
-     "scan(text, pos, sep, motion, cycle_off, arc_abs) -> (end, lines, blocks, motion)"},
+     "scan(text, pos, sep, motion, cycle_off, arc_abs[, strict]) -> (end, lines, blocks, motion)"},
     {"run", run, METH_VARARGS, "run the plain blocks of a scanned run (see the module source)"},
     {NULL, NULL, 0, NULL},
 };

@@ -173,13 +173,24 @@ def decode(data: bytes, file: str = STDIN_LABEL) -> SourceText:
     return from_text(text, file, encoding)
 
 
+def _ascii_stray(text: str, chunk: int = 1 << 16) -> bool:
+    """Whether ASCII `text` holds a stray control character: bytes.translate (10x faster than
+    searching with _STRAY) a piece at a time, so that checking a long program copies none of it
+    whole (streamed parses keep memory flat)."""
+    for i in range(0, len(text), chunk):
+        piece = text[i:i + chunk]
+        if len(piece.encode("ascii").translate(None, _ASCII_STRAY)) != len(piece):
+            return True
+    return False
+
+
 def from_text(text: str, file: str = STDIN_LABEL, encoding: str = "utf-8") -> SourceText:
     """Normalise already-decoded text (newlines, stray controls, final newline) into a SourceText."""
     if "\r" in text:                           # CRLF and lone CR: what re.sub("\r\n?") does, faster
         text = text.replace("\r\n", "\n")
         if "\r" in text:
             text = text.replace("\r", "\n")
-    if not text.isascii() or len(text.encode("ascii").translate(None, _ASCII_STRAY)) != len(text):
+    if not text.isascii() or _ascii_stray(text):
         text = _STRAY.sub(" ", text)
     had_final = text.endswith("\n") or not text
     if not had_final:

@@ -11,7 +11,8 @@ from hypothesis import given, settings, strategies as st
 
 from nctrans import pipeline, source
 from nctrans.machine import Machine
-from nctrans.dialects.iso_m.frontend import StreamedBody, parse_program, parse_stream
+from nctrans.dialects.base import StreamedBody
+from nctrans.dialects.iso_m.frontend import parse_program, parse_stream
 
 ISO_MILL = Path(__file__).resolve().parents[1].parent / "shared" / "corpus" / "iso-mill"
 PROGRAMS = sorted(ISO_MILL.iterdir()) if ISO_MILL.is_dir() else []

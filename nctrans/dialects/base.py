@@ -47,6 +47,23 @@ class EmitResult:
     diagnostics: list[Diagnostic] = field(default_factory=list)
 
 
+class StreamedBody:
+    """The main body of a streamed Program (Dialect.parse_stream): iterating it parses the next
+    blocks, once. The interpreter runs each block as it comes and drops it; `drain()` parses what
+    is left (after a program end) so that the diagnostics match a full parse."""
+    __slots__ = ("_blocks",)
+
+    def __init__(self, blocks):
+        self._blocks = blocks
+
+    def __iter__(self):
+        return self._blocks
+
+    def drain(self) -> None:
+        for _ in self._blocks:
+            pass
+
+
 class Marker(NamedTuple):
     """A detection marker: a construct in a line of code (comments removed) that points to a dialect.
     weight: evidence per matching line; cap: at most this many lines count."""

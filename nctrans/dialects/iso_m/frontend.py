@@ -859,30 +859,13 @@ def _control_flow_at(text: str, semicolon_comment: bool) -> Optional[int]:
     return None
 
 
-class StreamedBody:
-    """The main body of a streamed Program: iterating it parses the next blocks, once. The
-    interpreter runs each block as it comes and drops it; `drain()` parses what is left (after a
-    program end) so that the diagnostics match a full parse."""
-    __slots__ = ("_blocks",)
-
-    def __init__(self, blocks):
-        self._blocks = blocks
-
-    def __iter__(self):
-        return self._blocks
-
-    def drain(self) -> None:
-        for _ in self._blocks:
-            pass
-
-
 def parse_stream(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lowering):
     """Lazy parse for programs whose main body runs straight through (the common CAM output): a
     ParseResult whose Program.body is a StreamedBody and whose diagnostics list fills as the body
     is iterated (complete once it is drained). None when the text has control flow, a macro
     variable or subprograms (see _CONTROL): those need `parse_program`, which holds the IR whole.
     Memory then stays bounded by one batch of blocks instead of growing with the file."""
-    from nctrans.dialects.base import ParseResult
+    from nctrans.dialects.base import ParseResult, StreamedBody
 
     diags: list[Diagnostic] = DiagnosticList()
     program = Program(file, lowering.dialect, [], {}, {}, None)

@@ -58,6 +58,7 @@ class Sinumerik(Dialect):
     markers = MARKERS
     comment_evidence = {"semicolon_line": (1.0, 3), "semicolon_tail": (0.5, 2)}
     definition_files = (".def",)       # GUD modules _N_*GUD*_DEF (spec 1.8)
+    streams = True                     # CAM programs: frontend.streamable
     subprogram_endings = (".spf", ".SPF", ".mpf", ".MPF", ".txt")
 
     def sniff(self, text: str) -> float:
@@ -73,6 +74,10 @@ class Sinumerik(Dialect):
 
     def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
         return _parse(text, file)
+
+    def parse_stream(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        from nctrans.dialects.sinumerik.frontend import parse_stream
+        return parse_stream(text, file)
 
     def emit(self, program) -> EmitResult:
         return _emit(program)

@@ -25,7 +25,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedInput, UnexpectedToken, UnexpectedCharacters, UnexpectedEOF
 from lark.lexer import Lexer
 
-from nctrans import limits, resources
+from nctrans import limits, plainrun, resources
 from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.dialects.base import ParseResult
 from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
@@ -783,170 +783,373 @@ def _iso_section(file: str, lines: list[Line]) -> Optional[list]:
     return list(res.program.body)
 
 
-def parse(text: str, file: str = "<stdin>") -> ParseResult:
-    """Sinumerik source -> IR Program with NC0xx diagnostics (never raises on bad input)."""
-    from nctrans.source import from_text
-    src = from_text(text, file)
-    low = Lowerer(file)
-    meta = low.meta
-    meta["defaults"] = table().defaults()
-    diags = low.diags
-    diags.extend(src.diagnostics)
-    units: list[_Unit] = [_Unit(None)]
-    macros: dict[str, str] = {}
-    raw_lines = src.text.split("\n")
-    if raw_lines and raw_lines[-1] == "":
-        raw_lines.pop()
-    section: Optional[tuple[str, str, list]] = None      # (start kw, end kw, lines) of a data section
-    iso_lines: Optional[list[Line]] = None
-    zones: list = []
-    seen_code = False
-
-    max_block = limits.setting("MAX_BLOCK_CHARS", limits.MAX_BLOCK_CHARS)
-    for n, raw in enumerate(raw_lines, 1):
-        unit = units[-1]
-        if len(raw) > max_block:
-            low.error("NC010", f"block of {len(raw)} characters: longer than the {max_block} "
-                      "nctrans reads; not analysed", n, 1)
-            continue
-        if not raw.strip():
-            continue
-        m = _HEADER.match(raw)
-        if m and not raw.lstrip().startswith("%%"):
-            name = m.group(1)
-            um = _UNIT_NAME.match(name)
-            if seen_code or units[-1].pre or units[-1].proc:
-                units.append(_Unit(um.group(1).upper() if um else name.upper()))
-                meta.setdefault("unit_headers", {})[units[-1].name] = name
-            else:
-                meta["header"] = name
-                if um:
-                    meta["program_name"] = um.group(1).upper()
-                    meta["program_type"] = um.group(2).upper()
-            continue
-        m = _PATH.match(raw)
-        if m:
-            if len(units) == 1:
-                meta["path"] = m.group(1)
-            else:
-                units[-1].path = m.group(1)
-            continue
-        line = split_line(n, raw)
-        span = _span(file, line)
-        code = line.code
-        # macro expansion (identifier macros of this file)
-        if macros and code:
-            code = _expand(code, macros)
-            line.code = code
-        # ---- verbatim sections
-        if iso_lines is not None:
-            if _G290.search(code):
-                blocks = _iso_section(file, iso_lines)
-                if blocks is None:
-                    for il in iso_lines:
-                        unit.current.append(_passthrough_block(file, il, il.code, "ISO dialect section",
-                                                               "iso-m"))
-                else:
-                    unit.current.extend(blocks)
-                iso_lines = None
-                unit.current.append(_passthrough_block(file, line, code, "native dialect mode"))
-            else:
-                iso_lines.append(line)
-            continue
-        if section is not None:
-            start, end, body = section
-            unit.current.append(_passthrough_block(file, line, code, _SECTION_REASON[start]))
-            body.append(line)
-            if re.match(rf"^\s*{end}\b", code, re.IGNORECASE):
-                if start in ("CPROTDEF", "NPROTDEF"):
-                    zones.append(_zone(low, start, body))
-                section = None
-            continue
-        if not code:
-            unit.current.append(ir.Block(span, [], line.number, line.label, line.skip, line.comment))
-            continue
-        seen_code = True
-        m = _DEFINE.match(code)
-        if m:
-            macros[m.group(1).upper()] = m.group(2).strip()
-            meta.setdefault("macros", {})[m.group(1).upper()] = m.group(2).strip()
-            unit.current.append(_passthrough_block(file, line, code, "macro definition"))
-            continue
-        if _SYNC.match(code):
-            unit.current.append(_passthrough_block(file, line, code, "synchronized action"))
-            continue
-        if _DATA_ATTR.match(code):
-            unit.current.append(_passthrough_block(file, line, code, "data attribute"))
-            continue
-        if _G291.search(code):
-            unit.current.append(_passthrough_block(file, line, code, "ISO dialect mode"))
-            iso_lines = []
-            continue
-        m = _SECTION_START.match(code)
-        if m:
-            kw = m.group(1).upper()
-            section = (kw, _SECTION_END[kw], [line])
-            unit.current.append(_passthrough_block(file, line, code, _SECTION_REASON[kw]))
-            continue
-        code = _PCALL_PATH.sub(lambda mm: mm.group(1) + mm.group(3), code)
-        # ---- parse the statement part (plain address words skip the LALR parser)
-        try:
-            fast = _plain_words(code)
-            if fast is None:
-                deep = limits.too_complex(code)
-                if deep is not None:
-                    raise LexError("NC008", deep[1], deep[0])
-            tree = Tree("start", fast) if fast is not None else parser().parse(code)
-        except LexError as e:
-            low.error(e.rule, e.message, n, line.col + e.pos)
-            unit.current.append(_passthrough_block(file, line, code, "syntax error"))
-            continue
-        except UnexpectedInput as e:
-            _syntax_error(low, e, code, line)
-            unit.current.append(_passthrough_block(file, line, code, "syntax error"))
-            continue
-        stmts = [c for c in tree.children if isinstance(c, Tree)]
-        _assemble(low, unit, units, stmts, line, span)
-
-    if iso_lines is not None:
-        for il in iso_lines:
-            units[-1].current.append(_passthrough_block(file, il, il.code, "ISO dialect section", "iso-m"))
-    if section is not None:
-        diags.append(Diagnostic("NC006", "error", f"{section[0]} section without {section[1]}", file,
-                                section[2][0].lineno, 1))
-    if zones:
-        meta["protection_zones"] = zones
-
-    prog = ir.Program(file, DIALECT, [], {}, meta)
-    for i, unit in enumerate(units):
-        while unit.stack:
-            op = unit.stack.pop()
-            diags.append(Diagnostic("NC006", "error", f"{op.kind} is not closed (program ends first)",
-                                    file, op.line, 1))
-        if i == 0:
-            prog.body = unit.pre
-            if unit.proc is not None:
-                prog.subprograms[unit.proc.name] = unit.proc
-                prog.name = unit.proc.name
-                meta["entry"] = unit.proc.name
-            else:
-                prog.name = meta.get("program_name")
-        else:
-            sub = unit.proc or ir.Subprogram(unit.name or f"UNIT{i}", ir.Span(file, 1), [])
-            if unit.proc is not None and unit.pre:
-                sub.body = unit.pre + sub.body
-            elif unit.proc is None:
-                sub.body = unit.pre
-                meta.setdefault("members_without_proc", []).append(sub.name)
-            prog.subprograms[sub.name] = sub
-    if not src.text.strip():
-        pass
-    return ParseResult(prog, diags)
-
-
 _NUM_RE = r"(?:\d+\.?\d*|\.\d+)(?:[Ee][Xx][+-]?\d+)?"
 _PLAIN = re.compile(rf"(?:\s*[A-Za-z]\s*[+-]?{_NUM_RE}(?![A-Za-z_]))+\s*")
 _PAIR = re.compile(rf"([A-Za-z])\s*([+-]?{_NUM_RE})")
+
+
+def parse(text: str, file: str = "<stdin>") -> ParseResult:
+    """Sinumerik source -> IR Program with NC0xx diagnostics (never raises on bad input)."""
+    fp = _FileParse(text, file)
+    for _ in fp.blocks(stream=False):
+        pass
+    return ParseResult(fp.program, fp.low.diags)
+
+
+def parse_stream(text: str, file: str = "<stdin>") -> Optional[ParseResult]:
+    """Lazy parse for programs that run straight through (CAM output): a ParseResult whose
+    Program.body is a StreamedBody that parses as it is iterated (the diagnostics fill as it goes;
+    complete once drained), so memory stays flat however long the program. With the native kernel
+    runs of plain lines become PlainRuns, the fast lane the ISO family takes too. None when the text
+    needs the whole IR (see streamable)."""
+    from nctrans.dialects.base import StreamedBody
+    if not streamable(text):
+        return None
+    fp = _FileParse(text, file)
+    fp.read_first_header()
+    fp.program.body = StreamedBody(fp.blocks(stream=True))
+    return ParseResult(fp.program, fp.low.diags)
+
+
+# Words after which a program cannot run straight through block after block, or whose meaning the
+# IR analyses of a full parse check (declarations, variables): such a program is parsed whole.
+_NOT_STREAMED = frozenset({
+    "IF", "ELSE", "ENDIF", "WHILE", "ENDWHILE", "FOR", "ENDFOR", "LOOP", "ENDLOOP", "REPEAT", "REPEATB",
+    "UNTIL", "CASE", "GOTO", "GOTOF", "GOTOB", "GOTOC", "GOTOS", "PROC", "RET", "DEFINE", "DEF", "EXTERN",
+    "CALL", "PCALL", "MCALL", "EXTCALL", "ISOCALL", "CTABDEF", "CONTPRON", "CONTDCON", "CPROTDEF", "NPROTDEF",
+    "WHEN", "WHENEVER", "EVERY", "FROM", "DO", "ID", "IDS", "SETAL", "SAVE"})
+# What the stream check looks at in a line's code (upper-cased, strings emptied): names and
+# address words, `=`, system variables, indices and program headers.
+_STREAM_MARK = re.compile(r"[A-Z_][A-Z0-9_]*|[=$\[%]")
+_STREAM_ADDRESS = re.compile(r"[A-Z]\d+")
+_STREAM_STRING = re.compile(r'"[^"]*"')
+_STREAM_VALUE = re.compile(rf"\s*(?:[+-]?{_NUM_RE}|(?:AC|IC|DC|ACP|ACN)\s*\(\s*[+-]?{_NUM_RE}\s*\)|\"\")\s*(?=\s|$)")
+_STREAM_NAME = re.compile(r"(\w+)\s*$")
+# Address words that end or leave the program's straight run: ISO mode, subprogram return.
+_STREAM_CODES = frozenset({("G", 291), ("M", 17)})
+
+
+@lru_cache(maxsize=1)
+def _stream_words() -> tuple[frozenset, frozenset]:
+    """(names a streamed program may use, names it may assign a number to): the codes and commands
+    of the rules table and the address words `named` takes without an assignment."""
+    t = table()
+    o = t.options
+    words = {r.code.upper() for r in t.codes} | {"MSG", "AC", "IC", "DC", "ACP", "ACN"}
+    words |= {w.upper() for w in (*o.get("machine_commands", {}), *o.get("passthrough_words", {}),
+                                  *o.get("unsupported_functions", {}))}
+    targets = {w.upper() for w in (*o.get("axes", ()), *o.get("centre_words", {}), *o.get("via_words", {}),
+                                   *o.get("motion_words", {}))} | {"S", "T", "D"}
+    targets |= {f"{a}{i}" for a in "STD" for i in range(1, 10)}
+    return frozenset(words - _NOT_STREAMED), frozenset(targets - _NOT_STREAMED)
+
+
+def streamable(text: str) -> bool:
+    """Whether `text` runs straight through, block after block, with nothing the full parse's
+    analyses need (see _NOT_STREAMED): only known codes and commands, numbers assigned to address
+    words (`Z1=0`, `X=IC(5)`, `T="MILL"`), MSG texts and `;` comments, a program header only as
+    the first line. Errs towards the full parse, which is always right. With the native kernel the
+    plain lines are stepped over in runs (its strict scan) and only the others are looked at."""
+    scan = plainrun.native.scan if plainrun.native is not None else None
+    arc = plainrun.MOTIONS.index("arc_cw")
+    first = True
+    pos, n = 0, len(text)
+    while pos < n:
+        if scan is not None:
+            end, _, blocks, _ = scan(text, pos, "\n", arc, True, False, True)
+            if blocks:
+                pos, first = end, False
+                continue
+        nl = text.find("\n", pos)
+        if nl < 0:
+            nl = n
+        line, pos = text[pos:nl], nl + 1
+        if not _stream_line(line, first):
+            return False
+        if first and line.strip():
+            first = False
+    return True
+
+
+def _stream_line(line: str, first: bool) -> bool:
+    """The stream check of one line (`first`: no code or comment before it)."""
+    code = split_comment(line)[0].upper()
+    if '"' in code:
+        code = _STREAM_STRING.sub('""', code)
+    words, targets = _stream_words()
+    for m in _STREAM_MARK.finditer(code):
+        tok = m.group()
+        if tok == "=":
+            name = _STREAM_NAME.search(code, 0, m.start())
+            if name is None or name.group(1) not in targets or _STREAM_VALUE.match(code, m.end()) is None:
+                return False
+        elif tok == "%":
+            if not first or code[:m.start()].strip():
+                return False            # a second program unit, or `%` inside a block
+            return True                 # the header line itself
+        elif tok in ("$", "["):
+            return False
+        elif _STREAM_ADDRESS.fullmatch(tok):
+            if tok[0] == "L" or (tok[0], int(tok[1:])) in _STREAM_CODES:
+                return False            # L: a subprogram call
+        elif tok not in words and tok not in targets:
+            return False
+    return True
+
+
+class _FileParse:
+    """One file's parse: `blocks()` runs through the lines and, streamed, yields the blocks of the
+    main program as they are lowered (and keeps none); `program` is complete when it is done."""
+
+    def __init__(self, text: str, file: str):
+        from nctrans.source import from_text
+        self.src = from_text(text, file)
+        self.file = file
+        self.low = Lowerer(file)
+        self.low.meta["defaults"] = table().defaults()
+        self.low.diags.extend(self.src.diagnostics)
+        self.program = ir.Program(file, DIALECT, [], {}, self.low.meta)
+
+    def read_first_header(self) -> None:
+        """The program header of the first line, ahead of the streamed parse (the interpreter
+        reads the program's name when it starts; blocks() reads the line again, the same way)."""
+        first = self.src.text.lstrip().split("\n", 1)[0]
+        m = _HEADER.match(first)
+        if m and not first.startswith("%%"):
+            _read_header(self.low.meta, m.group(1))
+            self.program.name = self.low.meta.get("program_name")
+
+    def blocks(self, stream: bool):
+        file, low, prog = self.file, self.low, self.program
+        text = self.src.text
+        meta = low.meta
+        diags = low.diags
+        units: list[_Unit] = [_Unit(None)]
+        macros: dict[str, str] = {}
+        section: Optional[tuple[str, str, list]] = None      # (start kw, end kw, lines) of a data section
+        iso_lines: Optional[list[Line]] = None
+        zones: list = []
+        seen_code = False
+        main = units[0].pre
+        # streamed with the native kernel: runs of plain lines become one PlainRun each
+        scan = plainrun.native.scan if stream and plainrun.native is not None else None
+        motion = meta["defaults"].get("motion")          # the static motion mode (arcs by centre)
+
+        max_block = limits.setting("MAX_BLOCK_CHARS", limits.MAX_BLOCK_CHARS)
+        pos, end, n = 0, len(text), 0
+        while pos < end:
+            nl = text.find("\n", pos)
+            if nl < 0:
+                nl = end
+            start, raw = pos, text[pos:nl]
+            pos, n = nl + 1, n + 1
+            unit = units[-1]
+            if stream and main and len(units) == 1 and not unit.stack and unit.proc is None:
+                for b in main:
+                    if type(b) is ir.Block:
+                        for st in b.body:
+                            if type(st) is ir.ModeChange and st.group == "motion":
+                                motion = st.value
+                yield from main
+                main.clear()
+            if len(raw) > max_block:
+                low.error("NC010", f"block of {len(raw)} characters: longer than the {max_block} "
+                          "nctrans reads; not analysed", n, 1)
+                continue
+            if scan is not None and len(units) == 1 and not unit.stack and unit.proc is None \
+                    and iso_lines is None and section is None and not macros:
+                run_end, nlines, nblocks, last = scan(text, start, "\n", plainrun.motion_code(motion),
+                                                      True, False, True)
+                if nblocks >= PLAIN_RUN_MIN:
+                    main.append(plainrun.PlainRun(file, text, start, run_end, n, "\n", nblocks, plain_line,
+                                                  motion, None, False))
+                    pos, n = run_end, n + nlines - 1
+                    if last >= 0:
+                        motion = plainrun.MOTIONS[last]
+                    seen_code = True
+                    continue
+            if not raw.strip():
+                continue
+            m = _HEADER.match(raw)
+            if m and not raw.lstrip().startswith("%%"):
+                name = m.group(1)
+                um = _UNIT_NAME.match(name)
+                if seen_code or units[-1].pre or units[-1].proc:
+                    units.append(_Unit(um.group(1).upper() if um else name.upper()))
+                    meta.setdefault("unit_headers", {})[units[-1].name] = name
+                else:
+                    _read_header(meta, name)
+                continue
+            m = _PATH.match(raw)
+            if m:
+                if len(units) == 1:
+                    meta["path"] = m.group(1)
+                else:
+                    units[-1].path = m.group(1)
+                continue
+            line = split_line(n, raw)
+            span = _span(file, line)
+            code = line.code
+            # macro expansion (identifier macros of this file)
+            if macros and code:
+                code = _expand(code, macros)
+                line.code = code
+            # ---- verbatim sections
+            if iso_lines is not None:
+                if _G290.search(code):
+                    blocks = _iso_section(file, iso_lines)
+                    if blocks is None:
+                        for il in iso_lines:
+                            unit.current.append(_passthrough_block(file, il, il.code, "ISO dialect section",
+                                                                   "iso-m"))
+                    else:
+                        unit.current.extend(blocks)
+                    iso_lines = None
+                    unit.current.append(_passthrough_block(file, line, code, "native dialect mode"))
+                else:
+                    iso_lines.append(line)
+                continue
+            if section is not None:
+                start_kw, end_kw, body = section
+                unit.current.append(_passthrough_block(file, line, code, _SECTION_REASON[start_kw]))
+                body.append(line)
+                if re.match(rf"^\s*{end_kw}\b", code, re.IGNORECASE):
+                    if start_kw in ("CPROTDEF", "NPROTDEF"):
+                        zones.append(_zone(low, start_kw, body))
+                    section = None
+                continue
+            if not code:
+                unit.current.append(ir.Block(span, [], line.number, line.label, line.skip, line.comment))
+                continue
+            seen_code = True
+            m = _DEFINE.match(code)
+            if m:
+                macros[m.group(1).upper()] = m.group(2).strip()
+                meta.setdefault("macros", {})[m.group(1).upper()] = m.group(2).strip()
+                unit.current.append(_passthrough_block(file, line, code, "macro definition"))
+                continue
+            if _SYNC.match(code):
+                unit.current.append(_passthrough_block(file, line, code, "synchronized action"))
+                continue
+            if _DATA_ATTR.match(code):
+                unit.current.append(_passthrough_block(file, line, code, "data attribute"))
+                continue
+            if _G291.search(code):
+                unit.current.append(_passthrough_block(file, line, code, "ISO dialect mode"))
+                iso_lines = []
+                continue
+            m = _SECTION_START.match(code)
+            if m:
+                kw = m.group(1).upper()
+                section = (kw, _SECTION_END[kw], [line])
+                unit.current.append(_passthrough_block(file, line, code, _SECTION_REASON[kw]))
+                continue
+            code = _PCALL_PATH.sub(lambda mm: mm.group(1) + mm.group(3), code)
+            # ---- parse the statement part (plain address words skip the LALR parser)
+            try:
+                fast = _plain_words(code)
+                if fast is None:
+                    deep = limits.too_complex(code)
+                    if deep is not None:
+                        raise LexError("NC008", deep[1], deep[0])
+                tree = Tree("start", fast) if fast is not None else parser().parse(code)
+            except LexError as e:
+                low.error(e.rule, e.message, n, line.col + e.pos)
+                unit.current.append(_passthrough_block(file, line, code, "syntax error"))
+                continue
+            except UnexpectedInput as e:
+                _syntax_error(low, e, code, line)
+                unit.current.append(_passthrough_block(file, line, code, "syntax error"))
+                continue
+            stmts = [c for c in tree.children if isinstance(c, Tree)]
+            _assemble(low, unit, units, stmts, line, span)
+
+        if iso_lines is not None:
+            for il in iso_lines:
+                units[-1].current.append(_passthrough_block(file, il, il.code, "ISO dialect section", "iso-m"))
+        if section is not None:
+            diags.append(Diagnostic("NC006", "error", f"{section[0]} section without {section[1]}", file,
+                                    section[2][0].lineno, 1))
+        if zones:
+            meta["protection_zones"] = zones
+        if stream:
+            yield from main
+            main.clear()
+
+        for i, unit in enumerate(units):
+            while unit.stack:
+                op = unit.stack.pop()
+                diags.append(Diagnostic("NC006", "error", f"{op.kind} is not closed (program ends first)",
+                                        file, op.line, 1))
+            if i == 0:
+                if not stream:
+                    prog.body = unit.pre
+                if unit.proc is not None:
+                    prog.subprograms[unit.proc.name] = unit.proc
+                    prog.name = unit.proc.name
+                    meta["entry"] = unit.proc.name
+                else:
+                    prog.name = meta.get("program_name")
+            else:
+                sub = unit.proc or ir.Subprogram(unit.name or f"UNIT{i}", ir.Span(file, 1), [])
+                if unit.proc is not None and unit.pre:
+                    sub.body = unit.pre + sub.body
+                elif unit.proc is None:
+                    sub.body = unit.pre
+                    meta.setdefault("members_without_proc", []).append(sub.name)
+                prog.subprograms[sub.name] = sub
+
+
+def _read_header(meta: dict, name: str) -> None:
+    """The file's own program header `%_N_NAME_MPF` into meta."""
+    meta["header"] = name
+    um = _UNIT_NAME.match(name)
+    if um:
+        meta["program_name"] = um.group(1).upper()
+        meta["program_type"] = um.group(2).upper()
+
+
+# Plain lines in a row before the streamed parse hands them over as one PlainRun.
+PLAIN_RUN_MIN = 2
+_PLAIN_WORD = re.compile(r"([A-Z])([+-]?[0-9.]+)")
+
+
+def plain_line(code: str, motion: Optional[str], cycle: Optional[str], arc_abs: bool) -> tuple:
+    """(number, body, motion mode written or None) of a line the kernel's strict scan took (code
+    with its blanks removed: [N] [G0-G3] axis words, I J K, F): the Block the lowering above
+    builds for it (tests/test_sinumerik_streaming.py holds the two to each other). Unlike ISO,
+    the meaning of these words does not depend on the modal state before the line."""
+    number = feed = mode = None
+    target: dict = {}
+    center: dict = {}
+    axes = _plain_axes()
+    for letter, num in _PLAIN_WORD.findall(code):
+        if letter == "N":
+            number = num
+        elif letter == "G":
+            rule = table().lookup(normalise_code("G", num))
+            mode = ir.ModeChange(rule.group, rule.value, rule.code)
+        elif letter == "F":
+            feed = ir.Feed(ir.Num(float(num), num))
+        elif letter in axes:
+            target[letter] = ir.AxisValue(ir.Num(float(num), num))
+        else:
+            center[letter] = ir.AxisValue(ir.Num(float(num), num))
+    body: list = []
+    if mode is not None:
+        body.append(mode)
+    if feed is not None:
+        body.append(feed)
+    if target or center:
+        body.append(ir.Motion(target, center or None))
+    return number, body, None if mode is None else mode.value
+
+
+@lru_cache(maxsize=1)
+def _plain_axes() -> frozenset:
+    return frozenset(table().options.get("axes", ()))
+
+
 
 
 def _plain_words(code: str) -> Optional[list]:
