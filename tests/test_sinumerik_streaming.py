@@ -8,7 +8,9 @@ parse, with the kernel on and off. The programs are the ISO milling corpus writt
 """
 from __future__ import annotations
 
+import importlib
 import io
+import json
 import tracemalloc
 from functools import lru_cache
 
@@ -206,3 +208,52 @@ def test_streamed_memory_does_not_grow_with_program_length():
     p_small, p_large = peak_mib(small), peak_mib(large)
     # the full parse holds ~1 KiB per block (20 MiB here); streamed, 10x the program is flat
     assert p_large < p_small + 1.0, (p_small, p_large)
+
+
+# ------------------------------------------------------------------ plain words without the parser
+
+PLAIN_BLOCK_WORD = st.one_of(
+    st.tuples(st.sampled_from(["G", "M", "X", "Y", "Z", "I", "J", "K", "F", "S", "T", "D", "N", "H", "x", "L"]),
+              st.sampled_from(["", " "]), st.sampled_from(["", "+", "-"]),
+              st.sampled_from(["0", "1", "3", "01", "1.5", ".5", "4.", "17", "291", "1234567890123456"])),
+    st.tuples(st.sampled_from(["X", "Z1", "CR", "AR", "TURN", "I1", "AP", "RP", "F", "R1", "XV", "S", "T", "ABC",
+                               "x", "D"]),
+              st.sampled_from(["=", " = "]), st.sampled_from(["", "-", "+"]),
+              st.sampled_from(["0", "5", "5.5", ".5", "2.", "1EX3"]))).map("".join)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(PLAIN_BLOCK_WORD, min_size=1, max_size=5), st.sampled_from([" ", "  "]))
+def test_plain_words_read_without_the_parser_lower_as_the_parsers_trees(words, sep):
+    """Blocks of plain words (`X10`, `Z1=0`, `CR=-5.5`) skip lark (frontend._plain_words): the
+    Blocks and diagnostics are those of the parser's trees."""
+    fe = importlib.import_module("nctrans.dialects.sinumerik.frontend")  # nctrans.dialects is a function
+    text = sep.join(words) + "\n"
+    light = parse(text, "t.mpf")
+    saved = fe._plain_words
+    fe._plain_words = lambda code: None
+    try:
+        parsed = parse(text, "t.mpf")
+    finally:
+        fe._plain_words = saved
+    assert light.program.body == parsed.program.body, text
+    assert [repr(d) for d in light.diagnostics] == [repr(d) for d in parsed.diagnostics], text
+
+
+def test_a_cam_program_runs_without_loading_the_grammar(tmp_path):
+    """Plain CAM blocks, `;` comments, G74 Z1=0 and CR= arcs need no parser: lark (~55 ms of
+    start-up with its tables) is never imported for them."""
+    import subprocess
+    import sys
+    prog = tmp_path / "cam.mpf"
+    prog.write_text("; CAM\nG71 G17 G90\nG74 Z1=0\nT1 M6\nS1000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F100\n"
+                    "X10 Y0\nG2 X20 Y0 CR=5\nM30\n")
+    code = ("import sys, nctrans.cli as c; c.main(['toolpath', sys.argv[1], '--format', 'jsonl']); "
+            "print('lark' in sys.modules, file=sys.stderr)")
+    proc = subprocess.run([sys.executable, "-c", code, str(prog)], capture_output=True, text=True)
+    assert proc.stderr.strip().splitlines()[-1] == "False", proc.stderr
+    kinds = [json.loads(line)["kind"] for line in proc.stdout.splitlines()]
+    assert kinds == ["rapid", "rapid", "tool_change", "spindle", "rapid", "linear", "linear", "arc", "stop"]
+    # G2 from X10 Y0 to X20 Y0 with CR=5: a half circle about X15 Y0
+    arc = json.loads(proc.stdout.splitlines()[7])
+    assert arc["end"] == {"X": 20.0, "Y": 0.0, "Z": -1.0} and arc["center"] == {"X": 15.0, "Y": 0.0, "Z": -1.0}

@@ -21,10 +21,6 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Optional
 
-from lark import Lark, Token, Tree
-from lark.exceptions import UnexpectedInput, UnexpectedToken, UnexpectedCharacters, UnexpectedEOF
-from lark.lexer import Lexer
-
 from nctrans import limits, plainrun, resources
 from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.dialects.base import ParseResult
@@ -38,18 +34,39 @@ GRAMMAR = resources.path("grammars", "sinumerik.lark")
 DIALECT = "sinumerik"
 
 
-class _BlockLexer(Lexer):
-    """Adapter: lark calls this with the statement text; tokens come from lexer.tokenize."""
+class _LarkNotLoaded(Exception):
+    """What lark's names below stand for until _load_lark(): nothing is an instance of it."""
 
-    def __init__(self, lexer_conf):   # noqa: D401 - lark's interface
-        pass
 
-    def lex(self, data):
-        yield from tokenize(data)
+# lark (~40 ms of start-up, and ~15 ms more for the cached tables) is imported when the first block
+# needs the grammar: blocks of plain words (frontend._plain_words, the kernel's runs) never do, so a
+# CAM program runs without it. Until then its names are the placeholder above.
+Lark = Token = Tree = _LarkNotLoaded
+UnexpectedInput = UnexpectedToken = UnexpectedCharacters = UnexpectedEOF = _LarkNotLoaded
+
+
+def _load_lark() -> None:
+    global Lark, Token, Tree, UnexpectedInput, UnexpectedToken, UnexpectedCharacters, UnexpectedEOF
+    global _BlockLexer
+    from lark import Lark, Token, Tree
+    from lark.exceptions import UnexpectedInput, UnexpectedToken, UnexpectedCharacters, UnexpectedEOF
+    from lark.lexer import Lexer
+
+    class _BlockLexer(Lexer):
+        """Adapter: lark calls this with the statement text; tokens come from lexer.tokenize.
+        A module attribute (lark's table cache pickles the class by name)."""
+
+        def __init__(self, lexer_conf):   # noqa: D401 - lark's interface
+            pass
+
+        def lex(self, data):
+            yield from tokenize(data)
 
 
 @lru_cache(maxsize=1)
-def parser() -> Lark:
+def parser():
+    """The LALR parser of grammars/sinumerik.lark (tables cached on disk, see lark_cache)."""
+    _load_lark()
     return Lark(GRAMMAR.read_text(encoding="utf-8"), parser="lalr", lexer=_BlockLexer,
                 maybe_placeholders=True, cache=cache_option(DIALECT))
 
@@ -539,6 +556,8 @@ class Lowerer:
                 else:
                     self.word_col = line.col + ch[0].start_pos
                     self.address(str(ch[0]), _num(ch[1]), w, text)
+            elif d == "plain_assign":      # NAME=number read without the parser (_plain_words)
+                self.named(str(ch[0]), _num(ch[1]), w, text)
             elif d == "assign":
                 lv = ch[0]
                 values = [expr(c) for c in ch[2:] if isinstance(c, Tree) or (
@@ -725,7 +744,7 @@ def _type(type_spec: Tree) -> tuple[str, Optional[int]]:
 
 def _slice(code: str, st: Tree) -> str:
     """Source text of a statement (for Passthrough), from its first to its last token."""
-    toks = [t for t in st.scan_values(lambda v: isinstance(v, Token))]
+    toks = [t for t in st.scan_values(lambda v: isinstance(v, (Token, _PlainToken)))]
     if not toks:
         return ""
     return code[toks[0].start_pos:max(t.end_pos for t in toks)].strip()
@@ -784,8 +803,10 @@ def _iso_section(file: str, lines: list[Line]) -> Optional[list]:
 
 
 _NUM_RE = r"(?:\d+\.?\d*|\.\d+)(?:[Ee][Xx][+-]?\d+)?"
-_PLAIN = re.compile(rf"(?:\s*[A-Za-z]\s*[+-]?{_NUM_RE}(?![A-Za-z_]))+\s*")
-_PAIR = re.compile(rf"([A-Za-z])\s*([+-]?{_NUM_RE})")
+# a plain word: `X10`, `G1`, or a number given to an address by name, `Z1=0`, `CR=-5.5` (no `+`:
+# the parser reads `X=+5` as a unary plus); names are checked against _plain_names()
+_PLAIN = re.compile(rf"(?:\s*(?:[A-Z_][A-Z0-9_]*\s*=\s*-?{_NUM_RE}|[A-Za-z]\s*[+-]?{_NUM_RE})(?![A-Za-z_]))+\s*")
+_PAIR = re.compile(rf"([A-Z_][A-Z0-9_]*)\s*=\s*(-?{_NUM_RE})|([A-Za-z])\s*([+-]?{_NUM_RE})")
 
 
 def parse(text: str, file: str = "<stdin>") -> ParseResult:
@@ -1052,7 +1073,8 @@ class _FileParse:
                     deep = limits.too_complex(code)
                     if deep is not None:
                         raise LexError("NC008", deep[1], deep[0])
-                tree = Tree("start", fast) if fast is not None else parser().parse(code)
+                stmts = fast if fast is not None else [c for c in parser().parse(code).children
+                                                       if isinstance(c, Tree)]
             except LexError as e:
                 low.error(e.rule, e.message, n, line.col + e.pos)
                 unit.current.append(_passthrough_block(file, line, code, "syntax error"))
@@ -1061,7 +1083,6 @@ class _FileParse:
                 _syntax_error(low, e, code, line)
                 unit.current.append(_passthrough_block(file, line, code, "syntax error"))
                 continue
-            stmts = [c for c in tree.children if isinstance(c, Tree)]
             _assemble(low, unit, units, stmts, line, span)
 
         if iso_lines is not None:
@@ -1157,15 +1178,55 @@ def _plain_words(code: str) -> Optional[list]:
     without the lexer and parser; anything else returns None and takes the full path."""
     if not _PLAIN.fullmatch(code):
         return None
-    out = []
+    out: list = []
     for m in _PAIR.finditer(code):
-        letter = m.group(1).upper()
-        a0, n0, n1 = m.start(1), m.start(2), m.end(2)
-        if n1 - n0 > 15 or "X" in m.group(2) or "x" in m.group(2):
+        named = m.group(1) is not None
+        g = 1 if named else 3
+        a0, a1, n0, n1 = m.start(g), m.end(g), m.start(g + 1), m.end(g + 1)
+        number = m.group(g + 1)
+        if n1 - n0 > 15 or "X" in number or "x" in number:
             return None                  # an exponent or a long number: the lexer checks its range
-        out.append(Tree("word", [Token("ADDR", letter, a0, 1, a0 + 1, 1, a0 + 2, a0 + 1),
-                                 Token("NUMBER", m.group(2), n0, 1, n0 + 1, 1, n1 + 1, n1)]))
+        if named:
+            if m.group(1) not in _plain_names():
+                return None
+            out.append(_PlainWord([_PlainToken("IDENT", m.group(1), a0, a1),
+                                   _PlainToken("NUMBER", number, n0, n1)], "plain_assign"))
+        else:
+            out.append(_PlainWord([_PlainToken("ADDR", m.group(3).upper(), a0, a1),
+                                   _PlainToken("NUMBER", number, n0, n1)]))
     return out
+
+
+@lru_cache(maxsize=1)
+def _plain_names() -> frozenset:
+    """Names whose `NAME=number` words _plain_words reads: the axes and the address words of one
+    part of a motion (Lowerer.named gives them the number as it is)."""
+    o = table().options
+    return frozenset((*o.get("axes", ()), *o.get("centre_words", {}), *o.get("via_words", {}),
+                      *o.get("motion_words", {})))
+
+
+class _PlainToken(str):
+    """A plain word's letter or number with what the lowering reads of lark's Token (type,
+    start_pos, end_pos), so that plain blocks are lowered without loading lark."""
+
+    def __new__(cls, type_: str, value: str, start_pos: int, end_pos: int):
+        t = super().__new__(cls, value)
+        t.type, t.start_pos, t.end_pos = type_, start_pos, end_pos
+        return t
+
+
+class _PlainWord:
+    """The tree of a plain word, as lark's Tree shows it to the lowering: `word` (letter, number)
+    or `plain_assign` (name, number)."""
+    __slots__ = ("children", "data")
+
+    def __init__(self, children: list, data: str = "word"):
+        self.children = children
+        self.data = data
+
+    def scan_values(self, pred) -> list:
+        return [c for c in self.children if pred(c)]
 
 
 def _expr_text(e) -> str:

@@ -13,7 +13,6 @@ import math
 import re
 from typing import Iterator
 
-from lark import Token
 
 KEYWORDS = {k: k for k in (
     "DEF PROC VAR EXTERN IF ELSE ENDIF WHILE ENDWHILE FOR TO ENDFOR LOOP ENDLOOP REPEAT UNTIL CASE OF "
@@ -89,6 +88,7 @@ def _check_number(text: str, m: "re.Match", start: int, standalone: bool = False
 
 def tokenize(text: str, col0: int = 1) -> Iterator[Token]:
     """Tokens of `text`; columns are 1-based and offset by `col0 - 1` (the statement's place in the line)."""
+    from lark import Token          # here: the module is imported by code that never parses a block
     i, n = 0, len(text)
     last = [""]
     state = {"def": False, "depth": 0}
