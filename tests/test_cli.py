@@ -457,13 +457,9 @@ def test_e2e_convert_iso_to_sinumerik_is_equivalent(tmp_path):
     sample = ROOT / "corpus" / "iso-m" / "sample-pocket.nc"
     out = tmp_path / "pocket.mpf"
     rc, _, err = sh("convert", str(sample), "--to", "sinumerik", "-o", str(out))
-    if rc != 0:
-        pytest.skip(f"conversion not complete yet: {err[:200]}")
+    assert rc == 0, err
     rc, text, err = sh("equiv", str(sample), str(out), "--from-a", "iso-m", "--from-b", "sinumerik")
-    assert rc in (0, 1), err
-    if rc == 1:
-        # a real finding of equiv, for the converter's owners (reported); not a CLI failure
-        pytest.xfail("iso-m -> sinumerik conversion not toolpath-equivalent yet: " + text.strip()[:300])
+    assert rc == 0 and text.startswith("equivalent"), text + err
 
 
 # --------------------------------------------------------------------------- detection (in process)

@@ -50,20 +50,9 @@ from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
 from nctrans.toolpath_io import _spell, _str as _json_str    # the kernel writes as the writer does
 
-try:  # the colleague's modules; without them the feature is skipped
-    from nctrans.interp.cycles import expand_cycle
-except ImportError:  # pragma: no cover
-    expand_cycle = None
-try:
-    from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, hole_pattern,
-                                       plane_cycle_levels, swivel_plan, tap_steps)
-except ImportError:  # pragma: no cover
-    cycle_table = hole_pattern = plane_cycle_levels = swivel_plan = deep_hole_steps = None
-    coarse_pitch = tap_steps = None
-try:
-    from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
-except ImportError:  # pragma: no cover
-    CutterCompensator = PlannedMove = None
+from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
+from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, expand_cycle, hole_pattern,
+                                   plane_cycle_levels, swivel_plan, tap_steps)
 
 BLOCK, JUMP, JFALSE, EXEC, CASE, PLAIN = range(6)
 SHARED_SCOPE_CALLS = frozenset(("m98", "shared"))
@@ -527,7 +516,7 @@ class Interpreter(LatheMixin, RunChecks):
         self.last_from = start
         self.last_arc = (center, cw) if kind == "arc" else None
         if self.comp_exit or self.comp is not None or (
-                self.st.comp_side != "off" and CutterCompensator is not None and self.comp_radius):
+                self.st.comp_side != "off" and self.comp_radius):
             if self._comp_move(kind, start, end, center, cw, turns):
                 return
         elif self.st.comp_side != "off" and not self.st.radius_index:
@@ -543,7 +532,7 @@ class Interpreter(LatheMixin, RunChecks):
         if edge:
             self.st.radius_index = edge
             self.comp_radius = self.machine.radius_offset(edge)
-            if self.comp_radius and CutterCompensator is not None and self._comp_move(
+            if self.comp_radius and self._comp_move(
                     kind, start, end, center, cw, turns):
                 return
         elif not self.comp_d_reported:
@@ -629,7 +618,7 @@ class Interpreter(LatheMixin, RunChecks):
                 self.diags.append(Diagnostic("NC204", "error", msg, file, line))
             probs.clear()
         for it in items:
-            if PlannedMove is not None and isinstance(it, PlannedMove):
+            if isinstance(it, PlannedMove):
                 c = it.center
                 plane = it.payload[6]
                 a1, a2, _ = PLANE_AXES[plane]
@@ -1318,8 +1307,6 @@ class Interpreter(LatheMixin, RunChecks):
                 p["bottom"] = v
         if not vals and "bottom" not in p:
             return
-        if expand_cycle is None:
-            return
         missing = [k for k in ("bottom", "r_plane") if k not in p]
         if missing:
             self.diag("NC206", "error", f"canned cycle without {' and '.join(missing)}")
@@ -1434,8 +1421,6 @@ class Interpreter(LatheMixin, RunChecks):
     def _hole_pattern(self, s: n.CycleCall) -> None:
         """Sinumerik HOLES1/HOLES2: the modally called cycle at each position of the pattern
         (only positioning when no cycle is modal)."""
-        if hole_pattern is None or cycle_table is None:
-            return
         pat = {p.name: p for p in cycle_table().pattern}.get((s.name or "").upper())
         if pat is None:
             self.diag("NC103", "warning", f"hole pattern {s.name or s.kind} is not known")
@@ -1455,8 +1440,6 @@ class Interpreter(LatheMixin, RunChecks):
                 self._move("rapid", hole)
 
     def _run_cycle_call(self, s: n.CycleCall, hole: Optional[dict] = None) -> None:
-        if expand_cycle is None or plane_cycle_levels is None:
-            return
         st = self.st
         ax = PLANE_AXES[st.plane][2]
         params = {}
@@ -1532,8 +1515,6 @@ class Interpreter(LatheMixin, RunChecks):
         frame becomes TRANS(_X0..) : AROT(axis by axis) : ATRANS(_X1..) (_ST 1: composed on the
         current frame). Rotary axes are not positioned: that needs the machine's swivel data
         record (kinematics), which the machine model does not hold (NC107 info)."""
-        if swivel_plan is None:
-            return
         params: dict[str, Any] = {}
         for k, e in s.params.items():
             if k == "swivel_record":
