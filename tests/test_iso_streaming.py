@@ -117,3 +117,22 @@ def test_streamed_memory_does_not_grow_with_program_length():
     # the full parse holds ~1 KiB per block (20 MiB here); streamed, 10x the program is flat
     assert p_large < p_small + 1.0, (p_small, p_large)
     assert parse_program(small, "x").program.body       # the full parse still holds the body
+
+
+@pytest.mark.skipif(not PROGRAMS, reason="shared corpus not found")
+def test_control_flow_check_same_with_and_without_the_kernel_scan():
+    """The kernel's scan only steps over plain lines: whether a program streams does not depend on it."""
+    from nctrans import plainrun
+    from nctrans.dialects.iso_m.frontend import _control_flow_at
+    texts = [source.decode(p.read_bytes(), p.name).text for p in PROGRAMS if p.is_file()]
+    texts += ["G1X1F100\nX2\n(GOTO 5)\nX3\n", "G1X1F100\nX2\nX3 (open\nGOTO5\n", "G0X1\nG1X2F1;IF\n",
+              "G0X1\nX2\n#1=5\n", "G0 X1\nX2 Y3\nWHILE[1]DO1\n"]
+    saved = plainrun.native
+    try:
+        with_kernel = [_control_flow_at(t, True) is None for t in texts]
+        plainrun.native = None
+        without = [_control_flow_at(t, True) is None for t in texts]
+    finally:
+        plainrun.native = saved
+    assert with_kernel == without
+    assert with_kernel[-5:] == [True, False, True, False, False]

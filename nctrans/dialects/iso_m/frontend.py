@@ -840,10 +840,33 @@ _SCAN_CHUNK = 1 << 16
 
 def _control_flow_at(text: str, semicolon_comment: bool) -> Optional[int]:
     """Offset of the first control-flow mark outside a comment (None: the program runs straight
-    through, block after block). Searched in upper-cased chunks of whole lines (a case-insensitive
-    pattern with these alternatives is ~15x slower; chunks keep the copy small)."""
-    n = len(text)
-    base = 0
+    through, block after block). With the native kernel its scan steps over runs of plain lines
+    (which hold none: only N, G0-G3, axis, centre and F words) and only the other lines are
+    searched, ~10x faster on CAM output than searching the whole text."""
+    scan = plainrun.native.scan if plainrun.native is not None else None
+    if scan is None or "\n" not in text:
+        return _control_flow_in(text, 0, len(text), semicolon_comment)
+    arc = PLAIN_MOTIONS.index("arc_cw")
+    pos, n = 0, len(text)
+    while pos < n:
+        end, _lines, blocks, _motion = scan(text, pos, "\n", arc, True, False)
+        if blocks:
+            pos = end
+            continue
+        nl = text.find("\n", pos)
+        nl = n if nl < 0 else nl
+        found = _control_flow_in(text, pos, nl, semicolon_comment)
+        if found is not None:
+            return found
+        pos = nl + 1
+    return None
+
+
+def _control_flow_in(text: str, start: int, end: int, semicolon_comment: bool) -> Optional[int]:
+    """_control_flow_at within text[start:end), searched in upper-cased chunks of whole lines (a
+    case-insensitive pattern with these alternatives is ~15x slower; chunks keep the copy small)."""
+    n = end
+    base = start
     while base < n:
         cut = text.rfind("\n", base, base + _SCAN_CHUNK) if base + _SCAN_CHUNK < n else n
         if cut <= base:
