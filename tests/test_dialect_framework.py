@@ -85,8 +85,9 @@ def test_resolver_tries_the_callers_dialect_file_names(tmp_path):
 
 def test_definition_files_and_streaming_are_declared_by_the_dialect():
     assert base.get("sinumerik").definition_files == (".def",) and not base.get("iso-m").definition_files
-    assert base.get("iso-m").streams and not base.get("sinumerik").streams
-    assert base.get("sinumerik").parse_stream("G0 X1\n") is None
+    assert base.get("iso-m").streams and base.get("sinumerik").streams
+    assert base.get("sinumerik").parse_stream("R1=2\nG0 X=R1\n") is None      # variables: parsed whole
+    assert base.get("sinumerik").parse_stream("G0 X1\n") is not None          # CAM output: streamed
 
 
 def test_an_iso_family_member_reuses_the_front_end_and_emitter_with_its_own_names():
