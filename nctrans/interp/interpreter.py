@@ -42,7 +42,7 @@ from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
 from nctrans.interp.run_checks import RunChecks
 from nctrans.interp.state import LINEAR_AXES, ModalState
-from nctrans.interp import sysvars, unmodelled
+from nctrans.interp import sections, sysvars, unmodelled
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_MODES
 from nctrans import plainrun
@@ -109,12 +109,14 @@ class Frame:
     """A call-stack entry: where to resume in the caller, and how to repeat the callee.
     saved: the caller's modal state and frames, restored on return from a SAVE subprogram."""
     __slots__ = ("unit", "pc", "sidx", "scope", "callee", "repeats", "args", "make_scope", "modal",
-                 "saved")
+                 "saved", "section")
 
-    def __init__(self, unit, pc, sidx, scope, callee, repeats, make_scope, modal=False, saved=None):
+    def __init__(self, unit, pc, sidx, scope, callee, repeats, make_scope, modal=False, saved=None,
+                 section=False):
         self.unit, self.pc, self.sidx, self.scope = unit, pc, sidx, scope
         self.callee, self.repeats, self.make_scope, self.modal = callee, repeats, make_scope, modal
         self.saved = saved
+        self.section = section      # a repeated program section (REPEAT), not a call level
 
 
 # Modal groups a SAVE subprogram does not restore: not G codes (spindle, coolant, tool length),
@@ -207,6 +209,7 @@ class Interpreter(LatheMixin, RunChecks):
         self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
         self._unmodelled_at = None                          # the span of the block that set it
         self.stack: list[Frame] = []
+        self.sections = 0               # REPEAT section frames on the stack (not call levels)
         self.span: Optional[n.Span] = None
         self._rc_init()                 # run_checks: NC210-NC214
         self._register_system()
@@ -386,6 +389,8 @@ class Interpreter(LatheMixin, RunChecks):
             n.Goto: self._c_goto, n.Alarm: lambda s: (self._h_alarm, s),
             n.DataSetting: lambda s: (self._h_data, s),
             n.PolarPole: lambda s: (self._h_pole, s),
+            n.SectionRepeat: lambda s: (self._h_section, (s, None if s.count is None
+                                                           else self.ev.compile(s.count))),
             n.Passthrough: self._c_passthrough,
             n.SpindleLimit: lambda s: (self._h_spindle_limit, s),
         }
@@ -1414,7 +1419,7 @@ class Interpreter(LatheMixin, RunChecks):
         if s.modal:
             call = n.SubCall(s.name, args, modal="after_move", kind="mcall")
             self.modal_cycle = None
-            self.modal_call = (call, self._call_args(call), len(self.stack))
+            self.modal_call = (call, self._call_args(call), self._depth())
             return None
         return ("call", n.SubCall(s.name, args, kind="proc"))
 
@@ -1718,9 +1723,49 @@ class Interpreter(LatheMixin, RunChecks):
     # ---------------------------------------------------------------- calls
     def _h_call(self, s: n.SubCall):
         if s.modal == "after_move":
-            self.modal_call = (s, self._call_args(s), len(self.stack))
+            self.modal_call = (s, self._call_args(s), self._depth())
             return None
         return ("call", s)
+
+    def _depth(self) -> int:
+        """The call level (a repeated section is not one: MCALL still calls in it)."""
+        return len(self.stack) - self.sections
+
+    def _h_section(self, d):
+        s, count = d
+        rep = 1
+        if count is not None:
+            r = self._value(count, "repeat count P")
+            rep = 1 if r is None else int(round(r))
+        return ("section", s, rep) if rep >= 1 else None
+
+    def _section(self, s: n.SectionRepeat, rep: int, unit: Unit, pc: int, sidx: int):
+        """Run a program section again `rep` times (nctrans.interp.sections), then resume after
+        the REPEAT statement at (pc, sidx)."""
+        first, last, problem = sections.section_bounds(s, unit.labels, label_key, pc)
+        key = ("section", id(unit), first, last)
+        callee = self.units.get(key)
+        if callee is None and not problem:
+            code, labels, problem = sections.section_code(unit.code, unit.labels, first, last,
+                                                          (JUMP, JFALSE))
+            if not problem:
+                callee = Unit(unit.name, unit.file, unit.params)
+                callee.code, callee.labels = code, labels
+                callee.seen = bytearray(len(code))
+                self.units[key] = callee
+        if problem:
+            self.diag("NC222", "error", f"{'REPEATB' if s.line_only else 'REPEAT'}: {problem}; "
+                      "the repetition is skipped")
+            return unit, unit.code, pc, sidx
+        if len(self.stack) >= MAX_CALL_DEPTH:
+            self.diag("NC105", "error", f"calls and repeated sections nested deeper than "
+                      f"{MAX_CALL_DEPTH}; REPEAT {s.start} skipped")
+            return unit, unit.code, pc, sidx
+        scope = self.ev.scope
+        self.stack.append(Frame(unit, pc, sidx, scope, callee, rep - 1, lambda: scope,
+                                section=True))
+        self.sections += 1
+        return callee, callee.code, 0, 0
 
     def _h_modal_off(self, s):
         self.modal_call = None
@@ -1898,7 +1943,7 @@ class Interpreter(LatheMixin, RunChecks):
                         sidx = 0
                         pc += 1
                         if self.moved and self.modal_call is not None and \
-                                len(self.stack) <= self.modal_call[2]:
+                                len(self.stack) - self.sections <= self.modal_call[2]:
                             ctl = ("modal_call",)
                     if ctl is not None:
                         unit, code, pc, sidx = self._control(ctl, unit, pc, sidx)
@@ -2065,6 +2110,11 @@ class Interpreter(LatheMixin, RunChecks):
             return self._turning_control(ctl[1], unit, pc, sidx)
         if kind == "goto":
             target = self._find_label(unit, ctl[1], ctl[2], pc)
+            if target is None and self.stack and self.stack[-1].section:
+                self.diag("NC222", "error", f"jump to {ctl[1]} out of a repeated program section "
+                          "is not modelled; the repetition ends here")
+                self.stack[-1].repeats = 0
+                return self._return(None)
             if target is None:
                 self.diag("NC102", "error", f"jump target {ctl[1]} not found")
                 if self.stack:
@@ -2074,7 +2124,14 @@ class Interpreter(LatheMixin, RunChecks):
         if kind == "return":
             if not self.stack:
                 raise _Stop
+            while self.stack[-1].section:          # RET inside a repeated section ends the call
+                self.stack[-1].repeats = 0
+                self._return(None)
+                if not self.stack:
+                    raise _Stop
             return self._return(ctl[1])
+        if kind == "section":
+            return self._section(ctl[1], ctl[2], unit, pc, sidx)
         if kind in ("call", "modal_call"):
             if kind == "call":
                 s = ctl[1]
@@ -2116,6 +2173,8 @@ class Interpreter(LatheMixin, RunChecks):
             self.ev.scope = fr.make_scope()
             return fr.callee, fr.callee.code, 0, 0
         self.stack.pop()
+        if fr.section:
+            self.sections -= 1
         self.ev.scope = fr.scope
         if fr.saved is not None:
             self._restore_state(fr.saved)

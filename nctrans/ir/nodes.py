@@ -334,6 +334,18 @@ class Goto:
 
 
 @node
+class SectionRepeat:
+    """Sinumerik program section repetition: run the blocks from label `start` again `count` times
+    (P=n; None = once), then go on after this statement. `line_only` (REPEATB): the labelled block
+    alone. `end` (REPEAT start end): up to and including the block labelled `end`. Neither: up to
+    the first ENDLABEL block after `start`, else up to the block before the REPEAT."""
+    start: str
+    end: Optional[str] = None
+    count: Optional[Expr] = None
+    line_only: bool = False
+
+
+@node
 class Message:
     text: Expr
 
@@ -384,7 +396,7 @@ Statement = Union[
     ModeChange, Motion, Feed, SpindleSpeed, SpindleLimit, ToolSelect, ToolChange, OffsetSelect, Dwell,
     SetPosition, ResetSetPosition, FrameOp, HomeReturn, CycleParams, CycleCall, SubCall,
     ModalCallOff, Return, ProgramEnd, Stop, Assign, VarDecl, Goto, Message, Alarm, Passthrough,
-    DataSetting, PolarPole,
+    DataSetting, PolarPole, SectionRepeat,
 ]
 
 

@@ -62,6 +62,8 @@ def jump_targets(nodes: Iterable) -> set[str]:
                     out.add(str(s.target))
                 elif type(s) is n.Return and s.to_label:
                     out.add(str(s.to_label))
+                elif type(s) is n.SectionRepeat:      # the section runs again from its label
+                    out.add(str(s.start))
         elif t is n.Case:
             out.update(str(label) for _, label in node.branches)
             if node.default is not None:

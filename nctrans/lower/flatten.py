@@ -138,6 +138,8 @@ class _Walker:
         t = type(s)
         if t is n.Goto:
             self.note("loop" if s.direction == "backward" else "branch", span)
+        elif t is n.SectionRepeat:
+            self.note("loop", span)
         elif t is n.SubCall:
             self.note("call", span)
         elif t is n.CycleCall or t is n.CycleParams or (t is n.ModeChange and s.group == "cycle"

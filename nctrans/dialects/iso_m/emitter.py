@@ -1001,6 +1001,10 @@ class IsoEmitter:
             return [("GOTO", f"IF[{self.cond(s.cond)}]GOTO{target}")]
         return [("GOTO", f"GOTO{target}")]
 
+    def w_SectionRepeat(self, s: n.SectionRepeat):
+        raise NotExpressible(f"a program section repetition (REPEAT {s.start}): ISO has no "
+                             "repeat of blocks by label")
+
     def w_Message(self, s):
         self.lowered("message written as an (MSG, ...) comment")
         text = s.text.value if type(s.text) is n.Str else format_expr(s.text, self)

@@ -349,6 +349,11 @@ class Emitter:
                 out.alone(f"IF {self.expr(s.cond)} {kw} {tgt}")
             else:
                 out.words.append(f"{kw} {tgt}")
+        elif isinstance(s, ir.SectionRepeat):
+            words = ["REPEATB" if s.line_only else "REPEAT", s.start] + ([s.end] if s.end else [])
+            if s.count is not None:
+                words.append(f"P={self.expr(s.count)}")
+            out.alone(" ".join(words))
         elif isinstance(s, ir.Message):
             out.words.append(f"MSG({self.expr(s.text)})")
         elif isinstance(s, ir.Alarm):

@@ -1315,6 +1315,14 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
         if line.label or line.comment:
             unit.root.append(ir.Block(span, [], None, line.label, None, line.comment))
         return
+    if (d == "repeat_stmt" and len(stmts) > 1) or (
+            d == "call_name" and str(head.children[0]) == "REPEATB"):
+        # REPEAT label [label] [P=n] / REPEATB label [P=n]: program section repetition, not the
+        # REPEAT..UNTIL loop (a bare REPEAT)
+        node = _section_repeat(low, stmts[1:], line, line_only=d == "call_name")
+        unit.current.append(ir.Block(span, [node] if node else [], line.number, line.label,
+                                     line.skip, line.comment))
+        return
     ctrl = d in _KW or (d == "if_stmt")
     decls = [st for st in stmts if st.data == "def_stmt"]
     if decls and len(decls) != len(stmts):
@@ -1398,6 +1406,29 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
         unit.current.append(ir.Case(span, expr(ch[1]), branches, default))
     if rest and d not in ("if_stmt",):
         low.error("NC002", f"{_KW.get(d, d)} must stand in its own block", line.lineno, line.col)
+
+
+def _section_repeat(low: Lowerer, args: list, line: Line, line_only: bool) -> Optional[ir.SectionRepeat]:
+    """`REPEAT start [end] [P=n]` / `REPEATB label [P=n]` [GK: Siemens Fundamentals manual, program
+    section repetition; the seed lists REPEATB only in its keyword table, L24650]."""
+    kw = "REPEATB" if line_only else "REPEAT"
+    labels: list[str] = []
+    count = None
+    for st in args:
+        if st.data == "call_name" and count is None and len(labels) < (1 if line_only else 2):
+            labels.append(str(st.children[0]))
+        elif st.data == "assign" and count is None and str(st.children[0].children[0]) == "P" \
+                and len(st.children) == 3:
+            count = expr(st.children[2])
+        else:
+            low.error("NC002", f"{kw} expects a jump label{'' if line_only else ' (and an end label)'}"
+                      " and P=<number of repetitions>", line.lineno, line.col)
+            return None
+    if not labels:
+        low.error("NC002", f"{kw} without the jump label of the section to repeat", line.lineno,
+                  line.col)
+        return None
+    return ir.SectionRepeat(labels[0], labels[1] if len(labels) > 1 else None, count, line_only)
 
 
 def _open(low: Lowerer, unit: _Unit, kind: str, node, body: list, line: Line) -> None:
