@@ -308,6 +308,8 @@ class Evaluator:
         # through the rules tables (rules.system_meaning) on first read, and by writes
         self.global_lengths: dict[str, int] = {}   # declared STRING[n] lengths of global_names
         self.system: dict[Any, Callable[[], Any]] = {}
+        # indexed system variables read with their subscripts ($P_GG[n]), by spelling
+        self.indexed_system: dict[str, Callable[[tuple], Any]] = {}
         # neutral meaning (vocabulary.SYSTEM_VARIABLES, "<meaning>.<axis>" per axis) -> reader and
         # writer; the interpreter registers them
         self.meanings: dict[str, Callable[[], Any]] = {}
@@ -696,6 +698,13 @@ class Evaluator:
         return UNKNOWN
 
     def read_system(self, name: str, idx: Optional[tuple]) -> Any:
+        if idx is not None:
+            g = self.indexed_system.get(name)
+            if g is not None:
+                v = g(idx)
+                if v is UNKNOWN:
+                    self.unknown_used = True
+                return v
         f = self._system_reader(name)
         if f is not None:
             return f()

@@ -42,7 +42,7 @@ from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
 from nctrans.interp.run_checks import RunChecks
 from nctrans.interp.state import LINEAR_AXES, ModalState
-from nctrans.interp import sections, sysvars, unmodelled
+from nctrans.interp import ggroups, sections, sysvars, unmodelled
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_MODES
 from nctrans import plainrun
@@ -208,6 +208,7 @@ class Interpreter(LatheMixin, RunChecks):
         self.pole: Optional[tuple[float, float]] = None   # polar pole in the plane (program coords)
         self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
         self._unmodelled_at = None                          # the span of the block that set it
+        self.spelt_codes: dict[str, str] = {}   # neutral group -> the code spelt last ($P_GG)
         self.stack: list[Frame] = []
         self.sections = 0               # REPEAT section frames on the stack (not call levels)
         self.span: Optional[n.Span] = None
@@ -649,6 +650,8 @@ class Interpreter(LatheMixin, RunChecks):
         st = self.st
         g, v = s.group, s.value
         self._rc_mode(g, v)
+        if s.code:
+            self.spelt_codes[g] = s.code
         if g == "motion":
             if st.cycle != "off":
                 self._cycle_off()
@@ -1855,6 +1858,10 @@ class Interpreter(LatheMixin, RunChecks):
         for name, value in (getattr(self.machine, "variables", None) or {}).items():
             sysv[str(name).upper()] = lambda value=value: float(value)
         sysvars.register(self, self.program.dialect)
+        gg = ggroups.index_reader(self.program.dialect, st.groups, self.spelt_codes,
+                                  lambda: self.unmodelled_motion)
+        if gg is not None:
+            self.ev.indexed_system["$P_GG"] = gg
 
     # ================================================================ the loop
     def run(self) -> Iterator[ToolpathRecord]:
