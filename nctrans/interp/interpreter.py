@@ -1059,10 +1059,14 @@ class Interpreter(LatheMixin, RunChecks):
             if vals:
                 self._move("rapid", self._target(vals))
             return
-        if motion == "linear" or motion == "thread":
+        if motion == "linear":
             if vals:
                 self._need_feed()
                 self._move("linear", self._target(vals))
+            return
+        if motion == "thread":
+            if vals:
+                self._thread(vals, center)
             return
         if motion in ("arc_cw", "arc_ccw"):
             self._arc(vals, center, radius, turns, motion == "arc_cw", aperture)
@@ -1085,6 +1089,50 @@ class Interpreter(LatheMixin, RunChecks):
             self.spindle_reported = True
             self.diag("NC209", "warning", "feed move while the spindle is stopped (M5, or a tool change that stops it): the tool "
                       "would rub or break; start the spindle (M3/M4) before cutting")
+
+    def _thread(self, vals, center) -> None:
+        """G33: a feed synchronised with the spindle, `lead` mm per revolution: the feed is
+        lead x S and the record carries the lead (pitch). The lead is the I/J/K word of the
+        block (Sinumerik, LinuxCNC, Fagor: the one of the axis that travels furthest when
+        several are given), else the F word in a dialect whose table says F is the lead
+        (`[options] thread_lead = "feed"`: ISO seed 4.5 `G33 Z.. F<lead>`)."""
+        st = self.st
+        target = self._target(vals)
+        leads = {a: abs(v) for a, v, _ in self._eval_words(center)} if center else {}
+        lead = None
+        if leads:
+            travel = {w: abs(target.get(a, 0.0) - self.pos.get(a, 0.0))
+                      for w, a in (("I", "X"), ("J", "Y"), ("K", "Z"))}
+            lead = leads[max(leads, key=lambda w: travel.get(w, 0.0))]
+        elif self._thread_lead_is_feed():
+            lead = st.feed if st.feed and st.feed_mode != "inverse_time" else None   # mm
+        if not lead:
+            self.diag("NC206", "error", "thread (G33) without a lead: the move is not made")
+            return
+        if not st.spindle_speed:
+            self.diag("NC209", "warning", "thread (G33) with no spindle speed: the feed (lead x S) "
+                      "is unknown")
+        saved, saved_mode = st.feed, st.feed_mode
+        st.feed = lead * st.spindle_speed if st.spindle_speed else None
+        st.feed_mode = "per_min"
+        mark = len(self.out)
+        try:
+            self._move("linear", target)
+        finally:
+            st.feed, st.feed_mode = saved, saved_mode
+        for rec in self.out[mark:]:
+            rec.pitch = lead
+
+    def _thread_lead_is_feed(self) -> bool:
+        v = getattr(self, "_lead_is_feed", None)
+        if v is None:
+            try:
+                from nctrans.rules import load_table
+                v = load_table(self.program.dialect).options.get("thread_lead") == "feed"
+            except Exception:          # no table for this dialect
+                v = False
+            self._lead_is_feed = v
+        return v
 
     def _polar(self, vals, polar):
         """Polar words (radius, angle in the active plane about the pole: program zero until

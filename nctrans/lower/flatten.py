@@ -333,10 +333,19 @@ class _Flattener:
         else:
             a1 = a2 = None
             motion = rec.kind
+        thread = rec.kind == "linear" and bool(rec.pitch)
+        if thread:
+            # tapping / G33: spindle-synchronised, never a plain feed (its feed is lead x S)
+            motion = "thread"
+            self.info_once("thread", "--flatten: tapping and threads written as spindle-synchronised "
+                           "G33 moves with their lead, the spindle reversed between them as the "
+                           "source's cycle does (first at this line)", span)
         if motion != self.motion:
             body.append(n.ModeChange("motion", motion))
             self.motion = motion
-        if rec.kind != "rapid":
+        if thread:
+            self.feed = None                 # ISO writes the lead as F: the feed is written again
+        elif rec.kind != "rapid":
             fm = rec.feed_mode or "per_min"
             if fm != self.feed_mode:
                 body.append(n.ModeChange("feed_mode", fm))
@@ -350,6 +359,10 @@ class _Flattener:
         if not axes:
             axes = list(target_vals)
         motion_stmt = n.Motion({a: n.AxisValue(n.Num(target_vals[a])) for a in axes})
+        if thread:
+            along = max(("X", "Y", "Z"), key=lambda a: abs(target_vals.get(a, prog_now.get(a, 0.0))
+                                                           - prog_now.get(a, 0.0)))
+            motion_stmt.center = {CENTRE_WORD[along]: n.AxisValue(_num(rec.pitch))}
         if rec.kind == "arc":
             c = rec.center or {}
             motion_stmt.center = {CENTRE_WORD[a]: n.AxisValue(_num(c.get(a, 0.0) - self.mpos.get(a, 0.0)))

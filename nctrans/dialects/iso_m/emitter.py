@@ -201,6 +201,11 @@ class IsoEmitter:
         self.pos: dict[str, float] = {}
         self.plane = "XY"
         self.cip_mode = False
+        # G33: ISO writes the thread lead as F, which is then the modal feed; the feed the source
+        # programmed last is written again on the next feed move after the thread
+        self.thread_mode = False
+        self.last_feed: Optional[str] = None
+        self.feed_clobbered = False
         self.frame_trans: Optional[dict[str, float]] = {}
         self.frame_other = False
 
@@ -590,6 +595,7 @@ class IsoEmitter:
         elif s.group in ("units", "work_offset", "tool_length", "diameter", "cycle"):
             self.pos = {}
         if s.group == "motion":
+            self.thread_mode = s.value == "thread"
             self.cip_mode = s.value == "arc_3point"
             if self.cip_mode:
                 return []                   # written as G2/G3 by the CIP block itself
@@ -697,6 +703,11 @@ class IsoEmitter:
         if s.indirect:
             raise NotExpressible("axis words with a computed axis (AX[..]=)")
         words = []
+        if self.thread_mode and s.center:
+            return self._thread(s, words)
+        if self.feed_clobbered and self.last_feed is not None and s.target:
+            words.append(("F", self.last_feed))
+            self.feed_clobbered = False
         if s.machine_coords:
             words.append(("", "G53"))
         words += self._axes(s.target)
@@ -727,8 +738,21 @@ class IsoEmitter:
                 words.append(("L", "L" + self.val(n.Binary("+", t, n.Num(1.0)))))
         return words
 
+    def _thread(self, s: n.Motion, words: list) -> list:
+        """G33 Z.. F<lead> (ISO seed 4.5): the I/J/K lead word of the IR (Sinumerik, flattened
+        tapping) is written as F."""
+        if len(s.center) != 1:
+            raise NotExpressible("a thread with more than one lead word (ISO G33 has one F lead)")
+        (av,) = s.center.values()
+        words += self._axes(s.target)
+        words.append(("F", self.addr("F", av.value)))
+        self.feed_clobbered = True
+        return words
+
     def w_Feed(self, s):
-        return [("F", self.addr("F", s.value))]
+        self.last_feed = self.addr("F", s.value)
+        self.feed_clobbered = False
+        return [("F", self.last_feed)]
 
     def w_SpindleSpeed(self, s):
         if s.spindle != 1:
