@@ -1066,7 +1066,7 @@ class Interpreter(LatheMixin, RunChecks):
             return
         if motion == "thread":
             if vals:
-                self._thread(vals, center)
+                self._g33_move(vals, center)
             return
         if motion in ("arc_cw", "arc_ccw"):
             self._arc(vals, center, radius, turns, motion == "arc_cw", aperture)
@@ -1090,7 +1090,7 @@ class Interpreter(LatheMixin, RunChecks):
             self.diag("NC209", "warning", "feed move while the spindle is stopped (M5, or a tool change that stops it): the tool "
                       "would rub or break; start the spindle (M3/M4) before cutting")
 
-    def _thread(self, vals, center) -> None:
+    def _g33_move(self, vals, center) -> None:
         """G33: a feed synchronised with the spindle, `lead` mm per revolution: the feed is
         lead x S and the record carries the lead (pitch). The lead is the I/J/K word of the
         block (Sinumerik, LinuxCNC, Fagor: the one of the axis that travels furthest when
@@ -1107,11 +1107,11 @@ class Interpreter(LatheMixin, RunChecks):
         elif self._thread_lead_is_feed():
             lead = st.feed if st.feed and st.feed_mode != "inverse_time" else None   # mm
         if not lead:
-            self.diag("NC206", "error", "thread (G33) without a lead: the move is not made")
+            self.diag("NC206", "error", "thread move (G33) without a lead: the move is not made")
             return
         if not st.spindle_speed:
-            self.diag("NC209", "warning", "thread (G33) with no spindle speed: the feed (lead x S) "
-                      "is unknown")
+            self.diag("NC209", "warning", "thread move (G33) with no spindle speed: the feed "
+                      "(lead x S) is unknown")
         saved, saved_mode = st.feed, st.feed_mode
         st.feed = lead * st.spindle_speed if st.spindle_speed else None
         st.feed_mode = "per_min"
