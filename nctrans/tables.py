@@ -45,12 +45,7 @@ def load(path, schema: type, build: Callable[[Any], T], section: tuple[str, ...]
         raw = path.read_bytes()
     except OSError as e:
         raise TableError(f"{path}: cannot read: {e.strerror or e}") from None
-    module = Path(sys.modules[schema.__module__].__file__).read_bytes()
-    # a cache key, not a signature: CRC-32 and length of both texts (hashlib's import alone costs
-    # more than reading the cached table)
-    key = (f"{zlib.crc32(raw):08x}{len(raw):x}-{zlib.crc32(module):08x}{len(module):x}-"
-           f"{CACHE_VERSION}{marshal.version}{sys.version_info[0]}{sys.version_info[1]}")
-    cached = cache_dir() / f"{Path(path.name).stem}-{key}.marshal"
+    cached = _entry(Path(path.name).stem, raw, schema)
     data = _read_cached(cached)
     if data is not _MISS and _has_fields(data, schema):
         try:
@@ -60,6 +55,37 @@ def load(path, schema: type, build: Callable[[Any], T], section: tuple[str, ...]
     data = _validate(path, raw, schema, section, prepare)
     _store(cached, data)
     return build(data)
+
+
+def remembered(name: str, raw: bytes, schema: type, make: Callable[[], T], dump: Callable[[T], Any],
+               build: Callable[[Any], T]) -> T:
+    """make() -- which reads `raw` and validates it against `schema` -- remembered per content as
+    `load` remembers tables: while the bytes and the schema's module are unchanged, later runs get
+    build(the stored dump(result)) and skip make (tomllib and pydantic). `dump` returns marshal
+    data; a result it cannot dump is simply not remembered."""
+    cached = _entry(name, raw, schema)
+    data = _read_cached(cached)
+    if data is not _MISS:
+        try:
+            return build(data)
+        except Exception:            # an entry of the wrong shape: a miss, made again below
+            pass
+    result = make()
+    try:
+        data = dump(result)
+    except (TypeError, ValueError):
+        return result
+    _store(cached, data)
+    return result
+
+
+def _entry(name: str, raw: bytes, schema: type) -> Path:
+    module = Path(sys.modules[schema.__module__].__file__).read_bytes()
+    # a cache key, not a signature: CRC-32 and length of both texts (hashlib's import alone costs
+    # more than reading the cached table)
+    key = (f"{zlib.crc32(raw):08x}{len(raw):x}-{zlib.crc32(module):08x}{len(module):x}-"
+           f"{CACHE_VERSION}{marshal.version}{sys.version_info[0]}{sys.version_info[1]}")
+    return cache_dir() / f"{name}-{key}.marshal"
 
 
 # The cache is trusted only as far as it is checked: an entry is a header (magic, CRC-32 and length

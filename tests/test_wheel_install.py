@@ -107,6 +107,46 @@ def test_installed_cli_runs_outside_the_checkout(installed, outside):
     assert one.returncode == 0 and one.stdout.startswith("NC002")
 
 
+# Runs the installed CLI as if the wheel had no compiled kernel (a platform pip serves no binary
+# wheel for, built where no C compiler was found): importing nctrans._plainrun fails as it would.
+NO_KERNEL = r'''
+import sys
+from importlib.abc import MetaPathFinder
+
+class NoKernel(MetaPathFinder):
+    def find_spec(self, name, path, target=None):
+        if name == "nctrans._plainrun":
+            raise ImportError("no compiled kernel in this install")
+        return None
+
+sys.meta_path.insert(0, NoKernel())
+from nctrans import cli, plainrun
+assert plainrun.native is None
+sys.exit(cli.main(sys.argv[1:]))
+'''
+
+
+def test_installed_wheel_without_its_kernel(installed, outside):
+    """The pure-Python fallback of the installed package: the same toolpath and lint findings as
+    with the kernel, from outside the checkout."""
+    bin_dir, _, env = installed
+    work = outside / "no-kernel"
+    work.mkdir()
+    part = work / "part.nc"
+    shutil.copy(CORPUS / "iso-mill" / "mheaton-fusion-adaptive-1001.nc", part)
+    script = work / "no_kernel.py"
+    script.write_text(NO_KERNEL, encoding="utf-8")
+    python, nctrans = str(bin_dir / "python"), str(bin_dir / "nctrans")
+    out = {}
+    for args in (["toolpath", "part.nc"], ["lint", "--format", "json", "part.nc"]):
+        with_kernel = _run([nctrans, *args], cwd=work, env=env)
+        without = _run([python, str(script), *args], cwd=work, env=env)
+        assert with_kernel.returncode == without.returncode and without.returncode in (0, 1), without.stderr
+        assert without.stdout == with_kernel.stdout, args
+        out[args[0]] = without.stdout
+    assert out["toolpath"].count("\n") > 20_000 and json.loads(out["lint"])["files"] == 1
+
+
 API_SCRIPT = r'''
 import pathlib, sys, tracemalloc
 import nctrans
