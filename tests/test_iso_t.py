@@ -197,7 +197,8 @@ def test_iso_t_to_sinumerik_and_back_is_equivalent(path, tmp_path):
 
 @pytest.mark.rs274
 @pytest.mark.parametrize("path", [CONF / "g71-g70-type1.nc", CONF / "g90-g94-g92.nc",
-                                  TURN / "enier-haas-valve.nc"], ids=lambda p: p.name)
+                                  CONF / "g71-type2-pockets.nc", TURN / "enier-haas-valve.nc"],
+                         ids=lambda p: p.name)
 def test_flattened_iso_t_runs_in_rs274_with_the_same_xz_moves(path, rs274, rs274_cache):
     import rs274 as h
     from nctrans.lower.flatten import flatten
@@ -323,3 +324,26 @@ def test_g72_type2_face_groove_is_roughed_after_the_outer_levels():
     want += [("rapid", 20.0, -6.0), ("linear", 16.0, -6.0), ("linear", 16.0, -2.0), ("linear", 13.0, -2.0),
              ("linear", 13.0, -5.0), ("linear", 11.0, -5.0), ("linear", 11.0, 2.0), ("rapid", 20.0, 2.0)]
     assert moves(recs, 5) == want
+
+
+def test_g76_chamfer_pulls_out_at_45_degrees_over_tenths_of_the_lead():
+    """P011060: 1 finishing pass, chamfer 10 tenths of the lead F2 = 2 mm, 60-degree tool. Start
+    X30 (radius 15) Z5, root X24 (12), height P1500 = 1.5, first depth Q500 = 0.5, so the first pass
+    cuts at 13.5 - 0.5 = 13.0 with the flank shift (1.5 - 0.5) * tan 30 = 0.57735 in +Z. Every pass
+    leaves the root 2 before its (shifted) end and reaches the end 2 further out (45 degrees)."""
+    text = ("G18 G21 G99\nT0101\nG97 S500 M03\nG00 X30. Z5.\nG76 P011060 Q100 R0.05\n"
+            "G76 X24. Z-20. P1500 Q500 F2.0\nM30\n")
+    recs, diags = run(Path("g76.nc"), text)
+    assert not diags, diags
+    got = moves(recs, 6)
+    assert got[:5] == [("rapid", 15.0, 5.57735), ("rapid", 13.0, 5.57735), ("linear", 13.0, -17.42265),
+                       ("linear", 15.0, -19.42265), ("rapid", 15.0, 5.0)]
+    cuts = [r for r in recs if r.line == 6 and r.kind == "linear"]
+    assert len(cuts) % 2 == 0 and all(r.feed_mode == "per_rev" and r.feed == 2.0 for r in cuts)
+    for root, out in zip(cuts[::2], cuts[1::2]):
+        shift = root.end["Z"] + 18.0                       # the flank shift of this pass
+        assert out.end["Z"] == pytest.approx(-20.0 + shift, abs=1e-9)
+        assert out.end["X"] - root.end["X"] == pytest.approx(2.0, abs=1e-9)
+    assert cuts[-1].end["X"] == pytest.approx(12.0 + 2.0)   # the last pass at the root, X24
+    _, plain = run(Path("g76.nc"), text.replace("P011060", "P010060"))
+    assert not plain

@@ -236,3 +236,21 @@ def test_corpus_g42_program_keeps_its_nose_path_through_sinumerik(tmp_path):
     p = _cli("equiv", "--machine", str(machine), "--from-a", "iso-t", "--from-b", "iso-t",
              str(src), str(back))
     assert p.returncode == 0, p.stdout + p.stderr
+
+
+@pytest.mark.rs274
+def test_flattened_nose_path_runs_in_rs274_with_the_same_moves(rs274, rs274_cache):
+    """--flatten folds the nose compensation into the tip path: rs274 runs it as plain moves."""
+    from nctrans.lower.flatten import flatten
+    from test_flatten import rs274_run
+    machine = lathe()
+    text = CHAMFER.replace("T0101\n", "T0101\nG97 S500 M03\n")        # rs274 feeds per rev only turning
+    src = get("iso-t").parse(text, "nose.nc").program
+    records = [r for r in interpret(src, machine, diagnostics=[]) if r.kind in ("rapid", "linear", "arc")]
+    flat = flatten(src, machine, diagnostics=[])
+    res = get("iso-m").emit(flat)
+    assert "G42" not in res.text and not [d for d in res.diagnostics if d.severity == "error"]
+    result = rs274_run(res.text, "isot-nose", machine, rs274_cache)
+    assert result.completed, result.message
+    problem = h.compare(result.moves, [h.Motion.of(r) for r in records], "nose.nc")
+    assert problem is None, problem

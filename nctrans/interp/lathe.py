@@ -235,12 +235,10 @@ class LatheMixin:
         passes = int(opts.get("thread_finish_passes", 0))
         angle = float(opts.get("thread_angle", 0.0))
         mode = first.get("mode")
-        if mode is not None:                  # Fanuc P mmrraa
+        chamfer = 0
+        if mode is not None:                  # Fanuc P mmrraa: rr = pull-out in tenths of the lead
             m = int(round(mode))
             passes, chamfer, angle = m // 10000, (m // 100) % 100, float(m % 100)
-            if chamfer:
-                self.diag("NC232", "warning", "G76 thread chamfer (pull-out) is not modelled; the "
-                          "passes end square at Z")
         if "angle" in vals:
             angle = vals["angle"]
         height = vals.get("height", 0.0) * L
@@ -250,8 +248,10 @@ class LatheMixin:
             return
         depths = turning.thread_depths(height, depth1, first.get("min_depth", 0.0) * L,
                                        first.get("finish_allow", 0.0) * L, passes)
+        pull = chamfer * 0.1 * (self.st.feed or 0.0)
+        rise = math.tan(math.radians(float(opts.get("thread_chamfer_angle", 45.0))))
         self._emit_turning(turning.thread_passes(start, target, height, depths,
-                                                 vals.get("taper", 0.0) * L, angle))
+                                                 vals.get("taper", 0.0) * L, angle, pull, rise))
 
     # ------------------------------------------------------------------ contours
     def _contour_blocks(self, vals: dict, unit, pc):

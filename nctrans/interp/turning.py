@@ -332,10 +332,13 @@ def thread_depths(height: float, first: float, min_step: float = 0.0, finish_all
     return out
 
 
-def thread_passes(start, target, height: float, depths: list[float], taper: float, angle: float):
+def thread_passes(start, target, height: float, depths: list[float], taper: float, angle: float,
+                  chamfer: float = 0.0, chamfer_rise: float = 1.0):
     """G76 passes (d = X, p = Z). The root is the target; the crest lies `height` outside it (on the
     start side). Each pass: rapid along p to the flank-shifted start (single-edge infeed at half
-    the tool angle), rapid across to the depth, thread to the end, rapid out to d0, rapid to p0."""
+    the tool angle), rapid across to the depth, thread to the end, rapid out to d0, rapid to p0.
+    With a chamfer (pull-out) the thread leaves the root `chamfer` before the end and reaches the
+    end `chamfer * chamfer_rise` further out (rise = tan of the pull-out angle, 1 at 45 degrees)."""
     (d0, p0), (dt, pt) = start, target
     sd = _sign(dt - d0)
     sp = _sign(pt - p0)
@@ -349,8 +352,13 @@ def thread_passes(start, target, height: float, depths: list[float], taper: floa
         if abs(shift) > EPS:
             out.append(("rapid", (d0, ps), None, None))
         out.append(("rapid", (d_cut + taper, ps), None, None))
-        out.append(("thread", (d_cut, pt + shift), None, None))
-        out.append(("rapid", (d0, pt + shift), None, None))
+        if chamfer > EPS:
+            out.append(("thread", (d_cut, pt + shift - sp * chamfer), None, None))
+            out.append(("thread", (d_cut - sd * chamfer * chamfer_rise, pt + shift), None, None))
+        else:
+            out.append(("thread", (d_cut, pt + shift), None, None))
+        if abs(out[-1][1][0] - d0) > EPS:           # a pull-out may end on the start line
+            out.append(("rapid", (d0, pt + shift), None, None))
         out.append(("rapid", (d0, p0), None, None))
     return out
 
