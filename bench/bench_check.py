@@ -5,18 +5,23 @@ with its holder as two cylinders), four clamps and a vise jaw (a mesh of a few t
 triangles) beside the part, and the piece as stock. Three runs, each the streamed parse + interpreter the CLI uses: the toolpath alone
 (records drained), the check with limits and cycle time only, and the full check (also
 collisions and the stock Z-map). Moves/s = motion records / seconds, best of --repeat.
-Peak memory (tracemalloc) of the full check for the program and for the program 10x over must
-stay flat: records stream through, the Z-map is fixed by the stock's size. No assertions.
+Memory is measured on the command as a user runs it: `nctrans check FILE --machine M.toml` in a
+subprocess, its peak resident set (os.wait4), for a 30-line head of the program (what the
+imports, the machine and its meshes cost), the program, and the program 10x over, each with the
+limits-only and the full machine. Records stream through and the Z-map is fixed by the stock's
+size, so the only part that grows is the program's text, held once (~1 byte per character).
+No assertions.
 """
 from __future__ import annotations
 
 import argparse
 import gc
 import math
+import os
+import subprocess
 import sys
 import tempfile
 import time
-import tracemalloc
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -108,13 +113,35 @@ def best(fn, repeat: int) -> float:
     return out
 
 
-def peak_mib(text, name, machine) -> float:
-    gc.collect()
-    tracemalloc.start()
-    run_check(text, name, machine)
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    return peak / 2**20
+# A forked child's peak RSS counts the parent it was forked from until exec (Linux keeps
+# ru_maxrss across exec), and this process holds trimesh and the meshes: a small fresh Python
+# starts the command and reports that child's peak alone.
+_LAUNCH = ("import os, subprocess, sys, time\n"
+           "t = time.perf_counter()\n"
+           "p = subprocess.Popen(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)\n"
+           "_, status, usage = os.wait4(p.pid, 0)\n"
+           "print(usage.ru_maxrss / 1024, time.perf_counter() - t, os.waitstatus_to_exitcode(status))\n")
+
+
+def peak_rss(cmd: list[str]) -> tuple[float, float, int]:
+    """(peak resident MiB, wall seconds, exit code) of one CLI run, as measured by _LAUNCH."""
+    out = subprocess.run([sys.executable, "-c", _LAUNCH] + cmd, capture_output=True, text=True, check=True)
+    mib, seconds, code = out.stdout.split()
+    return float(mib), float(seconds), int(code)
+
+
+def cli_memory(tmp: Path, text: str) -> list[tuple[str, float, tuple, tuple]]:
+    """Rows (program, size MiB, (limits MiB, s, exit), (full MiB, s, exit)) of `nctrans check`."""
+    nctrans = [sys.executable, "-m", "nctrans"]
+    head = "\n".join(text.splitlines()[:30]) + "\nM30\n"
+    rows = []
+    for label, body in (("30-line head", head), ("program", text), ("program x10", repeated(text, 10))):
+        src = tmp / f"check-{label.replace(' ', '-')}.nc"
+        src.write_text(body)
+        runs = tuple(peak_rss(nctrans + ["check", str(src), "--from", "iso-m", "--machine", str(tmp / toml)])
+                     for toml in ("tools.toml", "full.toml"))
+        rows.append((label, src.stat().st_size / 2**20) + runs)
+    return rows
 
 
 def main(argv=None) -> int:
@@ -133,8 +160,7 @@ def main(argv=None) -> int:
         t_tp = best(lambda: drain(text, path.name, full), args.repeat)
         t_lim = best(lambda: run_check(text, path.name, limits_only), args.repeat)
         t_full = best(lambda: run_check(text, path.name, full), args.repeat)
-        one = peak_mib(text, path.name, full)
-        ten = peak_mib(repeated(text, 10), path.name, full)
+        rows = cli_memory(Path(d), text)
     print(f"\nnctrans check on {PROGRAM} ({len(text.splitlines()):,} lines, {moves:,} moves; "
           f"{len(full.fixtures)} fixtures, one a {jaw_faces:,}-triangle mesh; stock Z-map; best of {args.repeat})")
     print(f"{'run':<34}{'seconds':>9}{'moves/s':>11}")
@@ -142,7 +168,13 @@ def main(argv=None) -> int:
                      ("check: + collisions + stock", t_full)):
         print(f"{label:<34}{t:>9.2f}{moves / t:>11,.0f}")
     print(f"findings on this set-up: {len(res.findings)}; cycle time {res.cycle.total_s / 60:.1f} min")
-    print(f"peak memory of the full check (tracemalloc): program {one:.1f} MiB, program 10x {ten:.1f} MiB")
+    print("\n`nctrans check FILE --machine M.toml` as a user runs it: peak RSS of the process (MiB), wall s")
+    print(f"{'input':<16}{'file MiB':>9}{'limits MiB':>12}{'s':>7}{'full MiB':>10}{'s':>7}")
+    for label, size, (lm, ls, lrc), (fm, fs, frc) in rows:
+        bad = "" if lrc < 2 and frc < 2 else f"  (exit {lrc}/{frc}: failed)"
+        print(f"{label:<16}{size:>9.1f}{lm:>12.1f}{ls:>7.2f}{fm:>10.1f}{fs:>7.2f}{bad}")
+    (_, _, (l1, _, _), (f1, _, _)), (_, _, (l10, _, _), (f10, _, _)) = rows[1], rows[2]
+    print(f"10x / 1x: limits {l10 / l1:.2f}x, full {f10 / f1:.2f}x")
     return 0
 
 

@@ -170,6 +170,7 @@ def decode(data: bytes, file: str = STDIN_LABEL) -> SourceText:
         text, encoding = body.decode("utf-8", errors="replace"), "utf-8-sig"
     else:
         text, encoding = _decode_8bit(body)
+    del data, body, head            # the bytes go before normalising: peak = bytes + text, not more
     return from_text(text, file, encoding)
 
 

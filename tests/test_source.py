@@ -146,3 +146,14 @@ def test_newlines_and_stray_controls_normalised_as_the_plain_regexes_would(text)
     want = re.sub("[\x00-\x08\x0b-\x1f\x7f-\x9f\ufeff]", " ", re.sub("\r\n?", "\n", text))
     got = from_text(text, "t.nc").text
     assert got == (want if want.endswith("\n") else want + "\n")
+
+
+def test_a_stray_control_past_the_first_piece_is_normalised():
+    """The ASCII check goes a piece at a time: a control in a later piece, or at a piece's
+    edge, is still replaced."""
+    size = 1 << 16                  # the piece source._ascii_stray checks at a time
+    for at in (size - 1, size, 2 * size + 5):
+        text = "G0 X1\n" * (3 * size // 6)
+        text = text[:at] + "\x0c" + text[at + 1:]
+        got = from_text(text, "big.nc").text
+        assert len(got) == len(text) and got[at] == " " and "\x0c" not in got
