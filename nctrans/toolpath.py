@@ -10,9 +10,11 @@ from dataclasses import dataclass
 from typing import Optional
 
 KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant", "stop", "limits")
-# "limits": programmable travel limits from here on (e.g. Fagor G198/G199), machine coordinates:
-# `start` holds the lower limits, `end` the upper ones, by axis; an axis absent from both is
-# unbounded, and a limits record with neither lifts every programmable limit.
+# "limits": programmable travel limits from here on, in machine coordinates (Fagor G198/G199,
+# Sinumerik G25/G26 under WALIMON, ISO G22), of two sorts that replace only their own sort:
+# - without `zone`: `start` holds the lower limits, `end` the upper ones, by axis; an axis absent
+#   from both is unbounded, and a record with neither lifts every programmable axis limit;
+# - with zone "inside": the box from `start` to `end` is forbidden (neither: no zone any more).
 
 
 @dataclass(slots=True)
@@ -43,6 +45,7 @@ class ToolpathRecord:
     css: Optional[float] = None
     spindle_limit: Optional[float] = None
     css_axis: Optional[float] = None
+    zone: Optional[str] = None             # limits records: "inside" = the box is forbidden
 
     def to_dict(self) -> dict:
         out = {}

@@ -162,6 +162,8 @@ def to_json_line(r: ToolpathRecord) -> str:
         s += ',"spindle_limit":' + _spell(r.spindle_limit)
     if r.css_axis is not None:
         s += ',"css_axis":' + _spell(r.css_axis)
+    if r.zone is not None:
+        s += f',"zone":"{r.zone}"'
     s += "}"
     if "nan" in s or "inf" in s:      # a non-finite number (or a file name containing the letters)
         return _safe_json_line(r)

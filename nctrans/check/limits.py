@@ -32,10 +32,12 @@ class LimitCheck:
         self.max_rpm = machine.spindle.max_rpm
         self.known_axes = set(machine.axes)
         self.programmed: tuple[dict, dict] = ({}, {})     # programmable (lower, upper) limits
+        self.zone: Optional[tuple[dict, dict]] = None       # programmed forbidden box (min, max)
         self._found: dict[tuple, Finding] = {}
         self._unknown_axes: set[str] = set()
         self._speed: Optional[float] = None     # last spindle speed seen (reported where it changes)
         self._css_over = False                  # inside a run of moves whose CSS is over the limit
+        self._placed = False                    # has a move put the machine somewhere known?
 
     def findings(self) -> list[Finding]:
         return list(self._found.values())
@@ -44,7 +46,10 @@ class LimitCheck:
     def add(self, r: ToolpathRecord) -> None:
         kind = r.kind
         if kind == "limits":
-            self.programmed = (dict(r.start or {}), dict(r.end or {}))
+            if r.zone is not None:
+                self.zone = (dict(r.start), dict(r.end)) if r.start and r.end else None
+            else:
+                self.programmed = (dict(r.start or {}), dict(r.end or {}))
             return
         if r.spindle is not None and r.spindle != self._speed:
             self._speed = r.spindle
@@ -56,6 +61,9 @@ class LimitCheck:
         if kind == "arc" and r.center is not None:
             for p, _frac in arc_extremes(r):
                 self._point(r, p, "in the arc's sweep")
+        if self.zone is not None:
+            self._zone(r)
+        self._placed = True
         if kind != "rapid":
             self._feed(r)
         css = getattr(r, "css", None)
@@ -111,6 +119,34 @@ class LimitCheck:
                     "NC302", r.file, r.line, a,
                     f"{a} beyond the programmed lower limit{suffix}: {a}{v:.3f} is {lo - v:.3f} mm below {lo:g}",
                     dict(p), lo - v))
+
+    # ------------------------------------------------------------------ forbidden zone
+    def _zone(self, r: ToolpathRecord) -> None:
+        """A move whose path enters the programmed forbidden box (not only its end: a straight
+        move is clipped against the box, an arc as chords of at most 1 degree)."""
+        lo, hi = self.zone
+        axes = [a for a in lo if a in hi]
+        if not axes:
+            return
+        if not self._placed:        # the first move starts where the machine is assumed to be
+            pts = [r.end, r.end]
+        else:
+            pts = [r.start or r.end] + [p for p, _ in arc_points(r)] if r.kind == "arc" and r.center \
+                else [r.start or r.end, r.end]
+        deepest, depth = None, 0.0
+        for p, q in zip(pts, pts[1:]):
+            hit = segment_in_box(p, q, lo, hi, axes)
+            if hit is not None:
+                d = min(min(hit[a] - lo[a], hi[a] - hit[a]) for a in axes)
+                if deepest is None or d > depth:
+                    deepest, depth = hit, d
+        if deepest is not None:
+            box = " ".join(f"{a}{lo[a]:g}..{hi[a]:g}" for a in axes)
+            self._keep((r.file, r.line, "zone"), Finding(
+                "NC302", r.file, r.line, "zone",
+                f"the move enters the programmed protection zone {box} (machine coordinates), "
+                f"{depth:.3f} mm deep at " + " ".join(f"{a}{deepest[a]:.3f}" for a in axes),
+                dict(deepest), depth))
 
     # ------------------------------------------------------------------ feed
     def _feed(self, r: ToolpathRecord) -> None:
@@ -204,3 +240,47 @@ def smallest_radius(r: ToolpathRecord) -> float:
     elif (x0 > 0) != (x1 > 0):
         xs.append(0.0)                     # the move crosses the spindle axis
     return min(xs)
+
+
+def arc_points(r: ToolpathRecord, step_deg: float = 1.0):
+    """Points along an arc (machine coordinates) no more than `step_deg` apart, its end last, each
+    with its fraction of the sweep."""
+    t0, sweep, radius, (a1, a2) = arc_sweep(r)
+    n = max(1, int(math.ceil(abs(math.degrees(sweep)) / step_deg)))
+    s, e, c = r.start, r.end, r.center
+    out = []
+    for i in range(1, n + 1):
+        f = i / n
+        t = t0 + sweep * f
+        p = {a: s.get(a, 0.0) + (e.get(a, 0.0) - s.get(a, 0.0)) * f for a in set(s) | set(e)}
+        p[a1] = c[a1] + radius * math.cos(t)
+        p[a2] = c[a2] + radius * math.sin(t)
+        out.append((p, f))
+    out[-1] = (dict(e), 1.0)
+    return out
+
+
+def segment_in_box(p: dict, q: dict, lo: dict, hi: dict, axes) -> Optional[dict]:
+    """The deepest point of the straight move p -> q strictly inside the box (slab clipping), or
+    None when it stays outside or only touches the faces."""
+    t0, t1 = 0.0, 1.0
+    for a in axes:
+        a0, a1 = p.get(a, 0.0), q.get(a, 0.0)
+        d = a1 - a0
+        if abs(d) < 1e-12:
+            if a0 <= lo[a] + EPS or a0 >= hi[a] - EPS:
+                return None
+            continue
+        u, v = (lo[a] + EPS - a0) / d, (hi[a] - EPS - a0) / d
+        if u > v:
+            u, v = v, u
+        t0, t1 = max(t0, u), min(t1, v)
+        if t0 > t1:
+            return None
+    best, depth = None, -1.0
+    for t in (t0, (t0 + t1) / 2, t1):       # depth is concave along the segment: ends and middle
+        pt = {a: p.get(a, 0.0) + (q.get(a, 0.0) - p.get(a, 0.0)) * t for a in set(p) | set(q)}
+        dd = min(min(pt[a] - lo[a], hi[a] - pt[a]) for a in axes)
+        if dd > depth:
+            best, depth = pt, dd
+    return best

@@ -42,6 +42,7 @@ from nctrans.interp.frames import PLANE_AXES, Offsets, ProgrammableFrame
 from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
 from nctrans.interp.run_checks import RunChecks
 from nctrans.interp.state import LINEAR_AXES, ModalState
+from nctrans.interp.travel_limits import ProgrammedLimits
 from nctrans.interp import ggroups, sections, sysvars, unmodelled
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_MODES
@@ -173,6 +174,7 @@ class Interpreter(LatheMixin, RunChecks):
         self.ev = Evaluator()
         self.frame = ProgrammableFrame()
         self.off = Offsets()
+        self.travel_limits: Optional[ProgrammedLimits] = None     # set by the first TravelLimit
         if self.st.work_offset:
             self.off.set_work(self._work_offset(self.st.work_offset))
         # machine position (last emitted end) and the same point in program coordinates
@@ -394,6 +396,7 @@ class Interpreter(LatheMixin, RunChecks):
                                                            else self.ev.compile(s.count))),
             n.Passthrough: self._c_passthrough,
             n.SpindleLimit: lambda s: (self._h_spindle_limit, s),
+            n.TravelLimit: lambda s: (self._h_travel_limit, (s, self._words(s.values), self._words(s.corner))),
         }
 
     # ================================================================ helpers
@@ -719,6 +722,8 @@ class Interpreter(LatheMixin, RunChecks):
                 z = -z
         self.off.set_tool(z)
         self._resync()
+        if self.travel_limits is not None:      # limits on the tool tip follow its length
+            self._send_limits()
 
     def _c_feed(self, s: n.Feed):
         c = constant(s.value)
@@ -1176,6 +1181,28 @@ class Interpreter(LatheMixin, RunChecks):
         else:
             self.diag("NC220", "warning", f"{what} is not modelled: the analysed toolpath leaves "
                       "it out")
+
+    def _h_travel_limit(self, d) -> None:
+        """Programmed travel limits (travel_limits.py): nothing moves; `limits` records tell the
+        machine check. Values are lengths in program units, X as a radius."""
+        s, words, corner = d
+        if self.travel_limits is None:
+            self.travel_limits = ProgrammedLimits(getattr(self.machine, "axes", None))
+        scale = self.st.scale
+
+        def values(ws):
+            out = {}
+            for axis, c, f, _mode in ws:
+                v = c if c is not None else self._value(f, f"{axis} limit")
+                if v is not None:
+                    out[axis] = v * scale if axis in LENGTH_WORDS else v
+            return out
+        self.travel_limits.apply(s.kind, s.scope, values(words), values(corner), s.incremental)
+        self._send_limits()
+
+    def _send_limits(self) -> None:
+        for kw in self.travel_limits.pending(self.off.tool_z):
+            self._record("limits", **kw)
 
     def _h_pole(self, s: n.PolarPole) -> None:
         """G110/G111/G112: the pole relative to the last programmed point, the workpiece zero or

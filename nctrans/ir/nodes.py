@@ -385,6 +385,30 @@ class PolarPole:
 
 
 @node
+class TravelLimit:
+    """Programmable travel limits: they move nothing; the interpreter hands them to the machine
+    check as `limits` toolpath records, in machine coordinates.
+
+    scope (where the values are and which point they bound):
+    - "machine": machine axis positions (Fagor G198/G199 software limits);
+    - "work_area": the tool tip with tool-length compensation, without work offsets or frames
+      (the basic coordinate system: Sinumerik G25/G26 working area, switched by WALIMON/WALIMOF);
+    - "zone": a box the tool tip must not enter, in the same coordinates (ISO G22 stored stroke
+      check / protection zone 3; G23 switches it off).
+    kind: "lower" / "upper" (per-axis limits in `values`), "box" (`values` one corner, `corner`
+    the other), "on" / "off" (switch the scope's limits). incremental: the values are added to
+    the limits in force (Fagor G91 G198). text/dialect: the source spelling, which only that
+    dialect's emitter writes back (the scopes differ between controls)."""
+    kind: str
+    scope: str
+    values: dict[str, "Expr"] = field(default_factory=dict)
+    corner: dict[str, "Expr"] = field(default_factory=dict)
+    incremental: bool = False
+    text: str = ""
+    dialect: str = ""
+
+
+@node
 class Passthrough:
     """A valid construct the IR has no concept for: kept verbatim (never dropped) with why."""
     text: str
@@ -396,7 +420,7 @@ Statement = Union[
     ModeChange, Motion, Feed, SpindleSpeed, SpindleLimit, ToolSelect, ToolChange, OffsetSelect, Dwell,
     SetPosition, ResetSetPosition, FrameOp, HomeReturn, CycleParams, CycleCall, SubCall,
     ModalCallOff, Return, ProgramEnd, Stop, Assign, VarDecl, Goto, Message, Alarm, Passthrough,
-    DataSetting, PolarPole, SectionRepeat,
+    DataSetting, PolarPole, SectionRepeat, TravelLimit,
 ]
 
 

@@ -45,6 +45,7 @@ from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.unmodelled import no_motion_effect
 from nctrans.ir import nodes as n
+from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans.ir.walk import walk
 from nctrans.toolpath import ToolpathRecord
 
@@ -168,6 +169,9 @@ class _Walker:
                 self.note("arcform", span)
         elif t is n.Passthrough:
             self.passthrough(s, span)
+            return
+        elif t is n.TravelLimit:        # no motion; the limits stay in the check's toolpath
+            self.passthrough(n.Passthrough(s.text, NO_EFFECT_PREFIX + " (travel limits)", s.dialect), span)
             return
         if "expr" not in self.first and t is not n.Passthrough and dataclasses.is_dataclass(s):
             if any(_has_expr(getattr(s, f.name)) for f in dataclasses.fields(s)):

@@ -520,6 +520,11 @@ class _Emitter:
         elif t is n.SetPosition:
             words = " ".join(f"{a}{val(v.value)}" for a, v in s.target.items())
             word("", f"G92 {words}".strip(), alone=True)
+        elif t is n.TravelLimit:
+            if s.dialect != DIALECT:
+                raise NotExpressible(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
+                                     f"({s.scope.replace('_', ' ')} limits differ between controls)")
+            word("", s.text, alone=True)
         elif t is n.Passthrough:
             if s.dialect == DIALECT:
                 word("", s.text, alone=s.text.startswith("#"))

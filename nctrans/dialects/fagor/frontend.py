@@ -644,7 +644,8 @@ class Lowerer:
                 out.append((B_NONMODAL, ir.FrameOp("mirror", clear=True)))
 
     def _soft_limits(self, w: _Words, vals: dict, out) -> None:
-        """G198/G199: software limits as data for the machine check (Program.meta["soft_limits"])."""
+        """G198/G199: software limits for the machine check (TravelLimit; constant ones also as
+        Program.meta["soft_limits"])."""
         for rule, code, _ in w.gs:
             if rule.group != "soft_limit":
                 continue
@@ -654,13 +655,14 @@ class Lowerer:
                      "incremental": self.distance == "incremental"}
             for a, e in axes.items():
                 c = _const(e)
-                if c is None:
-                    self.note("NC415", "warning", f"{code} {a} with a computed value: not recorded")
-                    continue
-                entry["axes"][a] = c
+                if c is not None:           # (the interpreter evaluates computed values)
+                    entry["axes"][a] = c
             self.soft_limits.append(entry)
-            out.append((B_NONMODAL, ir.Passthrough(code + " " + " ".join(
-                f"{a}{_text_expr(e)}" for a, e in axes.items()), NO_PATH_EFFECT, DIALECT)))
+            # machine axis positions (the interpreter sends them to the check as `limits`)
+            out.append((B_NONMODAL, ir.TravelLimit(
+                rule.value, "machine", axes, incremental=self.distance == "incremental",
+                text=code + " " + " ".join(f"{a}{_text_expr(e)}" for a, e in axes.items()),
+                dialect=DIALECT)))
 
 
 _PLANE_LETTERS = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}

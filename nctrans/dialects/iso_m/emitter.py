@@ -1085,6 +1085,13 @@ class IsoEmitter:
         raise NotExpressible(f"a polar pole ({s.code or 'G111'}): ISO polar coordinates turn about "
                              "the work zero")
 
+    def w_TravelLimit(self, s: n.TravelLimit):
+        self.forget()
+        if s.dialect != self.dialect:
+            raise NotExpressible(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
+                                 f"({s.scope.replace('_', ' ')} limits differ between controls)")
+        return [("", s.text)]
+
     def w_Passthrough(self, s: n.Passthrough):
         self.forget()
         if s.dialect not in ("", self.dialect):

@@ -24,7 +24,7 @@ from nctrans.ir.nodes import (
     Alarm, Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
     HomeReturn, If, Loop, ModalCallOff, ModeChange, Motion, Num, OffsetSelect, Passthrough,
     Program, ProgramEnd, ResetSetPosition, Return, SetPosition, Span, SpindleSpeed, Stop,
-    Str, SubCall, Subprogram, ToolChange, ToolSelect, Var, While,
+    Str, SubCall, Subprogram, ToolChange, ToolSelect, TravelLimit, Var, While,
 )
 from nctrans.rules import load_table, normalise_code
 
@@ -161,7 +161,7 @@ class Lowering:
         self.g_handlers = {
             "motion": self._g_motion, "cycle": self._g_cycle, "work_offset": self._g_wcs,
             "frame": self._g_frame, "call": self._g_call, "nonmodal": self._g_nonmodal,
-            "passthrough": self._g_passthrough,
+            "passthrough": self._g_passthrough, "travel_limit": self._g_frame,
         }
         self.nonmodal_handlers = {
             "dwell": self._nm_owner, "home": self._nm_owner, "home2": self._nm_owner,
@@ -181,7 +181,7 @@ class Lowering:
             "set_position": self._own_set_position, "local_offset": self._own_local,
             "data_setting": self._own_g10, "rot": self._own_rot, "rot_off": self._own_clear,
             "scale": self._own_scale, "scale_off": self._own_clear, "mirror": self._own_mirror,
-            "mirror_off": self._own_mirror,
+            "mirror_off": self._own_mirror, "zone_on": self._own_zone, "zone_off": self._own_zone,
         }
 
     # ------------------------------------------------------------------ helpers
@@ -335,6 +335,24 @@ class Lowering:
     def _own_local(self, b: _Blk) -> None:
         values = {k: self.num(k, v) for k, v in b.vals.items() if k in AXIS_SET}
         b.out.append((B_NONMODAL, FrameOp("trans", values, local=True)))
+        self._drop_axes(b)
+
+    def _own_zone(self, b: _Blk) -> None:
+        """G22 X Y Z I J K: a box (X/Y/Z one corner, I/J/K the other) the tool tip must not enter
+        (protection zone 3; MD 22900 = 0, an internal zone), G22 alone switches it on again, G23
+        off. Nothing moves."""
+        code = b.owner_rule.code if b.owner_rule else "G22"
+        words = [k for k in ("X", "Y", "Z", "I", "J", "K") if k in b.vals]
+        text = " ".join([code] + [_word_text(k, b.vals[k]) for k in words])
+        if b.owner == "zone_off":
+            limit = TravelLimit("off", "zone", text=text, dialect=self.table_name)
+        else:
+            corner = dict(zip("IJK", "XYZ"))
+            values = {k: self.num(k, b.vals.pop(k)) for k in ("X", "Y", "Z") if k in b.vals}
+            other = {corner[k]: self.num(k, b.vals.pop(k)) for k in ("I", "J", "K") if k in b.vals}
+            limit = (TravelLimit("box", "zone", values, other, text=text, dialect=self.table_name)
+                     if values or other else TravelLimit("on", "zone", text=text, dialect=self.table_name))
+        b.out.append((B_NONMODAL, limit))
         self._drop_axes(b)
 
     def _own_g10(self, b: _Blk) -> None:

@@ -366,6 +366,13 @@ class Emitter:
                 ws += [f"{k}={self.expr(s.polar[key])}" for k, key in (("AP", "angle"), ("RP", "radius"))
                        if key in s.polar]
             out.alone(" ".join([code.code if code else "G111", *ws]))
+        elif isinstance(s, ir.TravelLimit):
+            if s.dialect == DIALECT:
+                out.alone(s.text)
+            else:
+                self.refuse(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
+                            f"({s.scope.replace('_', ' ')} limits differ between controls)")
+                out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
         elif isinstance(s, ir.Passthrough):
             if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
                 out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)

@@ -332,6 +332,7 @@ class _Words:
     frame: Optional[str] = None
     pole: Optional[tuple[str, str]] = None   # G110/G111/G112: (relative_to, code)
     indirect: list = field(default_factory=list)   # AX[expr]=value
+    limit: Optional[tuple[str, str]] = None   # G25/G26/WALIMON/WALIMOF: (kind, code as written)
 
 
 class Lowerer:
@@ -350,6 +351,7 @@ class Lowerer:
         self.commands = t.options.get("machine_commands", {})
         self.whole_block = set(t.options.get("whole_block_commands", []))
         self.unsupported = t.options.get("unsupported_functions", {})
+        self.travel_limits = t.options.get("travel_limits", {})
         known = t.options.get("no_motion_effect", {})
         self.no_effect = {w: NO_EFFECT_PREFIX for w in known.get("words", ())}
         self.no_effect.update({w: MILL_ONLY for w in known.get("mill_only", ())})
@@ -362,6 +364,9 @@ class Lowerer:
     # ---- codes
     def code(self, code: str, w: _Words, text: str) -> None:
         rule = table().lookup(code)
+        if rule is None and code in self.travel_limits:
+            w.limit = (self.travel_limits[code], _t(text))
+            return
         if rule is None:
             reason = self.unsupported.get(code)
             if reason is None and code.startswith("M"):
@@ -470,7 +475,7 @@ class Lowerer:
     def call(self, name: str, args: Optional[list], w: _Words, text: str, modal: bool = False) -> None:
         """A call by name (with or without arguments), a procedure or a keyword function."""
         if args is None and not modal:
-            if table().lookup(name) is not None or name in self.unsupported:
+            if table().lookup(name) is not None or name in self.unsupported or name in self.travel_limits:
                 self.code(name, w, text)
                 return
         if name in self.commands and not modal:
@@ -642,6 +647,8 @@ class Lowerer:
         elif w.fixed_point is not None:
             w.out.append(ir.Passthrough("FP=" + _expr_text(w.fixed_point), "fixed point without G75",
                                         DIALECT))
+        if w.limit:
+            self.travel_limit(w)
         if w.pole:
             # the block's axis / polar words place the pole; it moves nothing (spec 9.2)
             w.out.append(ir.PolarPole(w.pole[0], dict(w.target), dict(w.polar) or None, w.pole[1]))
@@ -676,6 +683,18 @@ class Lowerer:
                 if mark and not st.reason.startswith(NO_EFFECT_PREFIX):
                     st.reason = f"{mark} ({st.reason})" if st.reason else mark
         return sorted(w.out, key=_priority)
+
+    def travel_limit(self, w: _Words) -> None:
+        """G25/G26 (working-area limits: the block's axis words are the limits, it moves nothing)
+        and WALIMON/WALIMOF; G25/G26 S (spindle speed limits) are not modelled (NC220)."""
+        kind, code = w.limit
+        values = {a: (v.value if isinstance(v, ir.AxisValue) else v) for a, v in w.target.items()}
+        text = " ".join([code] + [f"{a}={_expr_text(e)}" for a, e in values.items()])
+        w.out.append(ir.TravelLimit(kind, "work_area", values, text=text, dialect=DIALECT))
+        w.target.clear()
+        if w.speed:
+            w.out.append(ir.Passthrough(f"{code} S", "spindle speed limit", DIALECT))
+            w.speed = []
 
     def vardecls(self, st: Tree) -> list:
         ch = st.children
