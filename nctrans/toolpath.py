@@ -14,7 +14,9 @@ KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant",
 # Sinumerik G25/G26 under WALIMON, ISO G22), of two sorts that replace only their own sort:
 # - without `zone`: `start` holds the lower limits, `end` the upper ones, by axis; an axis absent
 #   from both is unbounded, and a record with neither lifts every programmable axis limit;
-# - with zone "inside": the box from `start` to `end` is forbidden (neither: no zone any more).
+# - with zone "inside": the box from `start` to `end` is forbidden (neither: no zone any more);
+# - with zone "unmodelled": limits are switched here that the interpreter does not model (Sinumerik
+#   protection zones); the check reports that it cannot judge them.
 
 
 @dataclass(slots=True)
@@ -45,7 +47,7 @@ class ToolpathRecord:
     css: Optional[float] = None
     spindle_limit: Optional[float] = None
     css_axis: Optional[float] = None
-    zone: Optional[str] = None             # limits records: "inside" = the box is forbidden
+    zone: Optional[str] = None             # limits records: "inside" (a forbidden box), "unmodelled"
 
     def to_dict(self) -> dict:
         out = {}

@@ -158,3 +158,19 @@ def test_limits_from_another_control_are_not_written_as_if_they_meant_the_same(t
     assert "G198" not in res.text.replace("NC402 fagor: G198", "")
     assert "G25" not in res.text
     assert any("G198" in d.message for d in res.diagnostics)
+
+
+# --------------------------------------------------------------------------- not modelled
+
+def test_sinumerik_protection_zones_are_reported_at_their_activation_not_passed(tmp_path, capsys):
+    from nctrans import cli
+    prog = ("G90 G17 G54\nNPROTDEF(1,FALSE,3,TRUE,FALSE)\nG0 X0 Y0\nG1 X100\nG1 Y100\nG1 X0\n"
+            "G1 Y0\nEXECUTE(ERR)\nNPROT(1,2,0,0,0)\nG0 X50 Y50\nCPROT(1,0,0,0,0)\nM30\n")
+    (tmp_path / "z.mpf").write_text(prog)
+    (tmp_path / "m.toml").write_text(MACHINE)
+    machine = pipeline.load_machine(str(tmp_path / "m.toml"))
+    diags, result = check_loaded(pipeline.load(str(tmp_path / "z.mpf"), "sinumerik", stream=True), machine)
+    assert sorted(f.line for f in result.findings if f.rule == "NC307") == [9, 11]
+    assert {d.line for d in diags if d.rule == "NC220"} >= {2, 9, 11}
+    code = cli.main(["check", str(tmp_path / "z.mpf"), "--from", "sinumerik", "--machine", str(tmp_path / "m.toml")])
+    assert code == 1 and "z.mpf:9:1: warning[NC307]" in capsys.readouterr().out

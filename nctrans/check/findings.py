@@ -19,6 +19,7 @@ RULES = {
     "NC304": ("spindle-over-maximum", "error"),
     "NC305": ("axis-not-on-machine", "warning"),
     "NC306": ("check-not-modelled", "info"),
+    "NC307": ("limits-not-modelled", "warning"),
     "NC310": ("tool-hits-fixture", "error"),
     "NC311": ("holder-hits-fixture", "error"),
     "NC312": ("holder-hits-stock", "error"),

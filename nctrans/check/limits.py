@@ -46,7 +46,12 @@ class LimitCheck:
     def add(self, r: ToolpathRecord) -> None:
         kind = r.kind
         if kind == "limits":
-            if r.zone is not None:
+            if r.zone == "unmodelled":
+                self._found[(r.file, r.line, "unmodelled")] = Finding(
+                    "NC307", r.file, r.line, "limits",
+                    "travel limits or protection zones switched here are not modelled (NC220 names "
+                    "the construct): the check cannot tell whether the program respects them")
+            elif r.zone is not None:
                 self.zone = (dict(r.start), dict(r.end)) if r.start and r.end else None
             else:
                 self.programmed = (dict(r.start or {}), dict(r.end or {}))

@@ -45,7 +45,7 @@ from nctrans.interp.state import LINEAR_AXES, ModalState
 from nctrans.interp.travel_limits import ProgrammedLimits
 from nctrans.interp import ggroups, sections, sysvars, unmodelled
 from nctrans.ir import nodes as n
-from nctrans.ir.vocabulary import UNMODELLED_MODES
+from nctrans.ir.vocabulary import UNMODELLED_LIMITS, UNMODELLED_MODES
 from nctrans import plainrun
 from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
@@ -1181,6 +1181,8 @@ class Interpreter(LatheMixin, RunChecks):
         else:
             self.diag("NC220", "warning", f"{what} is not modelled: the analysed toolpath leaves "
                       "it out")
+        if s.reason in UNMODELLED_LIMITS:       # tell the machine check it cannot judge these
+            self._record("limits", zone="unmodelled")
 
     def _h_travel_limit(self, d) -> None:
         """Programmed travel limits (travel_limits.py): nothing moves; `limits` records tell the

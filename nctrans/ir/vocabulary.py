@@ -77,6 +77,11 @@ NO_MOTION_EFFECT = frozenset((
 NO_EFFECT_PREFIX = "no motion effect"
 MILL_ONLY = "no motion effect on a mill"
 
+# Passthrough reasons of constructs that switch travel limits the interpreter does not model
+# (Sinumerik NPROT/CPROT protection zones): besides NC220, the toolpath gets a `limits` record with
+# zone "unmodelled", so the machine check says at that line that it cannot judge them (NC307).
+UNMODELLED_LIMITS = frozenset(("protection zone",))
+
 # Modal values the interpreter records but does not model: selecting one is reported (NC220) with
 # what it leaves out. A value leaves this table when the interpreter models it: diameter programming
 # and constant surface speed are modelled by nctrans.interp.lathe (CSS on a lathe or in diameter mode;
