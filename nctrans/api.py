@@ -40,8 +40,8 @@ if TYPE_CHECKING:     # equivalence (and the jsonl writer it uses) loads only wh
 
 __all__ = [
     "Conversion", "Equivalence", "ErrorLevel", "NCError", "NCInputError", "NCProgramError",
-    "Toolpath", "UnknownDialectError", "detect", "dialects", "equiv", "lint", "parse",
-    "toolpath", "transpile",
+    "CheckReport", "Toolpath", "UnknownDialectError", "check", "detect", "dialects", "equiv", "lint",
+    "parse", "toolpath", "transpile",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -421,6 +421,75 @@ def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], d
                     diags = linting.lint_loaded(ld, m, target, run=lambda l, mm: check_loaded(l, mm)[0])
                 out.extend(d for d in diags if keep(d))
     _raise_on_errors(out, error_level)
+    return out
+
+
+# --------------------------------------------------------------------------- check
+
+@dataclass
+class CheckReport:
+    """What `nctrans check` finds for one program on one machine. Truthy when there is no
+    finding. `findings`: `nctrans.check.Finding` records (rule, file, line, subject, message,
+    the controlled point in machine coordinates and by how much a limit is exceeded);
+    `diagnostics`: the program's own diagnostics followed by the findings as diagnostics (what
+    `nctrans lint --machine` reports); `cycle_time`: the estimate as `nctrans check --format json`
+    gives it ("total_s", "rapid_s", "feed_s", "dwell_s", "tool_change_s", "per_tool")."""
+    findings: list[Any]
+    diagnostics: list[Diagnostic]
+    cycle_time: dict[str, Any]
+    moves: int
+    machine: str
+    label: str
+    _report: str = ""
+
+    def __bool__(self) -> bool:
+        return not self.findings
+
+    def report(self) -> str:
+        """The cycle-time table `nctrans check` prints after the findings."""
+        return self._report
+
+    def __repr__(self) -> str:
+        return (f"<CheckReport {self.label} on {self.machine!r}: {len(self.findings)} findings, "
+                f"{self.moves} moves, cycle {self.cycle_time.get('total_s', 0.0):.1f} s>")
+
+
+def check(source: Source, dialect: Optional[str] = None, machine: MachineLike = None, *,
+          fixtures: Iterable[PathLike] = (), stock: Optional[PathLike] = None,
+          search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
+          error_level: ErrorLevel = ErrorLevel.IGNORE) -> CheckReport:
+    """Check a program (text, a path or a parsed `Program`) against a machine, as `nctrans check`
+    does: travel and programmed limits, feed and spindle limits, collisions with the machine's
+    fixtures (and the mesh files in `fixtures`, machine coordinates) and, with stock, rapids into
+    uncut material; plus the cycle-time estimate. The toolpath streams through (memory flat in
+    program length). Fixtures and stock need the `check` extra; a mesh that cannot be read is an
+    NCInputError. `error_level=RAISE`: error diagnostics of the program or the check raise."""
+    from nctrans import check as _check
+    dirs = list(search_path)
+    with _search_path(dirs):
+        if isinstance(source, Program):
+            _check_dialect(dialect)
+            label, dia = source.file, dialect or source.dialect
+            m = _machine(machine, dia)
+            diags: list[Diagnostic] = []
+            records = pipeline.run_toolpath(source, m, diags, dialect=dia)
+        else:
+            ld = _load(source, dialect, stream=True, file=file)
+            label, m = ld.label, _machine(machine, ld.dialect)
+            diags = ld.diagnostics
+            records = iter(pipeline.toolpath_of(ld, m)) if ld.program is not None else iter(())
+        m = _check.with_extra_solids(m, [os.fspath(f) for f in fixtures],
+                                     None if stock is None else os.fspath(stock))
+        try:
+            mc = _check.MachineCheck(m)
+            for r in records:
+                mc.add(r)
+        except MachineError as e:
+            raise NCInputError(str(e)) from None
+        result = mc.finish()
+    out = CheckReport(list(result.findings), list(diags) + [f.to_diagnostic() for f in result.findings],
+                       result.cycle.to_dict(), result.moves, m.name, label, result.cycle.report())
+    _raise_on_errors(out.diagnostics, error_level)
     return out
 
 
