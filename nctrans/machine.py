@@ -119,20 +119,31 @@ class Tool:
 
 @dataclass
 class Mesh:
-    """A fixture or the stock: a mesh file (STL/OBJ/PLY, path relative to the machine file) or a
-    box, in machine coordinates, or relative to work offset `frame` (e.g. "G54") when given;
-    `position` moves it further."""
+    """A fixture or the stock: a mesh file (STL/OBJ/PLY, path relative to the machine file), a
+    box, or a cylinder about the Z axis (`cylinder = { radius, z_min, z_max }`: on a lathe a
+    solid of revolution about the spindle, a chuck, its jaws or a tailstock quill), in machine
+    coordinates, or relative to work offset `frame` (e.g. "G54") when given; `position` moves it
+    further."""
     __pydantic_config__ = _OPEN
     mesh: Optional[str] = None
     box: Optional[dict[str, list[float]]] = None
+    cylinder: Optional[dict[str, float]] = None
     name: Optional[str] = None
     position: Optional[list[float]] = None
     frame: Optional[str] = None
     cell: Optional[float] = None            # stock: Z-map cell size in mm (default from its size)
 
     def __post_init__(self) -> None:
-        if (self.mesh is None) == (self.box is None):
-            raise ValueError("give either mesh = \"file\" or box = { min = [x, y, z], max = [x, y, z] }")
+        if [self.mesh, self.box, self.cylinder].count(None) != 2:
+            raise ValueError("give one of mesh = \"file\", box = { min = [x, y, z], max = [x, y, z] } or "
+                             "cylinder = { radius = R, z_min = Z0, z_max = Z1 }")
+        if self.cylinder is not None:
+            if set(self.cylinder) != {"radius", "z_min", "z_max"}:
+                raise ValueError("cylinder needs exactly the keys radius, z_min and z_max")
+            _check_positive(self.cylinder["radius"], "cylinder radius")
+            if not self.cylinder["z_min"] < self.cylinder["z_max"]:
+                raise ValueError(f"cylinder z_min ({self.cylinder['z_min']:g}) must be below z_max "
+                                 f"({self.cylinder['z_max']:g})")
         if self.box is not None:
             if set(self.box) != {"min", "max"}:
                 raise ValueError("box needs exactly the keys min and max")

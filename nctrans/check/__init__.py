@@ -2,7 +2,8 @@
 
 It reads toolpath records (never the IR or the source), so every dialect is checked the same way.
 Limits, feeds and spindle speed are checked on every machine; collisions when the machine (or the
-command line) gives fixtures, the stock check when it gives stock. The cycle-time estimate comes
+command line) gives fixtures, the stock check when it gives stock; on a lathe, the tool tip against
+fixtures of revolution (check/turning.py). The cycle-time estimate comes
 from the same pass. Records stream through: nothing holds the whole toolpath.
 
 Collision and stock checks need the `check` extra (numpy, scipy, trimesh, python-fcl); they are
@@ -46,14 +47,18 @@ class MachineCheck:
         self.moves = 0
         self._rotary_noted = False
         self._placed = False        # has a move put the machine somewhere known yet?
-        if machine.fixtures or machine.stock is not None:
-            if machine.kind == "lathe":
-                self._not_modelled = "fixtures and stock on a lathe are not checked yet (mill geometry only)"
-            else:
-                self._not_modelled = None
-                self._geometry()
-        else:
-            self._not_modelled = None
+        self.turning = None
+        self._not_modelled = None
+        if machine.kind == "lathe":
+            from nctrans.check.turning import TurningCheck
+            if any(f.cylinder is not None for f in machine.fixtures):
+                self.turning = TurningCheck(machine, self.found)
+            if machine.stock is not None or any(f.cylinder is None for f in machine.fixtures):
+                self._not_modelled = ("on a lathe only fixtures given as cylinders about the spindle "
+                                      "(chuck, jaws, tailstock) are checked: fixtures given as meshes or "
+                                      "boxes, and the stock, are not")
+        elif machine.fixtures or machine.stock is not None:
+            self._geometry()
 
     def _geometry(self) -> None:
         try:
@@ -77,6 +82,10 @@ class MachineCheck:
         if self._not_modelled is not None:
             self.found.append(Finding("NC306", r.file, r.line, "machine", self._not_modelled))
             self._not_modelled = None
+        if self.turning is not None:
+            self.turning.add(r, self._placed)
+            self._placed = True
+            return
         if self.collisions is None and self.stock is None:
             return
         if not self._placed:

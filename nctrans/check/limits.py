@@ -282,10 +282,18 @@ def segment_in_box(p: dict, q: dict, lo: dict, hi: dict, axes) -> Optional[dict]
         t0, t1 = max(t0, u), min(t1, v)
         if t0 > t1:
             return None
-    best, depth = None, -1.0
-    for t in (t0, (t0 + t1) / 2, t1):       # depth is concave along the segment: ends and middle
-        pt = {a: p.get(a, 0.0) + (q.get(a, 0.0) - p.get(a, 0.0)) * t for a in set(p) | set(q)}
-        dd = min(min(pt[a] - lo[a], hi[a] - pt[a]) for a in axes)
-        if dd > depth:
-            best, depth = pt, dd
-    return best
+    # the depth (distance to the nearest face) is the least of linear functions of t: its
+    # maximum is at an end of the clipped span or where two of them cross
+    lines = []
+    for a in axes:
+        a0, d = p.get(a, 0.0), q.get(a, 0.0) - p.get(a, 0.0)
+        lines += [(a0 - lo[a], d), (hi[a] - a0, -d)]
+    ts = {t0, t1}
+    for i, (c1, s1) in enumerate(lines):
+        for c2, s2 in lines[i + 1:]:
+            if abs(s1 - s2) > 1e-12:
+                t = (c2 - c1) / (s1 - s2)
+                if t0 < t < t1:
+                    ts.add(t)
+    t = max(ts, key=lambda t: min(c + s * t for c, s in lines))
+    return {a: p.get(a, 0.0) + (q.get(a, 0.0) - p.get(a, 0.0)) * t for a in set(p) | set(q)}

@@ -71,6 +71,11 @@ def load_solid(m: Mesh, machine: Machine, default_name: str) -> Solid:
         lo, hi = np.array(m.box["min"], float), np.array(m.box["max"], float)
         mesh = trimesh.creation.box(bounds=np.array([lo, hi]))
         name = m.name or default_name
+    elif m.cylinder is not None:
+        c = m.cylinder
+        mesh = trimesh.creation.cylinder(radius=c["radius"], height=c["z_max"] - c["z_min"], sections=48)
+        mesh.apply_translation([0.0, 0.0, (c["z_min"] + c["z_max"]) / 2])
+        name = m.name or default_name
     else:
         mesh = load_mesh(m.mesh, machine).copy()
         name = m.name or Path(m.mesh).name
