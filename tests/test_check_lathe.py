@@ -104,3 +104,18 @@ def test_a_bad_cylinder_is_refused_with_its_key(tmp_path):
     (tmp_path / "m.toml").write_text(LATHE.replace("z_min = -100.0, z_max = -50.0", "z_min = -50.0, z_max = -100.0"))
     with pytest.raises(pipeline.PipelineError, match="z_min"):
         pipeline.load_machine(str(tmp_path / "m.toml"))
+
+
+def test_a_real_lathe_program_with_the_chuck_just_clear_and_just_too_close(tmp_path, corpus_dir):
+    """A Haas valve (22 mm stock, parted off near Z-54.8, the deepest any tool goes): a chuck face
+    at Z-56 leaves T1's grown nose 0.4 mm clear; at Z-54, T1 finishing down to Z-54.534 on line 24
+    is the first move into it."""
+    src = corpus_dir / "iso-turn" / "enier-haas-valve.nc"
+    text = src.read_text(encoding="utf-8", errors="replace")
+
+    def found(face: float):
+        machine = LATHE.replace("z_min = -100.0, z_max = -50.0", f"z_min = -150.0, z_max = {face}")
+        return collisions(tmp_path, "", machine=machine, head=text.replace("M30", "M05"))
+    assert not found(-56.0)
+    hits = found(-54.0)
+    assert hits and min(f.line for f in hits) == 24 and {f.subject for f in hits} == {"chuck"}
