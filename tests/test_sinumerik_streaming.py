@@ -257,3 +257,25 @@ def test_a_cam_program_runs_without_loading_the_grammar(tmp_path):
     # G2 from X10 Y0 to X20 Y0 with CR=5: a half circle about X15 Y0
     arc = json.loads(proc.stdout.splitlines()[7])
     assert arc["end"] == {"X": 20.0, "Y": 0.0, "Z": -1.0} and arc["center"] == {"X": 15.0, "Y": 0.0, "Z": -1.0}
+
+
+def test_streamed_conversion_writes_what_the_whole_program_converts_to():
+    """convert Sinumerik -> Sinumerik streams (emit_stream takes the PlainRuns apart with
+    plain_line): the same text as converting the whole parsed program, kernel on or off."""
+    path = ISO_MILL / "brianhooper-fusion-1001.nc"
+    if not path.exists():
+        pytest.skip("shared corpus not found")
+    text = as_sinumerik(path)
+    whole = transpile(text, read="sinumerik", write="sinumerik").text
+    assert whole and whole.count("\n") > 1000
+    saved = plainrun.native
+    try:
+        for kernel in (True, False):
+            plainrun.native = NATIVE if kernel else None
+            buf = io.StringIO()
+            resets = []
+            buf.reset = lambda: resets.append(1)        # called when the whole program is converted instead
+            result = transpile(text, read="sinumerik", write="sinumerik", out=buf)
+            assert result.text == "" and buf.getvalue() == whole and not resets
+    finally:
+        plainrun.native = saved
