@@ -364,13 +364,29 @@ def lint_table(paths: list[Path], repeat: int, notes: list[str]) -> None:
               f"{fmt(sarif_s * 1000 if sarif_s else None):>9}")
 
 
+# A child's peak resident size starts from its parent's at the fork (the kernel counts the shared
+# pages up to the exec), so a command started from this process (tens of MiB, nctrans imported)
+# would show at least that much. The command is started from this small probe instead (python -S,
+# no imports beyond os and resource: a few MiB), which reports the peak of its one child.
+_RSS_PROBE = """import os, resource, sys
+pid = os.posix_spawnp(sys.argv[1], sys.argv[1:], os.environ,
+                      file_actions=[(os.POSIX_SPAWN_OPEN, 1, os.devnull, os.O_WRONLY, 0),
+                                    (os.POSIX_SPAWN_OPEN, 2, os.devnull, os.O_WRONLY, 0)])
+status = os.waitpid(pid, 0)[1]
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, os.waitstatus_to_exitcode(status))
+"""
+
+
 def peak_rss(cmd: list[str]) -> tuple[float, float, int]:
-    """(peak resident MiB, wall seconds, exit code) of one CLI run (os.wait4: that child only)."""
+    """(peak resident MiB, wall seconds, exit code) of one CLI run (see _RSS_PROBE)."""
     t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    _, status, usage = os.wait4(proc.pid, 0)
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    return usage.ru_maxrss / 1024, time.perf_counter() - t0, proc.returncode
+    proc = subprocess.run([sys.executable, "-S", "-c", _RSS_PROBE, *cmd], capture_output=True, text=True)
+    elapsed = time.perf_counter() - t0
+    try:
+        kib, rc = proc.stdout.split()
+        return int(kib) / 1024, elapsed, int(rc)
+    except ValueError:
+        return float("nan"), elapsed, 3
 
 
 def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
