@@ -4,6 +4,7 @@ interpreter runs on; the corrected program is clean. Expected lines are counted 
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from nctrans import linting, pipeline
 from nctrans.machine import Machine, ToolChange, default_mill
@@ -159,3 +160,53 @@ def test_unit_switch_in_a_run_of_plain_blocks():
     assert found(text, "iso-m") == [(4, "NC214")]
     text = f"G21 G17 G0 X0 Y0 Z0\nG1 X1 F250\nG20\nG1\n{body}\nM30\n"
     assert found(text, "iso-m") == [(5, "NC214")]      # the first feed move is in the run
+
+# --------------------------------------------------------------------------- properties
+
+PLANE_WORDS = {"G17": ("X", "Y", "I", "J", "K"), "G18": ("Z", "X", "K", "I", "J"), "G19": ("Y", "Z", "J", "K", "I")}
+
+
+@settings(max_examples=30, deadline=None)
+@given(plane=st.sampled_from(sorted(PLANE_WORDS)), arcs=st.integers(1, 40), data=st.data(),
+       normal=st.sampled_from(["0", "0.5", "-2.25"]), stream=st.booleans())
+def test_arc_off_plane_found_at_its_line_only(plane, arcs, data, normal, stream):
+    """Runs of centre-format arcs in any plane, streamed (kernel lane) or not: only the one arc
+    carrying the normal axis's centre word is NC210, at its line."""
+    a, b, i, j, off = PLANE_WORDS[plane]
+    k = data.draw(st.integers(0, arcs - 1))
+    body = [f"{plane} G0 X0 Y0 Z0", f"G1 {a}1 F100"]
+    for n in range(arcs):
+        extra = f" {off}{normal}" if n == k else ""
+        body.append(f"G{2 + n % 2} {a}{n + 2} {b}0 {i}0.5 {j}0{extra}")
+    body.append("M30")
+    assert found("\n".join(body) + "\n", "iso-m", stream=stream) == [(3 + k, "NC210")]
+
+
+@settings(max_examples=40, deadline=None)
+@given(steps=st.lists(st.sampled_from(["G20", "G21", "F", "G1", "G0"]), min_size=1, max_size=25),
+       dialect=st.sampled_from(["iso-m", "fagor"]))
+def test_feed_after_unit_switch_matches_a_model(steps, dialect):
+    """Any sequence of unit switches, feed words and moves: NC214 at each first feed move after a
+    switch that leaves the feed in force programmed in the other unit (the model below)."""
+    inch, metric = ("G20", "G21") if dialect == "iso-m" else ("G70", "G71")
+    lines, expected = [f"{metric} G17 G0 X0 Y0 Z0", "G1 X1 F100"], []
+    units, fed_in, pending = "mm", "mm", False
+    for n, step in enumerate(steps):
+        if step in ("G20", "G21"):
+            new = "inch" if step == "G20" else "mm"
+            if new != units:
+                pending = new != fed_in
+                units = new
+            lines.append(inch if step == "G20" else metric)
+        elif step == "F":
+            fed_in, pending = units, False
+            lines.append(f"F{50 + n}")
+        elif step == "G1":
+            if pending:
+                expected.append((len(lines) + 1, "NC214"))
+                pending = False
+            lines.append(f"G1 X{n % 7 + 1}")
+        else:
+            lines.append(f"G0 X{n % 5}")
+    lines.append("M30")
+    assert [x for x in found("\n".join(lines) + "\n", dialect) if x[1] == "NC214"] == expected
