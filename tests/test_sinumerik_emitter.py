@@ -156,10 +156,12 @@ def test_iso_initial_level_known_from_the_program_gives_plain_numbers():
     assert emit(ir.Program("iso.nc", "iso-m", inc)).text.splitlines()[2] == "MCALL CYCLE81(10, 2, 0, -1)"
 
 
-def test_iso_cycles_without_exact_siemens_equivalent_are_refused():
-    body = [block(ir.ModeChange("cycle", "peck"), ir.CycleParams({"r_plane": ir.Num(2.0)}))]
+def test_iso_cycles_without_siemens_equivalent_are_refused():
+    # G87 back boring: no standard cycle bores upwards (rules/cycle-mapping.toml `none`)
+    body = [block(ir.ModeChange("cycle", "back_bore"), ir.CycleParams({"r_plane": ir.Num(2.0)}))]
     out = emit(ir.Program("iso.nc", "iso-m", body))
-    assert any(d.rule == "NC402" and "--flatten" in d.message for d in out.diagnostics)
+    assert any(d.rule == "NC402" and "--flatten" in d.message and "upwards" in d.message
+               for d in out.diagnostics)
 
 
 def test_foreign_passthrough_is_reported():

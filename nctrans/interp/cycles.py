@@ -211,18 +211,22 @@ def deep_hole_depths(rfp: float, bottom: float, first: Optional[float], decremen
 def deep_hole_steps(*, plane: str, vari: int, approach: float, rfp: float, bottom: float,
                     retract: float, first: Optional[float], decrement: float,
                     dwell_bottom: Optional[float], dwell_top: Optional[float],
-                    relief: Optional[float], feed: float, first_factor: Optional[float]) -> list[Step]:
+                    relief: Optional[float], feed: float, first_factor: Optional[float],
+                    anticipation: Optional[float] = None) -> list[Step]:
     """Sinumerik CYCLE83 at the current position [GK, Siemens cycles manual]: G0 to RFP+SDIS, then
     each infeed with G1 (the first at F*FRF), DTB dwell at each depth; VARI=1 (swarf removal):
     G0 back to RFP+SDIS, DTS dwell, G0 to the last depth less the anticipation distance (0.6 mm,
     or depth/50 up to 7 mm beyond 30 mm) before the next infeed; VARI=0 (chip breaking): G1 back
-    by _VRT (1 mm when not given) before the next infeed. Last: G0 to RTP. Steps as expand_cycle's,
+    by _VRT (1 mm when not given) before the next infeed. `anticipation`: _DIS1, the programmed
+    re-approach distance of VARI=1 (when given and positive; else the automatic one). Last: G0 to
+    RTP. Steps as expand_cycle's,
     plus ("feed", f) setting the feed of the linear steps after it. Points hold the drilling axis
     only: the caller completes them from the current point."""
     ax = DRILL_AXIS[plane]
     up = 1.0 if approach >= bottom else -1.0
     total = abs(rfp - bottom)
-    anticipation = 0.6 if total <= 30 else min(total / 50.0, 7.0)
+    if not anticipation or anticipation <= 0:
+        anticipation = 0.6 if total <= 30 else min(total / 50.0, 7.0)
     back = abs(relief) if relief else 1.0
     steps: list[Step] = [("rapid", {ax: approach})]
     depths = deep_hole_depths(rfp, bottom, first, abs(decrement or 0.0), up)

@@ -1586,13 +1586,16 @@ class Interpreter(LatheMixin, RunChecks):
             first = rfp - up * abs(p["fdpr"] * self.st.scale)
         vari = int(p.get("vari", 0) or 0)
         vari = 1 if vari % 10 == 1 else 0
+        anticipation = p.get("_dis1")     # _DIS1: re-approach distance (VARI=1), a length
+        if anticipation is not None:
+            anticipation *= self.st.scale
 
         def make(feed: float):
             return deep_hole_steps(plane=self.st.plane, vari=vari, approach=approach, rfp=rfp,
                                    bottom=bottom, retract=retract, first=first,
                                    decrement=p.get("decrement", 0.0), dwell_bottom=p.get("dwell"),
                                    dwell_top=p.get("dts"), relief=p.get("relief"), feed=feed,
-                                   first_factor=p.get("frf"))
+                                   first_factor=p.get("frf"), anticipation=anticipation)
         return make
 
     def _swivel_plane(self, s: n.CycleCall) -> None:

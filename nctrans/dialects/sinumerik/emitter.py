@@ -17,10 +17,11 @@ Lowerings for IR from other dialects (each reported as NC401 info, or NC402 when
   with RTP = R level under G99 and the ISO initial level under G98; incremental R/Z are added
   to the initial level. The initial level is the last constant programmed position of the drill
   axis when the program text fixes it (plain numbers), else `$P_EP[<drill axis>]` (the
-  programmed position when the MCALL block is read). Chosen for G81 drill, G82 drill_dwell, G85 bore_feed_out and G89
-  bore_dwell_feed_out, whose Siemens cycles do the same strokes. Peck, tapping, fine/back/manual
-  boring differ in stroke details from CYCLE83/84/86/87 and are refused with NC402 (convert with
-  --flatten so the interpreter expands them into motion).
+  programmed position when the MCALL block is read). Which cycle, and its further parameters, come
+  from rules/cycle-mapping.toml (nctrans.cyclemap): G81, G82, G83 (CYCLE83 VARI=1 with the ISO
+  re-approach distance as _DIS1), G85 and G89 make the same strokes as their Siemens cycles; the
+  others (G73 and G84/G74 whose strokes differ in detail, G76/G86/G87/G88) are refused with NC402
+  naming why, so they are expanded into motion instead.
 - ISO G92 -> ATRANS by ($P_EP - target); G92.1 -> TRANS; G68/G51/G51.1 pivots -> ATRANS/AROT
   (ASCALE, AMIRROR)/ATRANS sequences; G28/G30 -> G0 via point + G74/G75.
 """
@@ -36,6 +37,7 @@ from nctrans.dialects.base import EmitResult
 from nctrans.dialects.sinumerik.lexer import number_value
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
+from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.rules import load_table
 
 DIALECT = "sinumerik"
@@ -48,11 +50,16 @@ _OPS = {"==": "==", "!=": "<>", "<": "<", ">": ">", "<=": "<=", ">=": ">=", "con
         "or": " OR ", "xor": " XOR ", "and": " AND ", "bor": " B_OR ", "bxor": " B_XOR ",
         "band": " B_AND ", "+": "+", "-": "-", "*": "*", "/": "/", "div": " DIV ", "mod": " MOD "}
 _DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
-_ISO_CYCLES = {"drill": "CYCLE81", "drill_dwell": "CYCLE82", "bore_feed_out": "CYCLE85",
-               "bore_dwell_feed_out": "CYCLE89"}
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
 _AMBIGUOUS = re.compile(r"^[A-Za-z](?:\d\w*)?$")
+
+
+def _named(kind: str) -> bool:
+    """Whether an ISO cycle kind has a Sinumerik standard cycle making the same moves
+    (rules/cycle-mapping.toml)."""
+    mapping = mapping_table().for_modal(kind)
+    return mapping is not None and bool(mapping.named) and mapping.exact
 
 
 def _fmt(v: float) -> str:
@@ -80,6 +87,10 @@ class _State:
     cycle_call: str = ""                    # the active cycle call text, for holes at the current position
     cycle_init: Optional[float] = None      # ISO initial level when known statically
     known: dict = field(default_factory=dict)   # axis -> last programmed value when constant
+    feed: Optional[ir.Expr] = None          # modal F, S and feed mode (a tapping cycle's pitch)
+    speed: Optional[ir.Expr] = None
+    feed_mode: str = "per_min"
+    units: str = "mm"
 
 
 class Emitter:
@@ -250,6 +261,10 @@ class Emitter:
                 st.plane = s.value
             elif g == "distance":
                 st.distance = s.value
+            elif g == "feed_mode":
+                st.feed_mode = s.value
+            elif g == "units":
+                st.units = s.value
             if g == "cycle":
                 if s.value == "off":
                     if st.cycle_active:
@@ -261,9 +276,15 @@ class Emitter:
                     st.cycle_init = None
                 else:
                     st.cycle, st.cycle_pending = s.value, True
-                    if s.value not in _ISO_CYCLES:
-                        self.refuse(f"canned cycle {s.code or s.value} cannot be expressed exactly as a "
-                                    "Sinumerik cycle: convert with --flatten to expand it into motion")
+                    mapping = mapping_table().for_modal(s.value)
+                    if mapping is None or not mapping.named:
+                        why = f" ({mapping.none})" if mapping is not None and mapping.none else ""
+                        self.refuse(f"canned cycle {s.code or s.value} has no Sinumerik standard cycle"
+                                    f"{why}: convert with --flatten to expand it into motion")
+                    elif not mapping.exact:
+                        self.refuse(f"canned cycle {s.code or s.value} has no exact Sinumerik standard "
+                                    f"cycle ({mapping.differs}): convert with --flatten to expand it "
+                                    "into motion")
                 return
             if g == "cycle_retract":
                 st.cycle_retract, st.cycle_pending = s.value, True
@@ -285,7 +306,14 @@ class Emitter:
             self.motion(s, out)
         elif isinstance(s, ir.Feed):
             out.words.append(self.word("F", s.value))
+            if st.cycle_active and st.feed != s.value and self.cycle_takes("feed", "pitch"):
+                st.cycle_pending = True         # the cycle call carries the feed: call it anew
+            st.feed = s.value
         elif isinstance(s, ir.SpindleSpeed):
+            if s.spindle == 1:
+                if st.cycle_active and st.speed != s.value and self.cycle_takes("pitch"):
+                    st.cycle_pending = True
+                st.speed = s.value
             out.words.append(self.word("S", s.value) if s.spindle == 1 else
                              f"S{s.spindle}={self.expr(s.value)}")
         elif isinstance(s, ir.SpindleLimit):
@@ -388,7 +416,7 @@ class Emitter:
 
     def motion(self, m: ir.Motion, out: "_Line") -> None:
         st = self.st
-        if st.cycle != "off" and st.cycle in _ISO_CYCLES and m.target:
+        if st.cycle != "off" and m.target and _named(st.cycle):
             self.iso_cycle_position(m, out)
             return
         self.track(m)
@@ -535,12 +563,20 @@ class Emitter:
                     dp = f"{init}+{self.expr(r, 9)}+{self.expr(z, 9)}"
                 rtp = rfp if st.cycle_retract == "r_plane" else init
                 st.known[ax] = None
-            args = [rtp, rfp, "0", dp]
-            name = _ISO_CYCLES[st.cycle]
-            if name in ("CYCLE82", "CYCLE89"):
-                args += ["", self.expr(p.get("dwell", ir.Num(0.0)))]
+            mapping = mapping_table().for_modal(st.cycle)
+            given = {"RTP": rtp, "RFP": rfp, "SDIS": "0", "DP": dp}
+            for param, source in mapping.args.items():
+                text = self.cycle_arg(source, p)
+                if text is None:
+                    return
+                given[param] = text
+            from nctrans.interp.cycles import named_cycles
+            args = [given.get(param, "") for param in named_cycles()[mapping.named].params]
+            while args and args[-1] == "":
+                args.pop()
             self.info("cycle", "ISO canned cycle written as MCALL of the Siemens standard cycle")
-            st.cycle_call = f"{name}({', '.join(args)})".replace(", ,", ",,")
+            text = "".join((("," if a == "" else ", ") if i else "") + a for i, a in enumerate(args))
+            st.cycle_call = f"{mapping.named}({text})"
             out.alone("MCALL " + st.cycle_call)
             st.cycle_pending, st.cycle_active = False, True
         words = ["G0"] + [self.axis(a, v) for a, v in pos.items()]
@@ -554,6 +590,40 @@ class Emitter:
             n = int(rep.value)
         for _ in range(n):
             out.alone(" ".join(words))
+
+    def cycle_takes(self, *sources: str) -> bool:
+        """Whether the active ISO cycle's named call carries one of these derived values."""
+        mapping = mapping_table().for_modal(self.st.cycle)
+        return mapping is not None and any(v in sources for v in mapping.args.values())
+
+    def cycle_arg(self, source, params: dict) -> Optional[str]:
+        """The text of one further named-cycle argument (rules/cycle-mapping.toml `args`): a
+        number, an ISO cycle parameter, or a derived value; None after refusing."""
+        st = self.st
+        if isinstance(source, (int, float)):
+            return _fmt(float(source))
+        if source == "peck_clearance":
+            return _fmt(peck_clearance(st.units == "mm"))
+        if source == "feed":
+            if st.feed is None:
+                self.refuse("canned cycle without a feed rate")
+                return None
+            return self.expr(st.feed)
+        if source == "pitch":
+            sign = "-" if st.cycle == "tap_left" else ""
+            if st.feed is None or (st.feed_mode != "per_rev" and st.speed is None):
+                self.refuse("tapping cycle without a feed rate and spindle speed: its pitch is unknown")
+                return None
+            if st.feed_mode == "per_rev":
+                lead = st.feed
+            elif isinstance(st.feed, ir.Num) and isinstance(st.speed, ir.Num) and st.speed.value:
+                lead = ir.Num(st.feed.value / st.speed.value)
+            else:
+                lead = ir.Binary("/", st.feed, st.speed)
+            text = self.expr(lead, 10)
+            return f"-{text}" if sign else text
+        value = params.get(source)
+        return "" if value is None else self.expr(value)
 
     def subname(self, name: str) -> str:
         """Sinumerik spelling of a program name: ISO O1000 -> L1000; invalid names are refused."""
