@@ -37,6 +37,7 @@ from nctrans.ir.walk import constant
 from nctrans.rules import load_table
 
 from . import plan as pl
+from .cycles import CycleRefused, IsoCycle, iso_cycle, pattern_positions
 
 POINT_LETTERS = frozenset("XYZUVWABCIJKQRF")
 AXES = "XYZABCUVW"
@@ -208,6 +209,13 @@ class IsoEmitter:
         self.feed_clobbered = False
         self.frame_trans: Optional[dict[str, float]] = {}
         self.frame_other = False
+        # named cycles written as ISO canned cycles (nctrans.dialects.iso_m.cycles): the modal one
+        # (MCALL) and whether its G8x mode is on; motion mode, units and feed as programmed
+        self.named_cycle: Optional[IsoCycle] = None
+        self.named_active = False
+        self.motion_mode: Optional[str] = None
+        self.units_mm = True
+        self.feed_expr = None
 
     # -------------------------------------------------------------- reporting
     def _where(self):
@@ -594,8 +602,13 @@ class IsoEmitter:
             self.plane = s.value
         elif s.group in ("units", "work_offset", "tool_length", "diameter", "cycle"):
             self.pos = {}
+        if s.group == "units":
+            self.units_mm = s.value == "mm"
         if s.group == "motion":
             self.thread_mode = s.value == "thread"
+            self.motion_mode = s.value
+            if self.named_cycle is not None:
+                return []                   # the G8x mode holds group 1: restored after G80
             self.cip_mode = s.value == "arc_3point"
             if self.cip_mode:
                 return []                   # written as G2/G3 by the CIP block itself
@@ -692,6 +705,8 @@ class IsoEmitter:
         return format_number(-r if ang > 180 else r, True)
 
     def w_Motion(self, s: n.Motion):
+        if self.named_cycle is not None and s.target:
+            return self._named_hole(s)
         if s.via:
             return self._cip(s)
         if self.cip_mode and s.target:
@@ -750,6 +765,7 @@ class IsoEmitter:
         return words
 
     def w_Feed(self, s):
+        self.feed_expr = s.value
         self.last_feed = self.addr("F", s.value)
         self.feed_clobbered = False
         return [("F", self.last_feed)]
@@ -926,8 +942,116 @@ class IsoEmitter:
                 raise NotExpressible(f"cycle parameter {key}")
         return words
 
-    def w_CycleCall(self, s):
-        raise NotExpressible(f"the cycle call {s.name or s.kind} (expand cycles first)")
+    def w_CycleCall(self, s: n.CycleCall):
+        if s.kind in ("holes_line", "holes_circle"):
+            return self._hole_pattern(s)
+        if s.kind == "swivel_plane":
+            raise NotExpressible(f"the cycle call {s.name or s.kind} (expand cycles first)")
+        try:
+            cyc = iso_cycle(s, self)
+        except CycleRefused as err:
+            raise NotExpressible(f"the cycle call {err} (expand cycles first)") from None
+        lines = _Lines()
+        if s.modal:
+            if self.named_cycle is not None:
+                lines += self._cycle_off()
+            self.named_cycle = cyc
+            self.lowered(f"{cyc.name} called modally written as {cyc.retract} {cyc.code} at each "
+                         "following position")
+            return lines
+        # a one-shot call leaves a modal one (MCALL) in force: its G8x mode starts again at the next hole
+        if self.named_active:
+            lines.append([("G:9", "G80")])
+            self.named_active = False
+        self.lowered(f"{cyc.name} written as {cyc.retract} {cyc.code} at the current position, then G80")
+        lines.append(self._cycle_words(cyc, []))
+        lines += self._restore(cyc) if self.named_cycle is None else [[("G:9", "G80")]]
+        return lines
+
+    def _drill_axis(self) -> str:
+        return {"XY": "Z", "ZX": "Y", "YZ": "X"}.get(self.plane, "Z")
+
+    def _cycle_words(self, cyc: IsoCycle, plane_words: list) -> list:
+        """The first block of an ISO cycle: G98/G99 G8x, the hole, Z R Q P (F)."""
+        ax = self._drill_axis()
+        if cyc.rtp is not None and self.pos.get(ax) != cyc.rtp:
+            raise NotExpressible(f"{cyc.name} with RTP {format_number(cyc.rtp)} above the approach "
+                                 f"level: the ISO cycle returns to where the tool is when it starts "
+                                 f"(G98), which is not RTP here")
+        words = [("G:10", cyc.retract), ("G:9", cyc.code), *plane_words, *cyc.words]
+        if cyc.feed is not None:
+            words.append(("F", self.addr("F", cyc.feed)))
+        self.pos = {a: v for a, v in self.pos.items() if a != ax}
+        if cyc.rtp is not None:
+            self.pos[ax] = cyc.rtp
+        return words
+
+    def _restore(self, cyc: IsoCycle) -> list:
+        """After G80: the motion mode (ISO G80 leaves none) and the feed the cycle replaced."""
+        lines = [[("G:9", "G80")]]
+        if self.motion_mode not in (None, "arc_3point"):
+            lines.append([self._g("motion", self.motion_mode)])
+        if cyc.feed is not None:
+            if self.feed_expr is None:
+                raise NotExpressible(f"{cyc.name} with its own feed when the feed before it is unknown")
+            lines.append([("F", self.addr("F", self.feed_expr))])
+        return lines
+
+    def _cycle_off(self) -> list:
+        cyc = self.named_cycle
+        self.named_cycle, self.named_active = None, False
+        return self._restore(cyc)
+
+    def _named_hole(self, s: n.Motion):
+        """A block after MCALL CYCLE8x: it moves to the hole in the plane, then the cycle drills."""
+        a1, a2 = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}.get(self.plane, ("X", "Y"))
+        cyc = self.named_cycle
+        if set(s.target) - {a1, a2} or s.center or s.radius is not None or s.via or s.polar \
+                or s.machine_coords or s.indirect or s.turns is not None or s.aperture is not None:
+            raise NotExpressible(f"a move of {', '.join(sorted(s.target))} while {cyc.name} is called "
+                                 "modally (an ISO cycle mode only positions in the plane)")
+        if self.motion_mode != "rapid":
+            raise NotExpressible(f"a feed move to the hole while {cyc.name} is called modally "
+                                 "(an ISO cycle positions at rapid)")
+        plane_words = self._axes(s.target)
+        ax_pos = self.pos.get(self._drill_axis())
+        self._track(s)
+        if self.named_active:
+            return plane_words
+        self.pos[self._drill_axis()] = ax_pos
+        if ax_pos is None:
+            self.pos.pop(self._drill_axis())
+        words = self._cycle_words(cyc, plane_words)
+        self.named_active = True
+        return words
+
+    def _hole_pattern(self, s: n.CycleCall):
+        """HOLES1/HOLES2 as the list of its positions (the modal cycle drills at each)."""
+        positions = pattern_positions(s)
+        if positions is None:
+            raise NotExpressible(f"the hole pattern {s.name or s.kind} with computed arguments")
+        a1, a2 = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}.get(self.plane, ("X", "Y"))
+        lines = _Lines()
+        saved = self.motion_mode
+        if self.named_cycle is None:
+            lines.append([self._g("motion", "rapid")])
+            self.motion_mode = "rapid"
+        mode = self.motion_mode
+        self.motion_mode = "rapid"
+        for p1, p2 in positions:
+            move = n.Motion({a1: n.AxisValue(n.Num(round(p1, 9) + 0.0)),
+                             a2: n.AxisValue(n.Num(round(p2, 9) + 0.0))})
+            if self.distance == "incremental":
+                raise NotExpressible(f"the hole pattern {s.name} under incremental distances")
+            lines.append(self.w_Motion(move) if self.named_cycle is not None else self._axes(move.target))
+            if self.named_cycle is None:
+                self._track(move)
+        self.motion_mode = mode
+        if self.named_cycle is None and saved not in (None, "rapid", "arc_3point"):
+            lines.append([self._g("motion", saved)])
+        self.motion_mode = saved
+        self.lowered(f"hole pattern {s.name} written as its {len(positions)} positions")
+        return lines
 
     def w_SubCall(self, s: n.SubCall):
         self.forget()
@@ -1001,6 +1125,8 @@ class IsoEmitter:
         return words
 
     def w_ModalCallOff(self, s):
+        if self.named_cycle is not None:
+            return _Lines(self._cycle_off())
         return [("G:12", "G67")]
 
     def w_Return(self, s):
