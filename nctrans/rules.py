@@ -95,6 +95,30 @@ def system_meaning(key: str | int) -> Optional[str]:
     return _system_spellings().get(f"#{key}" if isinstance(key, int) else str(key).upper())
 
 
+def system_spelling(table_name: str, key: str | int, axis: Optional[str] = None
+                    ) -> Optional[tuple[str, Optional[str]]]:
+    """How the table `table_name` spells the system variable another dialect spells `key` (with an
+    axis index `axis`, as Sinumerik $AA_IM[X]): (spelling, axis index or None), through their
+    neutral meaning; None when the table has no spelling of that meaning. A per-axis meaning
+    ("axis_position_machine.X") finds either its own number (ISO #5021) or the axis-indexed
+    spelling ($AA_IM with index X)."""
+    meaning = system_meaning(key)
+    if meaning is None:
+        return None
+    if axis is not None:
+        meaning = f"{meaning}.{axis}"
+    own = load_table(table_name).system_variables
+    found = next((sp for sp, m in own.items() if m == meaning), None)
+    if found is not None:
+        return found, None
+    base, _, per_axis = meaning.partition(".")
+    if per_axis:
+        found = next((sp for sp, m in own.items() if m == base), None)
+        if found is not None:
+            return found, per_axis
+    return None
+
+
 @lru_cache(maxsize=None)
 def load_table(dialect: str) -> RulesTable:
     """rules/<dialect>.toml, validated by pydantic (once per content: see nctrans.tables)."""

@@ -65,5 +65,16 @@ def test_iso_position_numbers_and_sinumerik_names_read_the_same_position():
     diags: list = []
     moves = [r for r in interpret(iso, None, diagnostics=diags) if r.kind == "linear"]
     assert moves[-1].end["X"] == 3.0 + 4.0 + 5.0 and not diags
-    moves, diags = _run("G0 X3 Y4 Z5\nR1=$AA_IW[X]+$P_EP[Y]+$AA_MW[Z]+$P_TOOLNO\nG1 X=R1 F100\nM30\n")
+    moves, diags = _run("G0 X3 Y4 Z5\nR1=$AA_IW[X]+$P_EP[Y]+$AA_IM[Z]+$P_TOOLNO\nG1 X=R1 F100\nM30\n")
     assert moves[-1].end["X"] == 12.0
+
+
+def test_measured_positions_are_probe_results_not_the_position():
+    from nctrans.rules import system_meaning
+    # seed (840D advanced programming, MEAS): $AA_MW / $AA_MM hold the measured value of the last
+    # probing move; ISO #5061.. the skip position. nctrans does not model probing: unknown (NC107)
+    assert system_meaning("$AA_MW") == "probe_position_work" and system_meaning("$AA_MM") == \
+        "probe_position_machine"
+    assert system_meaning(5061) == "probe_position_work.X"
+    moves, diags = _run("G0 X3 Y4 Z5\nR1=$AA_MW[Z]\nG1 X=R1 F100\nM30\n")
+    assert [d.rule for d in diags] == ["NC107"]

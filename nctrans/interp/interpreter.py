@@ -1930,6 +1930,7 @@ class Interpreter(LatheMixin, RunChecks):
         values["programmable_frame"] = lambda: FrameValue((("state", copy_frame(self.frame)),))
         self.ev.meaning_setters["programmable_frame"] = self._set_pframe
         values["active_tool"] = lambda: float(st.tool or 0)
+        values["programmed_tool"] = lambda: float(st.tool_selected or 0)
         values["active_tool_edge"] = lambda: float(st.radius_index or 0)
         values["feed"] = lambda: st.feed or 0.0
         values["spindle_speed"] = lambda: st.spindle_speed or 0.0

@@ -55,8 +55,14 @@ SYSTEM_VARIABLES = (
     "plane_axis_1",              # geometry axes of the active plane, as axis names: abscissa,
     "plane_axis_2",              # ordinate,
     "plane_axis_3",              # applicate (the tool axis)
+    "programmed_tool",           # the last programmed T number (selected, not yet changed in)
+    "probe_position_work",       # where the last probing (skip / measuring) move stopped, per axis,
+    "probe_position_machine",    # in work / machine coordinates: not modelled (reads are unknown)
+    "parts_machined",            # workpiece counters of the control: machine state the analysis
+    "parts_required",            # cannot know (reads are unknown)
 )
-AXIS_MEANINGS = ("axis_position_work", "axis_position_machine")
+AXIS_MEANINGS = ("axis_position_work", "axis_position_machine", "probe_position_work",
+                 "probe_position_machine")
 
 # Variable spaces of nodes.Var
 # "local": a local parameter of the call frame that exists once assigned (Fagor P0..P99, V.P.):

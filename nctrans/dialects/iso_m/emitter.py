@@ -238,6 +238,8 @@ class IsoEmitter:
         self.frame_other = True
 
     def var_text(self, v: n.Var) -> str:
+        if v.space == "system":
+            return self._system_var(v)
         if v.space == "name":
             key = str(v.key).upper()
             arr = self.arrays.get((self.unit, key)) or self.arrays.get((None, key))
@@ -252,6 +254,24 @@ class IsoEmitter:
             self.lowered("R[expr] written as #[500+expr]")
             return f"#[500+{format_expr(v.indices[0], self)}]"
         return f"#{self.map_var(v)}"
+
+    def _system_var(self, v: n.Var) -> str:
+        """Another dialect's system variable as the ISO number of the same neutral meaning
+        (rules/<dialect>.toml [system_variables]; $AA_IM[X] -> #5021)."""
+        from nctrans.rules import system_spelling
+        axis = None
+        if v.indices:
+            idx = v.indices[0]
+            if len(v.indices) != 1 or type(idx) is not n.Var or idx.space != "name" \
+                    or str(idx.key).upper() not in AXES:
+                raise NotExpressible(f"system variable {v.key} with this index")
+            axis = str(idx.key).upper()
+        found = system_spelling(self.table_name, str(v.key), axis)
+        if found is None or found[1] is not None or not found[0][1:].isdigit():
+            raise NotExpressible(f"system variable {v.key}{f'[{axis}]' if axis else ''} (no ISO "
+                                 "number of the same meaning)")
+        self.lowered(f"system variable {v.key}{f'[{axis}]' if axis else ''} written as {found[0]}")
+        return found[0]
 
     def _element(self, arr: pl.ArrayPlan, v: n.Var) -> str:
         idx = v.indices or []
@@ -540,6 +560,8 @@ class IsoEmitter:
 
     def assign(self, s: n.Assign) -> str:
         try:
+            if s.target.space == "system":
+                raise NotExpressible(f"writing the system variable {s.target.key}")
             return f"{self.val(s.target)}={format_expr(s.value, self)}"
         except NotExpressible as err:
             self.refuse(str(err))

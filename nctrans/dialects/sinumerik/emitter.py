@@ -38,7 +38,7 @@ from nctrans.dialects.sinumerik.lexer import number_value
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
-from nctrans.rules import load_table
+from nctrans.rules import load_table, system_meaning, system_spelling
 
 DIALECT = "sinumerik"
 _NUM_OK = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?$|'[HB][0-9A-F]+'$|TRUE$|FALSE$",
@@ -210,6 +210,8 @@ class Emitter:
             return f"({v.key})"        # C or R1R2 alone would read back as address words
         if v.space in ("name", "system"):
             return f"{v.key}{idx}"
+        if v.space == "num" and isinstance(v.key, int) and v.key >= 1000 and not v.indices:
+            return self.system_var(v, target)
         if v.space == "num":
             self.info("num", "ISO macro variables #n written as R parameters Rn")
             if v.key is None:
@@ -220,6 +222,21 @@ class Emitter:
             return f"R{v.key}"
         self.refuse(f"variable {v.space}:{v.key} has no Sinumerik equivalent")
         return f"_{v.key}"
+
+    def system_var(self, v: ir.Var, target: bool) -> str:
+        """An ISO system variable (#1000 and up) as the Sinumerik variable of the same neutral
+        meaning (rules/<dialect>.toml [system_variables]: #5021 -> $AA_IM[X])."""
+        found = system_spelling(DIALECT, v.key)
+        if found is None:
+            meaning = system_meaning(v.key)
+            self.refuse(f"system variable #{v.key}" + (f" ({meaning.replace('_', ' ')})" if meaning else "")
+                        + " has no Sinumerik equivalent")
+            return "R0"
+        if target:
+            self.refuse(f"writing the system variable #{v.key}")
+        name, axis = found
+        self.info("sysvar", "ISO system variables written as the Sinumerik variables of the same meaning")
+        return f"{name}[{axis}]" if axis else name
 
     # ---------------------------------------------------------------- words
     def word(self, addr: str, e: ir.Expr) -> str:
