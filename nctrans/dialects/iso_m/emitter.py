@@ -341,6 +341,7 @@ class IsoEmitter:
         if head:
             title = meta.get("title")
             self.out.append(head + (f" {self._comment(str(title))}" if title is not None else ""))
+        names_at = len(self.out)
         self.nodes(p.body)
         for key, sub in p.subprograms.items():
             self.unit = key
@@ -365,9 +366,27 @@ class IsoEmitter:
             self.nodes(sub.body)
             if key in self.sub_numbers and not walk.ends_with_return(sub.body):
                 self.out.append("M99")
+        self.out[names_at:names_at] = self._name_table()
         if percent:
             self.out.append("%")
         return "\n".join(self.out) + "\n"
+
+    def _name_table(self) -> list[str]:
+        """Comment lines naming where each variable of the source lives (ISO has numbers only):
+        `(VAR LEN = #100)`, `(VAR ARR[3] = #510..#512)`, `(VAR R1 = #501)`, per unit."""
+        lines = []
+        for (space, key), number in self.var_map.items():
+            if space in ("name", "R"):
+                lines.append(f"(VAR {'R' if space == 'R' else ''}{key} = #{number})")
+        for unit, plan in self.plans.items():
+            where = f" IN {unit}" if unit else ""
+            for name, number in plan.locals.items():
+                lines.append(f"(VAR {name}{where} = #{number})")
+        for (unit, name), arr in self.arrays.items():
+            where = f" IN {unit}" if unit else ""
+            dims = ",".join(str(d) for d in arr.dims)
+            lines.append(f"(VAR {name}[{dims}]{where} = #{arr.base}..#{arr.base + arr.size - 1})")
+        return lines
 
     def _plan(self) -> None:
         """Labels, locals and O numbers of every unit, before any jump or call is written."""
