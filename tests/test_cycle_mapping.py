@@ -51,10 +51,16 @@ def cycle_series(draw, kind: str):
     feed = draw(st.integers(10, 2000))
     holes = draw(st.lists(st.tuples(coord, coord), min_size=1, max_size=3))
     x0, y0 = holes[0]
+    mode = "G90"
+    if draw(st.booleans()):
+        # G91: R from the initial level, Z from R, holes as steps, K repeats this block only
+        mode = "G91"
+        words = [f"Z{bottom - r:.2f}", f"R{r - initial:.2f}", *words[2:],
+                 f"K{draw(st.integers(1, 3))}"]
     lines = ["G17 G21 G90 G54", "T1 M6", "S1200 M3", f"G0 X0 Y0 Z{initial:.2f}",
-             f"{retract} {EXACT[kind]} X{x0:.2f} Y{y0:.2f} {' '.join(words)} F{feed}"]
+             f"{mode} {retract} {EXACT[kind]} X{x0:.2f} Y{y0:.2f} {' '.join(words)} F{feed}"]
     lines += [f"X{x:.2f} Y{y:.2f}" for x, y in holes[1:]]
-    lines += ["G80", f"G0 Z{initial + 10:.2f}", "M30"]
+    lines += ["G80", f"G90 G0 Z{initial + 10:.2f}", "M30"]
     return "\n".join(lines) + "\n"
 
 

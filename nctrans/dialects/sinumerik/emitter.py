@@ -602,7 +602,7 @@ class Emitter:
             # MCALL only fires on a block that moves, so call the cycle once, here
             words = [st.cycle_call]
         n = 1
-        rep = st.cycle_params.get("repeat")
+        rep = st.cycle_params.pop("repeat", None)      # ISO K: this block only
         if isinstance(rep, ir.Num):
             n = int(rep.value)
         for _ in range(n):
