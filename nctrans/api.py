@@ -313,6 +313,12 @@ class Toolpath(Iterator[ToolpathRecord]):
         self.count += 1
         return rec
 
+    def close(self) -> None:
+        """Stop the run early (what it holds is released; later iteration ends at once)."""
+        close = getattr(self._records, "close", None)
+        if close is not None:
+            close()
+
     def summary(self, machine: MachineLike = None) -> str:
         """Run the rest of the toolpath and return what `nctrans toolpath --summary` prints."""
         from nctrans import toolpath_io
@@ -529,14 +535,23 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
     from nctrans import equivalence as _equivalence
     if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not math.isfinite(tol) or tol <= 0:
         raise NCInputError(f"tol must be a positive finite number of mm, not {tol!r}")
-    dirs = list(search_path)
-    ta = toolpath(a, read_a, machine, search_path=dirs, file="<a>")
-    tb = toolpath(b, read_b, machine, search_path=dirs, file="<b>")
-    ra, rb = list(ta), list(tb)
+    # Both programs run at once, in step (the comparison reads each toolpath as a stream, so
+    # memory stays flat); the search path is set once around both runs.
+    with _search_path(search_path):
+        ta = toolpath(a, read_a, machine, file="<a>")
+        tb = toolpath(b, read_b, machine, file="<b>")
+        try:
+            diff = _equivalence.compare(ta, tb, tol) if ta.parsed and tb.parsed else None
+            for _ in ta:                # the rest of each run: its diagnostics complete
+                pass
+            for _ in tb:
+                pass
+        finally:
+            ta.close()
+            tb.close()
     diags = ta.diagnostics + tb.diagnostics
     if not (ta.parsed and tb.parsed):
-        return Equivalence(False, tol, None, (len(ra), len(rb)), diags)
-    diff = _equivalence.compare(ra, rb, tol)
-    return Equivalence(diff is None, tol, diff, (len(ra), len(rb)), diags)
+        return Equivalence(False, tol, None, (ta.count, tb.count), diags)
+    return Equivalence(diff is None, tol, diff, (ta.count, tb.count), diags)
 
 

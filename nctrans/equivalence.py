@@ -9,20 +9,32 @@ arc in one program equals the same arc written as short lines in the other. Gaps
 and value of their events, after dropping events that change nothing (S1000 M3 on one line equals
 S1000 then M3). Zero-length moves are ignored. The first difference is returned with both sides'
 file:line.
+
+Both toolpaths are consumed as streams, in lockstep: the two walks along a pair of runs (A's
+points over B's polyline and B's over A's) advance one step each in turn, and only the window of
+points between where each walk stands is held. Memory is flat in program length. Two runs that
+fall more than LOOKAHEAD points out of step (one path wanders where the other does not follow) are
+reported as a difference at the point where the walk got stuck.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections import deque
+from dataclasses import dataclass
 from typing import Iterable, Iterator, Optional
 
 from nctrans.toolpath import ToolpathRecord
-from nctrans.toolpath_io import PLANE_AXES, arc_sweep
+from nctrans.toolpath_io import arc_sweep
 
 DEFAULT_TOL = 0.001
 _ZERO = 1e-9
 _MAX_CHORDS = 20000
 _REL = 1e-6       # relative tolerance for event values (feed, speed, dwell)
+# Points of one run held beyond where the slower walk stands; past it the runs are out of step.
+LOOKAHEAD = 50_000
+# Tokens looked at past a run's end to say what follows it (messages only).
+_PEEK = 1000
+_AXIS_ORDER = "XYZABCUVW"
 
 
 @dataclass
@@ -38,21 +50,36 @@ class Difference:
         return f"{self.where(self.a, 'A')}: {self.where(self.b, 'B')}: {self.message}"
 
 
-@dataclass
-class _Run:
-    cls: str                                  # "rapid" | "feed"
-    axes: tuple[str, ...]
-    points: list[tuple[float, ...]]
-    recs: list[ToolpathRecord]                # the record each point came from
-    feed: Optional[tuple] = None              # (feed, feed_mode) for feed runs
+# --------------------------------------------------------------------------- axes and points
 
+class _Axes:
+    """The axes seen so far in either toolpath, in order of first appearance. Points are tuples
+    over these; a point made before an axis appeared is shorter and reads 0 there (as every
+    record reads 0 on an axis it does not name)."""
 
-@dataclass
-class _Gap:
-    events: list[tuple[str, object, ToolpathRecord]] = field(default_factory=list)
+    def __init__(self) -> None:
+        self.names: list[str] = []
+        self.index: dict[str, int] = {}
 
+    def add(self, d: Optional[dict]) -> None:
+        if d:
+            for a in d:
+                if a not in self.index:
+                    self.index[a] = len(self.names)
+                    self.names.append(a)
 
-# --------------------------------------------------------------------------- discretisation
+    def point(self, d: Optional[dict]) -> tuple[float, ...]:
+        d = d or {}
+        return tuple(float(d.get(a, 0.0)) for a in self.names)
+
+    def pad(self, p: tuple[float, ...]) -> tuple[float, ...]:
+        n = len(self.names)
+        return p if len(p) == n else p + (0.0,) * (n - len(p))
+
+    def fmt(self, p: tuple[float, ...]) -> str:
+        pairs = sorted(zip(self.names, p), key=lambda av: (_AXIS_ORDER.find(av[0]) % 99, av[0]))
+        return " ".join(f"{a}{v:.4f}" if len(a) == 1 else f"{a}={v:.4f}" for a, v in pairs)
+
 
 def _point(d: Optional[dict], axes: tuple[str, ...]) -> tuple[float, ...]:
     d = d or {}
@@ -92,7 +119,7 @@ def arc_points(r: ToolpathRecord, axes: tuple[str, ...], tol: float) -> list[tup
     return pts
 
 
-# --------------------------------------------------------------------------- sequence building
+# --------------------------------------------------------------------------- token stream
 
 def _close(a, b) -> bool:
     if isinstance(a, float) or isinstance(b, float):
@@ -102,20 +129,9 @@ def _close(a, b) -> bool:
     return a == b
 
 
-def _axes_of(records: list[ToolpathRecord]) -> tuple[str, ...]:
-    seen: dict[str, None] = {}
-    for r in records:
-        for pt in (r.start, r.end):
-            if pt:
-                for a in pt:
-                    seen.setdefault(a, None)
-    order = "XYZABCUVW"
-    return tuple(sorted(seen, key=lambda a: (order.find(a) if a in order else 99, a)))
-
-
-def _is_zero_move(r: ToolpathRecord, axes: tuple[str, ...]) -> bool:
-    s, e = _point(r.start, axes), _point(r.end, axes)
-    if any(abs(x - y) > _ZERO for x, y in zip(s, e)):
+def _is_zero_move(r: ToolpathRecord) -> bool:
+    s, e = r.start or {}, r.end or {}
+    if any(abs(e.get(a, 0.0) - s.get(a, 0.0)) > _ZERO for a in {*s, *e}):
         return False
     if r.kind == "arc":       # start == end: a full circle unless the radius is nil
         t0, sweep, radius, _ = arc_sweep(r)
@@ -123,138 +139,303 @@ def _is_zero_move(r: ToolpathRecord, axes: tuple[str, ...]) -> bool:
     return True
 
 
-def build_sequence(records: Iterable[ToolpathRecord], axes: tuple[str, ...], tol: float) -> list:
-    """Records -> alternating list of _Gap and _Run (a gap before every run, one at the end)."""
-    seq: list = []
-    gap = _Gap()
-    run: Optional[_Run] = None
-    # state that events are compared against: only real changes become events
-    state: dict[str, object] = {}
+# Tokens: ("E", key, value, record) an event of a gap; ("R", class, first point, record) a run
+# starts; ("P", point, record) the run's next point. A toolpath is gap (run gap)*.
 
-    def event(key: str, value, rec: ToolpathRecord) -> None:
-        nonlocal gap, run
+def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Iterator[tuple]:
+    """A toolpath's records as the tokens of its gaps and runs, one at a time."""
+    state: dict[str, object] = {}
+    run: Optional[str] = None              # class of the run being produced
+
+    def changed(key: str, value) -> bool:
+        nonlocal run
         if key in state and _close(state[key], value) and key not in ("dwell", "stop", "tool_change"):
-            return
+            return False
         state[key] = value
-        if run is not None:
-            seq.append(run)
-            run = None
-        gap.events.append((key, value, rec))
+        run = None
+        return True
 
     for r in records:
         k = r.kind
         if k in ("rapid", "linear", "arc"):
-            if _is_zero_move(r, axes):
+            if _is_zero_move(r):
                 continue
+            axes.add(r.start)
+            axes.add(r.end)
             cls = "rapid" if k == "rapid" else "feed"
             if cls == "feed":
                 feed = (r.feed, r.feed_mode or "per_min")
-                if state.get("feed") is None or not (_close(state["feed"][0], feed[0])
-                                                      and state["feed"][1] == feed[1]):
-                    event("feed", feed, r)
-            if run is None or run.cls != cls:
-                if run is not None:
-                    seq.append(run)
-                seq.append(gap)
-                gap = _Gap()
-                run = _Run(cls, axes, [_point(r.start, axes)], [r])
-            pts = arc_points(r, axes, tol) if k == "arc" else [_point(r.end, axes)]
-            run.points.extend(pts)
-            run.recs.extend([r] * len(pts))
+                last = state.get("feed")
+                if last is None or not (_close(last[0], feed[0]) and last[1] == feed[1]):
+                    state["feed"] = feed
+                    run = None
+                    yield ("E", "feed", feed, r)
+            if run != cls:
+                run = cls
+                yield ("R", cls, axes.point(r.start), r)
+            if k == "arc":
+                a1, a2 = arc_sweep(r)[3]
+                axes.add({a1: 0.0, a2: 0.0})
+                for p in arc_points(r, tuple(axes.names), tol):
+                    yield ("P", p, r)
+            else:
+                yield ("P", axes.point(r.end), r)
         elif k == "tool_change":
-            event("tool_change", r.tool, r)
+            if changed("tool_change", r.tool):
+                yield ("E", "tool_change", r.tool, r)
         elif k == "spindle":
-            if r.spindle is not None:
-                event("spindle_speed", r.spindle, r)
-            if r.spindle_dir is not None:
-                event("spindle_dir", r.spindle_dir, r)
+            if r.spindle is not None and changed("spindle_speed", r.spindle):
+                yield ("E", "spindle_speed", r.spindle, r)
+            if r.spindle_dir is not None and changed("spindle_dir", r.spindle_dir):
+                yield ("E", "spindle_dir", r.spindle_dir, r)
         elif k == "coolant":
-            event("coolant", r.coolant, r)
+            if changed("coolant", r.coolant):
+                yield ("E", "coolant", r.coolant, r)
         elif k == "dwell":
-            event("dwell", r.dwell_s, r)
+            if changed("dwell", r.dwell_s):
+                yield ("E", "dwell", r.dwell_s, r)
         elif k == "stop":
-            event("stop", r.stop_kind, r)
-    if run is not None:
-        seq.append(run)
-    seq.append(gap)
-    return seq
+            if changed("stop", r.stop_kind):
+                yield ("E", "stop", r.stop_kind, r)
+
+
+class _Stream:
+    """A token stream with a look-ahead queue."""
+
+    def __init__(self, tokens: Iterator[tuple]):
+        self.tokens = tokens
+        self.ahead: deque = deque()
+
+    def peek(self, k: int = 0) -> Optional[tuple]:
+        while len(self.ahead) <= k:
+            t = next(self.tokens, None)
+            if t is None:
+                return None
+            self.ahead.append(t)
+        return self.ahead[k]
+
+    def take(self) -> Optional[tuple]:
+        if self.ahead:
+            return self.ahead.popleft()
+        return next(self.tokens, None)
+
+    def what_next(self) -> str:
+        """What follows the current position, in words (for messages): the class of the next
+        run, else the first event, else the end."""
+        first_event = None
+        for k in range(_PEEK):
+            t = self.peek(k)
+            if t is None:
+                break
+            if t[0] == "R":
+                return f"{t[1]} motion"
+            if t[0] == "E" and first_event is None:
+                first_event = t
+        if first_event is not None:
+            return _fmt_event(first_event[1], first_event[2])
+        return "the end of the toolpath"
+
+
+class _Run:
+    """The points of one run of one toolpath, pulled from its stream as the walks need them; only
+    the window from `base` on is held."""
+
+    def __init__(self, stream: _Stream, axes: _Axes, head: tuple):
+        _, self.cls, p0, r0 = head
+        self.stream = stream
+        self.axes = axes
+        self.buf: list = [(p0, r0)]
+        self.base = 0
+        self.low = 0
+        self.count = 1
+        self.ended = False
+        self.first = (p0, r0)
+        self.last = (p0, r0)
+
+    def _pull(self, keep: bool = True) -> bool:
+        if self.ended:
+            return False
+        t = self.stream.peek()
+        if t is None or t[0] != "P":
+            self.ended = True
+            return False
+        self.stream.take()
+        item = (t[1], t[2])
+        if keep:
+            self.buf.append(item)
+        self.count += 1
+        self.last = item
+        return True
+
+    def has(self, k: int) -> bool:
+        """Whether point k is held (pulling up to it); False past the run's end."""
+        while k >= self.base + len(self.buf):
+            if not self._pull():
+                return False
+        return True
+
+    def point(self, k: int) -> tuple[float, ...]:
+        i = k - self.base
+        p, r = self.buf[i]
+        if len(p) != len(self.axes.names):
+            p = self.axes.pad(p)
+            self.buf[i] = (p, r)
+        return p
+
+    def rec(self, k: int) -> ToolpathRecord:
+        return self.buf[k - self.base][1]
+
+    def trim(self, k: int) -> None:
+        """Points before k are no longer needed (they are dropped in batches)."""
+        self.low = k
+        drop = k - self.base
+        if drop > 1024 and drop * 2 > len(self.buf):
+            del self.buf[:drop]
+            self.base = k
+
+    @property
+    def window(self) -> int:
+        """Points held that are still needed."""
+        return self.count - self.low
+
+    def drain(self) -> None:
+        """Read to the run's end, keeping only its last point."""
+        while self._pull(keep=False):
+            pass
+
+    def last_point(self) -> tuple[float, ...]:
+        return self.axes.pad(self.last[0])
 
 
 # --------------------------------------------------------------------------- geometry
 
 def _dist_point_segment(p, a, b) -> float:
     ab = [y - x for x, y in zip(a, b)]
-    ap = [y - x for x, y in zip(a, p)]
-    L2 = sum(v * v for v in ab)
-    t = 0.0 if L2 == 0 else max(0.0, min(1.0, sum(u * v for u, v in zip(ab, ap)) / L2))
-    return math.sqrt(sum((pv - (av + t * bv)) ** 2 for pv, av, bv in zip(p, a, ab)))
+    L2 = math.fsum(v * v for v in ab)
+    if L2 == 0:
+        return math.dist(p, a)
+    t = max(0.0, min(1.0, math.fsum(u * (y - x) for u, x, y in zip(ab, a, p)) / L2))
+    return math.dist(p, [x + t * u for x, u in zip(a, ab)])
 
 
-def _walk(P: list, Q: list, tol: float) -> tuple[Optional[int], int]:
-    """Walk P's points along polyline Q, visiting Q's segments in order. Returns (index of the first
-    point of P farther than tol from Q, or None; index of the segment of Q reached)."""
-    if len(Q) == 1:
-        for i, p in enumerate(P):
-            if math.dist(p, Q[0]) > tol:
-                return i, 0
-        return None, 0
-    j = 0
-    last = len(Q) - 2
-    for i, p in enumerate(P):
-        while _dist_point_segment(p, Q[j], Q[j + 1]) > tol:
-            if j == last:
-                return i, j
-            j += 1
-    return None, j
+class _Walk:
+    """P's points walked along Q's polyline, Q's segments visited in order: `failed` is the index
+    of the first point of P farther than tol from Q (None while none is), `j` the segment of Q
+    reached. One step is one distance test."""
+
+    def __init__(self, P: _Run, Q: _Run):
+        self.P, self.Q = P, Q
+        self.i = 0
+        self.j = 0
+        self.failed: Optional[int] = None
+        self.finished = False
+        self.stuck = 0              # steps since P's point last advanced
+
+    def step(self, tol: float) -> None:
+        P, Q = self.P, self.Q
+        if not P.has(self.i):
+            self.finished = True
+            return
+        p = P.point(self.i)
+        if not Q.has(1):                        # Q is one point
+            if math.dist(p, Q.point(0)) > tol:
+                self.failed, self.finished = self.i, True
+            else:
+                self.i += 1
+            return
+        j = self.j
+        q0, q1 = Q.point(j), Q.point(j + 1)
+        # an end point within tol puts the segment within tol (the common case: cheap to test)
+        if math.dist(p, q1) <= tol or math.dist(p, q0) <= tol or _dist_point_segment(p, q0, q1) <= tol:
+            self.i += 1
+            self.stuck = 0
+        elif not Q.has(j + 2):                  # j is Q's last segment
+            self.failed, self.finished = self.i, True
+        else:
+            self.j = j + 1
+            self.stuck += 1
 
 
-def _beyond(Q: list, j: int, p, tol: float) -> int:
-    """Index of the first point of Q after segment j that is farther than tol from p."""
-    for k in range(j + 1, len(Q)):
-        if math.dist(Q[k], p) > tol:
-            return k
-    return len(Q) - 1
+def _beyond(Q: _Run, j: int, p, tol: float) -> tuple:
+    """(point, record) of the first point of Q after segment j that is farther than tol from p
+    (Q's last point when none is, or when the window runs out)."""
+    k = j + 1
+    while Q.has(k) and k - j < LOOKAHEAD:
+        q = Q.point(k)
+        if math.dist(q, p) > tol:
+            return q, Q.rec(k)
+        k += 1
+    return Q.last_point(), Q.last[1]
 
 
-def _compare_runs(ra: _Run, rb: _Run, tol: float, next_a: str = "", next_b: str = "") -> Optional[Difference]:
-    """First difference between two runs; next_a/next_b say what follows each (for messages)."""
-    cls = ra.cls
-    if ra.cls != rb.cls:
-        return Difference(f"{ra.cls} motion in A where B has {rb.cls} motion", ra.recs[0], rb.recs[0])
-    A, B = ra.points, rb.points
-    if math.dist(A[0], B[0]) > tol:
-        return Difference(f"{cls} motion starts at {_fmt(A[0], ra.axes)} in A, "
-                          f"{_fmt(B[0], rb.axes)} in B", ra.recs[0], rb.recs[0])
-    fa, ja = _walk(A, B, tol)
-    fb, jb = _walk(B, A, tol)
-    ends_apart = math.dist(A[-1], B[-1]) > tol
-    if fa is None and ends_apart:           # A stops where B goes on
-        k = _beyond(B, ja, A[-1], tol)
-        return Difference(f"A's {cls} motion ends at {_fmt(A[-1], ra.axes)}"
-                          f"{' and ' + next_a + ' follows' if next_a else ''}; "
-                          f"B's goes on to {_fmt(B[k], rb.axes)}", ra.recs[-1], rb.recs[k])
-    if fb is None and ends_apart:           # B stops where A goes on
-        k = _beyond(A, jb, B[-1], tol)
-        return Difference(f"B's {cls} motion ends at {_fmt(B[-1], rb.axes)}"
-                          f"{' and ' + next_b + ' follows' if next_b else ''}; "
-                          f"A's goes on to {_fmt(A[k], ra.axes)}", ra.recs[k], rb.recs[-1])
+def _near(Q: _Run, j: int) -> tuple:
+    """(point, record) of the end of Q's segment j (of the first segment still held)."""
+    k = max(j + 1, Q.base)
+    return (Q.point(k), Q.rec(k)) if Q.has(k) else (Q.last_point(), Q.last[1])
+
+
+def _compare_runs(A: _Run, B: _Run, sa: _Stream, sb: _Stream, tol: float) -> Optional[Difference]:
+    """First difference between two runs, read in lockstep; both are left where the comparison
+    stopped (the caller drains them)."""
+    cls, fmt = A.cls, A.axes.fmt
+    if A.cls != B.cls:
+        return Difference(f"{A.cls} motion in A where B has {B.cls} motion", A.first[1], B.first[1])
+    a0, b0 = A.axes.pad(A.first[0]), B.axes.pad(B.first[0])
+    if math.dist(a0, b0) > tol:
+        return Difference(f"{cls} motion starts at {fmt(a0)} in A, {fmt(b0)} in B", A.first[1], B.first[1])
+    ab, ba = _Walk(A, B), _Walk(B, A)
+    while not (ab.finished and ba.finished):
+        if not ab.finished:
+            ab.step(tol)
+        if not ba.finished:
+            ba.step(tol)
+        A.trim(min(ab.i, ba.j))
+        B.trim(min(ba.i, ab.j))
+        if A.window > LOOKAHEAD or B.window > LOOKAHEAD:
+            return _out_of_step(A, B, ab, ba, tol)
+    fa, fb = ab.failed, ba.failed
+    if fa is None:                          # all of A lies along B: does B stop where A does?
+        q, beyond = _beyond(B, ab.j, A.last_point(), tol)
+        B.drain()
+        if math.dist(A.last_point(), B.last_point()) > tol:
+            follows = sa.what_next()
+            return Difference(f"A's {cls} motion ends at {fmt(A.last_point())}"
+                              f"{' and ' + follows + ' follows' if follows else ''}; "
+                              f"B's goes on to {fmt(q)}", A.last[1], beyond)
+    if fb is None:
+        q, beyond = _beyond(A, ba.j, B.last_point(), tol)
+        A.drain()
+        if math.dist(A.last_point(), B.last_point()) > tol:
+            follows = sb.what_next()
+            return Difference(f"B's {cls} motion ends at {fmt(B.last_point())}"
+                              f"{' and ' + follows + ' follows' if follows else ''}; "
+                              f"A's goes on to {fmt(q)}", beyond, B.last[1])
     if fa is not None:
-        k = min(ja + 1, len(B) - 1)
-        return Difference(f"path leaves tolerance {tol:g} mm: A passes {_fmt(A[fa], ra.axes)}, "
-                          f"B is near {_fmt(B[k], rb.axes)}", ra.recs[fa], rb.recs[k])
+        q, near = _near(B, ab.j)
+        return Difference(f"path leaves tolerance {tol:g} mm: A passes {fmt(A.point(fa))}, "
+                          f"B is near {fmt(q)}", A.rec(fa), near)
     if fb is not None:
-        k = min(jb + 1, len(A) - 1)
-        return Difference(f"path leaves tolerance {tol:g} mm: B passes {_fmt(B[fb], rb.axes)}, "
-                          f"A is near {_fmt(A[k], ra.axes)}", ra.recs[k], rb.recs[fb])
-    if ends_apart:
-        return Difference(f"{cls} motion ends at {_fmt(A[-1], ra.axes)} in A, "
-                          f"{_fmt(B[-1], rb.axes)} in B", ra.recs[-1], rb.recs[-1])
+        q, near = _near(A, ba.j)
+        return Difference(f"path leaves tolerance {tol:g} mm: B passes {fmt(B.point(fb))}, "
+                          f"A is near {fmt(q)}", near, B.rec(fb))
     return None
 
 
-def _fmt(p, axes) -> str:
-    return " ".join(f"{a}{v:.4f}" if len(a) == 1 else f"{a}={v:.4f}" for a, v in zip(axes, p))
+def _out_of_step(A: _Run, B: _Run, ab: _Walk, ba: _Walk, tol: float) -> Difference:
+    """The walks fell LOOKAHEAD points apart: the one stuck longest has a point the other path
+    does not come back to within that window."""
+    fmt = A.axes.fmt
+    why = f"(not found within {LOOKAHEAD} points of the other path)"
+    if ba.finished or (not ab.finished and ab.stuck >= ba.stuck):
+        q, near = _near(B, ab.j - ab.stuck)
+        return Difference(f"path leaves tolerance {tol:g} mm: A passes {fmt(A.point(ab.i))}, "
+                          f"B is near {fmt(q)} {why}", A.rec(ab.i), near)
+    q, near = _near(A, ba.j - ba.stuck)
+    return Difference(f"path leaves tolerance {tol:g} mm: B passes {fmt(B.point(ba.i))}, "
+                      f"A is near {fmt(q)} {why}", near, B.rec(ba.i))
 
+
+# --------------------------------------------------------------------------- gaps
 
 def _fmt_event(key: str, value) -> str:
     if key == "feed":
@@ -263,36 +444,20 @@ def _fmt_event(key: str, value) -> str:
     return f"{key.replace('_', ' ')} {value}"
 
 
-def _compare_gaps(ga: _Gap, gb: _Gap, ra: Optional[ToolpathRecord], rb: Optional[ToolpathRecord]
-                  ) -> Optional[Difference]:
-    for (ka, va, reca), (kb, vb, recb) in zip(ga.events, gb.events):
-        same = ka == kb and (_close(va[0], vb[0]) and va[1] == vb[1] if ka == "feed" else _close(va, vb))
-        if not same:
-            return Difference(f"{_fmt_event(ka, va)} in A, {_fmt_event(kb, vb)} in B", reca, recb)
-    na, nb = len(ga.events), len(gb.events)
-    if na > nb:
-        k, v, rec = ga.events[nb]
-        return Difference(f"{_fmt_event(k, v)} in A has no counterpart in B", rec, gb.events[-1][2] if nb else rb)
-    if nb > na:
-        k, v, rec = gb.events[na]
-        return Difference(f"{_fmt_event(k, v)} in B has no counterpart in A", ga.events[-1][2] if na else ra, rec)
-    return None
+def _same_event(ea: tuple, eb: tuple) -> bool:
+    _, ka, va, _ = ea
+    _, kb, vb, _ = eb
+    if ka != kb:
+        return False
+    return _close(va[0], vb[0]) and va[1] == vb[1] if ka == "feed" else _close(va, vb)
 
 
-def _what_next(seq: list, n: int) -> str:
-    """What follows item n of a sequence, in words (for messages)."""
-    for item in seq[n + 1:]:
-        if isinstance(item, _Run):
-            return f"{item.cls} motion"
-    for item in seq[n + 1:]:
-        if item.events:
-            return _fmt_event(*item.events[0][:2])
-    return "the end of the toolpath"
-
+# --------------------------------------------------------------------------- comparison
 
 def compare(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: float = DEFAULT_TOL
             ) -> Optional[Difference]:
-    """The first difference between toolpaths a and b, or None when they are equivalent."""
+    """The first difference between toolpaths a and b, or None when they are equivalent. Both are
+    read as streams and only as far as the first difference."""
     for d in differences(a, b, tol):
         return d
     return None
@@ -303,31 +468,55 @@ def differences(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: f
     """Every difference between the pieces (runs of motion, gaps of events) of a and b paired in
     order; the first is compare's answer. Pairing is by position, so once the two have gone out of
     step (a missing run), later differences may follow from the first (backplot --compare marks
-    them all)."""
-    la, lb = list(a), list(b)
-    axes = _axes_of(la + lb)
-    sa, sb = build_sequence(la, axes, tol), build_sequence(lb, axes, tol)
-    last_a = last_b = None
-    for n, (ia, ib) in enumerate(zip(sa, sb)):
-        if isinstance(ia, _Run) and isinstance(ib, _Run):
-            d = _compare_runs(ia, ib, tol, _what_next(sa, n), _what_next(sb, n))
-            last_a, last_b = ia.recs[-1], ib.recs[-1]
-        elif isinstance(ia, _Gap) and isinstance(ib, _Gap):
-            d = _compare_gaps(ia, ib, last_a, last_b)
-            if ia.events:
-                last_a = ia.events[-1][2]
-            if ib.events:
-                last_b = ib.events[-1][2]
-        else:  # cannot happen: both sequences alternate gap/run from a gap
-            d = Difference("toolpaths differ in structure", last_a, last_b)
+    them all). Memory stays flat: each toolpath is read once, in step with the other."""
+    axes = _Axes()
+    sa, sb = _Stream(_tokens(a, axes, tol)), _Stream(_tokens(b, axes, tol))
+    last_a: Optional[ToolpathRecord] = None
+    last_b: Optional[ToolpathRecord] = None
+    while True:
+        # a gap: events paired in order; one difference per gap
+        found: Optional[Difference] = None
+        while True:
+            ta, tb = sa.peek(), sb.peek()
+            a_event = ta is not None and ta[0] == "E"
+            b_event = tb is not None and tb[0] == "E"
+            if a_event and b_event:
+                sa.take(), sb.take()
+                if found is None and not _same_event(ta, tb):
+                    found = Difference(f"{_fmt_event(ta[1], ta[2])} in A, {_fmt_event(tb[1], tb[2])} in B",
+                                       ta[3], tb[3])
+                last_a, last_b = ta[3], tb[3]
+            elif a_event or b_event:
+                if found is None:
+                    side, t = ("A", ta) if a_event else ("B", tb)
+                    other = "B" if side == "A" else "A"
+                    msg = f"{_fmt_event(t[1], t[2])} in {side} has no counterpart in {other}"
+                    found = Difference(msg, t[3], last_b) if side == "A" else Difference(msg, last_a, t[3])
+                s = sa if a_event else sb
+                t = s.take()
+                if a_event:
+                    last_a = t[3]
+                else:
+                    last_b = t[3]
+            else:
+                break
+        if found is not None:
+            yield found
+        ta, tb = sa.peek(), sb.peek()
+        if ta is None and tb is None:
+            return
+        if ta is None or tb is None:
+            name, t, other = ("A", ta, last_b) if tb is None else ("B", tb, last_a)
+            what = f"{t[1]} motion"
+            if name == "A":
+                yield Difference(f"A continues with {what}; B has ended", t[3], other)
+            else:
+                yield Difference(f"B continues with {what}; A has ended", other, t[3])
+            return
+        A, B = _Run(sa, axes, sa.take()), _Run(sb, axes, sb.take())
+        d = _compare_runs(A, B, sa, sb, tol)
         if d is not None:
-            yield d
-    if len(sa) != len(sb):
-        longer, name = (sa, "A") if len(sa) > len(sb) else (sb, "B")
-        extra = longer[min(len(sa), len(sb))]
-        rec = extra.recs[0] if isinstance(extra, _Run) else (extra.events[0][2] if extra.events else None)
-        what = f"{extra.cls} motion" if isinstance(extra, _Run) else "events"
-        if name == "A":
-            yield Difference(f"A continues with {what}; B has ended", rec, last_b)
-        else:
-            yield Difference(f"B continues with {what}; A has ended", last_a, rec)
+            yield d                     # before reading the rest: compare() stops here
+        A.drain()
+        B.drain()
+        last_a, last_b = A.last[1], B.last[1]

@@ -223,3 +223,64 @@ def test_moving_one_point_beyond_tolerance_is_found(points, which, axis, delta):
             p[axis] += delta
         b.line_to(**p)
     assert compare(a.recs, b.recs, tol=0.001) is not None
+
+
+# --------------------------------------------------------------------------- streaming
+
+def _endless_line(file="a.nc"):
+    """A toolpath that never ends: a feed run along X, 1 mm per record."""
+    import itertools
+    yield from base(file).recs
+    for k in itertools.count(1):
+        yield ToolpathRecord(k + 10, file, k + 10, "linear", start={"X": 9.0 + k, "Y": 0.0, "Z": -1.0},
+                             end={"X": 10.0 + k, "Y": 0.0, "Z": -1.0}, feed=100.0, feed_mode="per_min")
+
+
+def test_first_difference_is_found_without_reading_to_the_end():
+    """Both toolpaths are read as streams, in step: an endless A still gets its answer where B
+    turns away (a whole-list comparison would never return)."""
+    b = base("b.nc").line_to(X=20).line_to(Y=5)
+    d = compare(_endless_line(), b.recs)
+    assert d is not None and d.b.file == "b.nc" and d.b.line == 6
+
+
+def test_one_line_equals_many_short_segments_within_a_small_lookahead(monkeypatch):
+    """The walks advance in step, so a run written as one line in A and as 20,000 segments in B
+    never needs more than a small window of either."""
+    from nctrans import equivalence
+    monkeypatch.setattr(equivalence, "LOOKAHEAD", 200)
+    a = base().line_to(X=2010)
+    b = base("b.nc")
+    for k in range(1, 20001):
+        b.line_to(X=10 + k * 0.1)
+    assert compare(a.recs, b.recs) is None
+    assert compare(b.recs, a.recs) is None
+    b.line_to(X=2010, Y=0.5)
+    assert compare(a.recs, b.recs) is not None
+
+
+def test_paths_out_of_step_beyond_the_lookahead_are_a_difference(monkeypatch):
+    """A retraces its first pass 300 points long while B goes on elsewhere: once the walks are
+    more than LOOKAHEAD points apart the comparison stops with a located difference instead of
+    holding the rest."""
+    from nctrans import equivalence
+    monkeypatch.setattr(equivalence, "LOOKAHEAD", 100)
+    a, b = base(), base("b.nc")
+    for k in range(1, 301):
+        a.line_to(X=10 + k * 0.01 * (1 if k % 2 else -1), Y=k * 0.5)
+        b.line_to(X=10 + k * 0.01 * (1 if k % 2 else -1), Y=k * 0.5)
+    for k in range(1, 301):                     # A retraces the same zig-zag; B leaves sideways
+        a.line_to(X=10 + k * 0.01 * (1 if k % 2 else -1), Y=150 - k * 0.5)
+        b.line_to(X=20 + k, Y=150)
+    d = compare(a.recs, b.recs)
+    assert d is not None and "tolerance" in d.message
+
+
+def test_an_axis_that_appears_late_is_compared():
+    """Axes are learnt as the streams go: an A axis first seen in the last move still counts."""
+    a = base().line_to(X=20).line_to(X=30)
+    b = base("b.nc").line_to(X=20).line_to(X=30)
+    a.recs[-1].end = {**a.recs[-1].end, "A": 90.0}
+    assert compare(a.recs, b.recs) is not None
+    b.recs[-1].end = {**b.recs[-1].end, "A": 90.0}
+    assert compare(a.recs, b.recs) is None
