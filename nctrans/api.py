@@ -227,11 +227,14 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     long it is. On refusal what was written must be discarded (reset() or OutputFile.discard())."""
     _check_dialect(write)
     with _search_path(search_path):
-        ld = _load(text, read, file=file, stream=out is not None and not flatten)
+        ld = _load(text, read, file=file, stream=out is not None)
         with _api_errors():
             target = pipeline.get_dialect(write)
         if ld.streamed is not None:
-            streamed = _transpile_stream(ld, target, strict, out)
+            if flatten:
+                streamed = _transpile_flat_stream(ld, target, strict, out, _machine(machine, ld.dialect))
+            else:
+                streamed = _transpile_stream(ld, target, strict, out)
             if streamed is not None:
                 _raise_on_errors(streamed.diagnostics, error_level)
                 return streamed
@@ -250,7 +253,12 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                                            resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
                 return result
 
-            result = convert(program, target, flatten=flatten, strict_mode=strict, flatten_with=flatten_with)
+            result = None
+            if flatten and out is not None:         # written as the run goes: flat memory
+                result = _transpile_flat_stream(ld, target, strict, out, flat_machine)
+            if result is None:
+                result = convert(program, target, flatten=flatten, strict_mode=strict,
+                                 flatten_with=flatten_with)
             diags.extend(result.diagnostics)
             out_text = result.text
         elif strict:
@@ -263,6 +271,31 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
         out.write(out_text)
         out_text = ""
     return Conversion(out_text, diags, ld.dialect or "", write)
+
+
+def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any, machine: Machine) -> Any:
+    """--flatten with an output sink: the flattened blocks are written as the interpreter makes
+    them (convert_flat_stream); None when the target cannot stream (the sink is then reset)."""
+    from nctrans.convert import convert_flat_stream
+    from nctrans.lower.flatten import flatten_blocks, flattened_meta
+    program = ld.program
+    resolver = pipeline.make_resolver(ld.source_dir, ld.dialect)
+
+    def blocks(into: list[Diagnostic]) -> Iterator[Any]:
+        return flatten_blocks(program, machine, diagnostics=into, resolver=resolver)
+
+    result = convert_flat_stream(program, target, blocks, flattened_meta(program), out.write, strict_mode=strict)
+    if result is None:
+        out.reset()
+        return None
+    if ld.streamed is None:
+        return result
+    pipeline.finish_stream(ld)                  # a streamed parse: its diagnostics come first
+    diags = ld.diagnostics
+    if any(d.severity == "error" for d in diags):
+        return Conversion(None, diags, ld.dialect or "", target.name)   # as the whole parse: not run
+    diags.extend(result.diagnostics)
+    return Conversion(result.text, diags, ld.dialect or "", target.name)
 
 
 def _transpile_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any) -> Optional[Conversion]:

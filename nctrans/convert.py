@@ -14,7 +14,7 @@ The policy, in one place (sqlglot's "unsupported level"):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Callable, Iterable, Optional
 
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import Dialect
@@ -152,9 +152,13 @@ def convert_stream(program: Program, target: Dialect, write: Callable[[str], Non
     whole program instead. A Conversion whose text is None was refused (discard what was written);
     `retry_whole` then says a refusal (NC402) might still be lowered to plain motion by converting
     the whole program. Text, when not refused, is "" (everything was written)."""
-    if target.lowering_passes:
-        return None
-    found = target.emit_stream(program, stream_chunks(program.body), write)
+    if not all(getattr(p, "structural_only", False) for p in target.lowering_passes):
+        return None             # a pass that may rewrite plain blocks needs the whole program
+    from nctrans.dialects.base import CannotStream
+    try:
+        found = target.emit_stream(program, stream_chunks(program.body), write)
+    except CannotStream:
+        return Conversion(None, [], retry_whole=True)
     if found is None:
         return None
     refusals = [d for d in found if _is_refusal(d)]
@@ -163,3 +167,32 @@ def convert_stream(program: Program, target: Dialect, write: Callable[[str], Non
         return Conversion(None, diags, retry_whole=True)
     refused = any(d.severity == "error" for d in diags)
     return Conversion(None if refused else "", diags)
+
+
+def convert_flat_stream(program: Program, target: Dialect, blocks: Callable[[list], Iterable],
+                        meta: dict, write: Callable[[str], None], *,
+                        strict_mode: bool = False) -> Optional[Conversion]:
+    """convert(flatten=True) written as the run goes: `blocks(diagnostics)` yields the flattened
+    program's blocks as the interpreter produces them (nctrans.lower.flatten.flatten_blocks) and
+    the target writes them chunk by chunk, so a program whose loops unroll into millions of moves
+    is never held whole. None when the target cannot stream (convert the whole program instead);
+    a Conversion whose text is None was refused (discard what was written)."""
+    library = _library_entry(program)
+    if library is not None:
+        return Conversion(None, [_library_refusal(program, library, target.name)])
+    if not all(getattr(p, "structural_only", False) for p in target.lowering_passes):
+        return None
+    from nctrans.dialects.base import CannotStream
+    flat_diags: list[Diagnostic] = []
+    shell = Program(program.file, program.dialect, [], {}, meta, None)
+    try:
+        found = target.emit_stream(shell, stream_chunks(blocks(flat_diags)), write)
+    except CannotStream:
+        return None
+    if found is None:
+        return None
+    diags = flat_diags + list(found)
+    if strict_mode:
+        diags = strict(diags)
+    refused = any(d.severity == "error" for d in diags)
+    return Conversion(None if refused else "", diags, flattened=True)

@@ -530,3 +530,61 @@ def test_cli_convert_flatten(tmp_path, capsys):
     recs, diags = toolpath(back)
     src_recs, _ = toolpath(parse("sinumerik", src.read_text(), "frames.mpf"))
     assert equiv.compare(src_recs, recs) is None
+
+
+# --------------------------------------------------------------------------- streamed (issue 15)
+
+class _Sink:
+    def __init__(self):
+        self.parts: list[str] = []
+
+    def write(self, s: str) -> None:
+        self.parts.append(s)
+
+    def reset(self) -> None:
+        self.parts = []
+
+
+def test_flattened_blocks_come_as_the_program_runs():
+    """An endless loop gives its first blocks at once: the flattened program is produced as the
+    interpreter runs, never collected whole first (islice would wait for the step budget)."""
+    from itertools import islice
+
+    from nctrans.lower.flatten import flatten_blocks
+    prog = get("sinumerik").parse("G0 X0 Y0\nLOOP\nG91 G1 X1 F100\nENDLOOP\nM30\n", "e.mpf").program
+    first = list(islice(flatten_blocks(prog, default_mill(), diagnostics=[]), 6))
+    moves = [s for b in first for s in b.body if type(s) is n.Motion]
+    assert len(moves) >= 4
+
+
+@pytest.mark.parametrize("source, dialect, target", [
+    ("corpus/sinumerik/control_flow.mpf", "sinumerik", "iso-m"),
+    ("corpus/sinumerik/cycles.mpf", "sinumerik", "sinumerik"),
+    ("corpus/iso-m/sample-pocket.nc", "iso-m", "iso-m"),
+    ("corpus/iso-m/sample-pocket.nc", "iso-m", "sinumerik"),
+])
+def test_streamed_flatten_writes_what_the_whole_one_does(source, dialect, target):
+    """convert --flatten with an output writes as it goes (several pieces): the same text and
+    the same diagnostics, in the same order, as flattening the whole program first."""
+    from nctrans import api
+    text = (Path(__file__).resolve().parents[1] / source).read_text()
+    whole = api.transpile(text, dialect, target, flatten=True)
+    sink = _Sink()
+    streamed = api.transpile(text, dialect, target, flatten=True, out=sink)
+    assert whole.text is not None and streamed.text == "" and len(sink.parts) > 1
+    assert "".join(sink.parts) == whole.text
+    assert [d.format_text() for d in streamed.diagnostics] == [d.format_text() for d in whole.diagnostics]
+
+
+def test_streamed_flatten_keeps_notes_of_a_straight_program_in_order():
+    """A straight ISO program is flattened from its streamed parse: the unmodelled M code and
+    the radius arc are reported as the whole walk reports them, the block after M30 included."""
+    from nctrans import api
+    text = "G21 G90\nG0 X0 Y0\nG1 X10 F100\nM123\nG2 X20 R5\nM30\nG0 X5\nM456\n"
+    whole = api.transpile(text, "iso-m", "iso-m", flatten=True)
+    sink = _Sink()
+    streamed = api.transpile(text, "iso-m", "iso-m", flatten=True, out=sink)
+    got = [d.format_text() for d in streamed.diagnostics]
+    assert got == [d.format_text() for d in whole.diagnostics]
+    assert any("M123" in g and "NC403" in g for g in got) and any("M456" in g for g in got)
+    assert "".join(sink.parts) == whole.text

@@ -64,6 +64,11 @@ class StreamedBody:
             pass
 
 
+class CannotStream(Exception):
+    """Raised by Dialect.emit_stream when the program turns out to need the whole-program
+    emitter (nothing written is final: the caller discards it and converts the whole program)."""
+
+
 class Marker(NamedTuple):
     """A detection marker: a construct in a line of code (comments removed) that points to a dialect.
     weight: evidence per matching line; cap: at most this many lines count."""

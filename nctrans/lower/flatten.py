@@ -38,7 +38,7 @@ import math
 
 import dataclasses
 import re
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Iterator, Optional
 
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.interp.interpreter import Interpreter
@@ -415,15 +415,52 @@ def _split_turns(rec: ToolpathRecord) -> list[ToolpathRecord]:
     return pieces
 
 
+def _walked(body, walker: "_Walker") -> Iterator:
+    """The blocks of a streamed body (runs of plain blocks taken apart), each walked by `walker`
+    as it is handed on."""
+    from nctrans.convert import stream_chunks
+    for chunk in stream_chunks(body, 256):
+        walker.nodes(chunk)
+        yield from chunk
+
+
 def flatten(program: n.Program, machine=None, *, diagnostics: list,
             resolver: Optional[Callable] = None, max_steps: Optional[int] = None) -> n.Program:
     """Plain-motion Program equivalent to `program` on `machine` (default mill); NC4xx diagnostics
     (and the interpreter's own) are appended to `diagnostics`."""
+    blocks = list(flatten_blocks(program, machine, diagnostics=diagnostics, resolver=resolver,
+                                 max_steps=max_steps))
+    return n.Program(program.file, program.dialect, blocks, {}, flattened_meta(program), None)
+
+
+def flattened_meta(program: n.Program) -> dict:
+    """The meta of the flattened program (what its emitter reads before the first block)."""
+    meta: dict[str, object] = {"flattened_from": program.dialect, "percent": True}
+    defaults = program.meta.get("defaults") if isinstance(program.meta, dict) else None
+    if isinstance(defaults, dict):
+        # the records hold the radius: the flattened program is in radius whatever the source was
+        meta["defaults"] = {g: v for g, v in defaults.items() if g != "diameter"}
+    return meta
+
+
+def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
+                   resolver: Optional[Callable] = None, max_steps: Optional[int] = None
+                   ) -> Iterator[n.Block]:
+    """The blocks of flatten()'s program, one at a time as the run produces them, so a program
+    whose loops unroll into millions of moves is never held whole. `diagnostics` is complete
+    once the iteration has ended."""
     if machine is None:
         from nctrans.machine import default_mill
         machine = default_mill()
-    walker = _Walker(diagnostics, getattr(machine, "kind", "mill"))
-    walker.program(program)
+    streamed = type(program.body) is not list
+    first_diag = len(diagnostics)
+    # A streamed body (a straight program parsed as it runs) is walked block by block as the
+    # interpreter takes it; its notes go where the whole walk would have put them, first.
+    walker = _Walker([] if streamed else diagnostics, getattr(machine, "kind", "mill"))
+    if streamed:
+        program = dataclasses.replace(program, body=_walked(program.body, walker))
+    else:
+        walker.program(program)
 
     wrapped = None
     if resolver is not None:
@@ -441,14 +478,21 @@ def flatten(program: n.Program, machine=None, *, diagnostics: list,
         kwargs["max_steps"] = max_steps
     interp = Interpreter(program, machine, **kwargs)
     fl.interp = interp
+    last: Optional[n.Block] = None
     for _ in interp.run():
-        pass
+        if fl.blocks:
+            last = fl.blocks[-1]
+            yield from fl.blocks
+            fl.blocks.clear()
+    if fl.blocks:
+        last = fl.blocks[-1]
     raised = getattr(interp, "alarm", None)
     if raised is not None:
         # the source stops with an alarm here: the flattened program raises the same alarm, so
         # the run's NC221 becomes a lowering note (the conversion keeps the behaviour)
         number, text, span = raised
         fl.blocks.append(n.Block(span, [n.Alarm(number, text)]))
+        last = fl.blocks[-1]
         for i, d in enumerate(interp_diags):
             if d.rule == "NC221":
                 interp_diags[i] = Diagnostic("NC401", "info", f"--flatten: the program raises an alarm "
@@ -456,8 +500,15 @@ def flatten(program: n.Program, machine=None, *, diagnostics: list,
                                              "); the flattened program raises it too", d.file, d.line,
                                              d.column, d.end_line, d.end_column)
     if not fl.ended:
-        last = fl.blocks[-1].span if fl.blocks else n.Span(program.file, 1)
-        fl.blocks.append(n.Block(last, [n.ProgramEnd("end_rewind")]))
+        span = last.span if last is not None else n.Span(program.file, 1)
+        fl.blocks.append(n.Block(span, [n.ProgramEnd("end_rewind")]))
+    yield from fl.blocks
+    fl.blocks.clear()
+    if streamed:
+        for _ in program.body:      # what follows the program end is walked as a whole walk would
+            pass
+        diagnostics[first_diag:first_diag] = walker.diags
+        walker.diags = diagnostics
     diagnostics.extend(interp_diags)
     for d in interp_diags:
         if d.rule == "NC103" or (d.rule == "NC205" and "budget" in d.message):
@@ -465,9 +516,3 @@ def flatten(program: n.Program, machine=None, *, diagnostics: list,
                                           f"{d.message}", d.file, d.line, d.column, d.end_line,
                                           d.end_column))
     walker.report()
-    meta: dict[str, object] = {"flattened_from": program.dialect, "percent": True}
-    defaults = program.meta.get("defaults") if isinstance(program.meta, dict) else None
-    if isinstance(defaults, dict):
-        # the records hold the radius: the flattened program is in radius whatever the source was
-        meta["defaults"] = {g: v for g, v in defaults.items() if g != "diameter"}
-    return n.Program(program.file, program.dialect, fl.blocks, {}, meta, None)

@@ -69,3 +69,8 @@ def _rewrite(program: n.Program, kind: type, rewrite: Callable[[object], list],
         return program, []
     result = dataclasses.replace(program, body=body, subprograms=subs)
     return result, [at_span("NC401", "info", message, first[0])]
+
+
+# A pass that rewrites structures only (loops, branches) leaves a body of plain blocks as it is: a
+# streamed conversion (whose body is plain blocks by construction) may skip it.
+for_to_while.structural_only = True  # type: ignore[attr-defined]

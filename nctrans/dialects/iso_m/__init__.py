@@ -107,6 +107,14 @@ class IsoFamily(Dialect):
         from .emitter import emit_program
         return emit_program(program, self.emitter())
 
+    def emit_stream(self, program, chunks, write):
+        """emit() chunk by chunk (nctrans.dialects.iso_m.stream_emit); None for a member with an
+        emitter of its own (not an IsoEmitter)."""
+        if type(self).emit is not IsoFamily.emit:
+            return None
+        from .stream_emit import emit_stream
+        return emit_stream(program, chunks, write, self.emitter())
+
     def sniff(self, text: str) -> float:
         return sniff(text)
 
