@@ -144,3 +144,27 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
     second = ranked[1][1] if len(ranked) > 1 else 0.0
     ambiguous = total < MIN_EVIDENCE or conf - second < MIN_MARGIN
     return Guess(None if ambiguous else top, conf, scores, evidence, first, ambiguous, content)
+
+
+# Evidence of one marker hit that, on a line a front end could not read, points to another dialect.
+FOREIGN_WEIGHT = 2.0
+
+
+def foreign_marker(line: str, dialect: str) -> Optional[tuple[str, int, str]]:
+    """(other dialect, column, marked text) when one line of code carries a strong marker of another
+    dialect and none of `dialect`'s own: a syntax error on such a line most likely means the file
+    is read as the wrong dialect (NC005 at that line). None otherwise."""
+    code = next(_code_lines(line.split("\n", 1)[0]), None)
+    if code is None or not code[1].strip():
+        return None
+    best: Optional[tuple[float, str, int, str]] = None
+    for d in base.dialects():
+        for m in d.markers:
+            hit = m.pattern.search(code[1])
+            if hit is None:
+                continue
+            if d.name == dialect and m.weight >= 1.0:
+                return None
+            if d.name != dialect and m.weight >= FOREIGN_WEIGHT and (best is None or m.weight > best[0]):
+                best = (m.weight, d.name, hit.start() + 1, hit.group(0).strip()[:30])
+    return None if best is None else best[1:]

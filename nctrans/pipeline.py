@@ -115,9 +115,30 @@ def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Opt
 def _add_parse_diagnostics(diags: list, parsed: list, src, dialect: str, guess) -> None:
     diags.extend(parsed)
     if not any(x.rule == "NC005" for x in diags):
-        wrong = _wrong_dialect(src, dialect, guess)
+        wrong = _wrong_dialect(src, dialect, guess) or _foreign_syntax_error(src, dialect, parsed)
         if wrong is not None:
             diags.append(wrong)
+
+
+def _foreign_syntax_error(src: _source.SourceText, dialect: str, parsed: list) -> Optional[Diagnostic]:
+    """NC005 at the first syntax error (NC002) whose line carries a strong marker of another
+    dialect and none of this one's (`X=5` read as ISO): the likely cause is the wrong --from."""
+    first = next((d for d in parsed if d.rule == "NC002" and d.severity == "error"), None)
+    if first is None or not first.line:
+        return None
+    start = 0
+    for _ in range(first.line - 1):
+        start = src.text.find("\n", start) + 1
+        if start == 0:
+            return None
+    end = src.text.find("\n", start)
+    found = _detect.foreign_marker(src.text[start:end if end >= 0 else len(src.text)], dialect)
+    if found is None:
+        return None
+    other, col, text = found
+    return Diagnostic("NC005", "error",
+                      f"this looks like {other}, not {dialect} ({text!r} at line {first.line}): use --from {other}",
+                      src.file, first.line, col, first.line, col + max(len(text), 1))
 
 
 def _finish_stream(ld: Loaded, run_diags: list[Diagnostic]) -> None:

@@ -306,12 +306,13 @@ def test_long_straight_program_gives_all_its_moves_and_converts_streamed(tmp_pat
     assert lines == n + 1                     # every move, and the stop
 
 
-def test_streamed_conversion_equals_the_whole_one(tmp_path):
+@pytest.mark.parametrize("target", ["sinumerik", "iso-m"])
+def test_streamed_conversion_equals_the_whole_one(tmp_path, target):
     from nctrans import api
     text = "%\nO1\nG21 G90 G17\nT1 M6\nS8000 M3\nG0 X0 Y0 Z5.\nG1 Z-1. F500.\n" + "".join(
         f"G1 X{i % 97}.5 Y{i % 89}.25\n" + (f"G2 X{i % 97}.5 Y{i % 89}.25 I1. J0\n" if i % 50 == 0 else "")
         for i in range(9000)) + "M30\n%\n"
-    whole = api.transpile(text, "iso-m", "sinumerik")
+    whole = api.transpile(text, "iso-m", target)
 
     class Sink:
         def __init__(self):
@@ -323,7 +324,39 @@ def test_streamed_conversion_equals_the_whole_one(tmp_path):
         def reset(self):
             self.parts = []
     sink = Sink()
-    streamed = api.transpile(text, "iso-m", "sinumerik", out=sink)
+    streamed = api.transpile(text, "iso-m", target, out=sink)
     assert streamed.text == "" and len(sink.parts) > 2          # written in several pieces
     assert "".join(sink.parts) == whole.text
     assert [d.format_text() for d in streamed.diagnostics] == [d.format_text() for d in whole.diagnostics]
+
+
+# --------------------------------------------------------------------------- wrong dialect (11)
+
+@pytest.mark.parametrize("text, column, marked", [
+    ("G0 X=5\nM30\n", 4, "X=5"),                          # a Sinumerik axis assignment
+    ("G0 X10\nG1 Y=R1+2 F100\nM30\n", 4, "Y=R1"),
+])
+def test_syntax_error_on_another_dialects_line_is_a_located_nc005(tmp_path, text, column, marked):
+    f = write(tmp_path, "w.nc", text)
+    line = text[:text.index(marked)].count("\n") + 1
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 1 and located(out, "NC005", "w.nc", line, column), out
+    assert "use --from sinumerik" in out and located(out, "NC002", "w.nc", line)
+    rc, _, err = run("convert", f.name, "--from", "iso-m", "--to", "sinumerik", "-o", "out.mpf", cwd=tmp_path)
+    assert rc == 1 and located(err, "NC005", "w.nc", line, column) and not (tmp_path / "out.mpf").exists()
+
+
+def test_an_iso_syntax_error_is_not_blamed_on_the_dialect(tmp_path):
+    f = write(tmp_path, "s.nc", "G0 X1--5\nM30\n")
+    rc, out, _ = run("lint", f.name, "--from", "iso-m", cwd=tmp_path)
+    assert rc == 1 and "NC002" in out and "NC005" not in out
+
+
+def test_plain_mpf_calling_a_subprogram_by_name_is_sinumerik(tmp_path):
+    """`RECSUB` alone on a line calls a subprogram by name: with the .mpf ending that settles it."""
+    write(tmp_path, "RECSUB.spf", "PROC RECSUB\nG1 X5 F100\nRET\n")
+    f = write(tmp_path, "main.mpf", "G0 X10\nRECSUB\nM30\n")
+    rc, out, err = run("detect", f.name, cwd=tmp_path)
+    assert rc == 0 and "sinumerik" in out and "ambiguous" not in out + err
+    rc, out, _ = run("toolpath", f.name, cwd=tmp_path)
+    assert rc == 0 and '"X":5.0' in out
