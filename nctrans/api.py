@@ -231,6 +231,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
         with _api_errors():
             target = pipeline.get_dialect(write)
         if ld.streamed is not None:
+            streamed: Optional[Conversion]
             if flatten:
                 streamed = _transpile_flat_stream(ld, target, strict, out, _machine(machine, ld.dialect))
             else:
@@ -253,7 +254,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                                            resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
                 return result
 
-            result = None
+            result: Any = None
             if flatten and out is not None:         # written as the run goes: flat memory
                 result = _transpile_flat_stream(ld, target, strict, out, flat_machine)
             if result is None:
@@ -273,12 +274,15 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     return Conversion(out_text, diags, ld.dialect or "", write)
 
 
-def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any, machine: Machine) -> Any:
+def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any,
+                           machine: Machine) -> Optional[Conversion]:
     """--flatten with an output sink: the flattened blocks are written as the interpreter makes
     them (convert_flat_stream); None when the target cannot stream (the sink is then reset)."""
     from nctrans.convert import convert_flat_stream
     from nctrans.lower.flatten import flatten_blocks, flattened_meta
     program = ld.program
+    if program is None:
+        return None
     resolver = pipeline.make_resolver(ld.source_dir, ld.dialect)
 
     def blocks(into: list[Diagnostic]) -> Iterator[Any]:
@@ -289,7 +293,7 @@ def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: 
         out.reset()
         return None
     if ld.streamed is None:
-        return result
+        return Conversion(result.text, list(result.diagnostics), ld.dialect or "", target.name)
     pipeline.finish_stream(ld)                  # a streamed parse: its diagnostics come first
     diags = ld.diagnostics
     if any(d.severity == "error" for d in diags):
