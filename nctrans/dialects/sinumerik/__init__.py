@@ -49,9 +49,9 @@ MARKERS = (
     Marker(1.5, 1, re.compile(r"\bG7[01]\b", _I)),          # inch/metric (ISO mills: G20/G21)
     # array element assignment by name (GUD/LUD arrays: INI[53]=0); ISO writes #[..] instead
     Marker(3.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?[A-Z_]{2,}\w*[ \t]*\[[^\]]*\][ \t]*=", _I)),
-    # a subprogram called by its name alone on a line (RECSUB, L100 P2 aside); ISO keywords that
-    # stand alone (END1, GOTO10, DO2) are numbered words, not names
-    Marker(2.0, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?(?!(?:END|GOTO|DO|THEN)\d)[A-Z_]{2,}\w*[ \t]*$", _I)),
+    # a subprogram called by its name alone on a line (RECSUB), written in capitals as programs
+    # name them; ISO keywords that stand alone (END1, GOTO10, DO2) are numbered words, not names
+    Marker(1.5, 2, re.compile(r"^[ \t]*(?:N\d+[ \t]+)?(?!(?:END|GOTO|DO|THEN)\d)[A-Z_]{2,}[A-Z0-9_]*[ \t]*$")),
 )
 
 class Sinumerik(Dialect):
