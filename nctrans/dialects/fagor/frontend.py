@@ -29,7 +29,7 @@ from typing import Any, Optional
 from lark import Lark, Token, Tree
 from lark.exceptions import LarkError, UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from nctrans import resources
+from nctrans import limits, resources
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import ParseResult
 from nctrans.ir import nodes as ir
@@ -722,6 +722,10 @@ def find_instruction(code: str) -> Optional[tuple[int, int, str]]:
 
 # ------------------------------------------------------------------ structure
 
+# grammar rules that open a control structure, and the structure's name
+_OPENERS = {"if_": "$IF", "while_": "$WHILE", "do_": "$DO", "for_": "$FOR", "switch": "$SWITCH"}
+
+
 class _Open:
     __slots__ = ("kind", "node", "body", "line", "extra")
 
@@ -1032,6 +1036,17 @@ class Parser:
         ch = t.children
         if line.number or line.label or line.comment:
             u.current.append(ir.Block(span, [], line.number, line.label, None, line.comment))
+        most = int(table().options.get("max_structure_nesting", limits.MAX_STRUCTURE_NESTING))
+        if d in _OPENERS and len(u.stack) >= most:
+            # past the limit: NC008, and the structure stays out of the IR (its blocks go to the
+            # enclosing body) so that no walker of the IR recurses deeper than the limit
+            kind = _OPENERS[d]
+            if len(u.stack) == most:            # once per excursion past the limit
+                self.error("NC008", f"{kind} nested {len(u.stack) + 1} deep: nesting too deep (at "
+                           f"most {most} control structures)", line.lineno, line.col)
+            u.stack.append(_Open(kind, ir.If(span, ir.Num(0.0), []), u.current, line.lineno,
+                                 (self.fresh("BRK"), self.fresh("CNT"), kind == "$SWITCH")))
+            return
         if d == "goto":
             u.current.append(ir.Block(span, [ir.Goto(_target(ch[0], low))]))
         elif d == "if_goto":
