@@ -36,6 +36,9 @@ MAX_STRUCTURE_NESTING = 16
 # Strings (Sinumerik STRING[n]; n at most 200 characters on the 840D): an undeclared string
 # (a concatenation result, a CHAR/STRING parameter) is capped at the same length.
 MAX_STRING = 200
+# Repeated execution (loop iterations, jumps back, calls) of one run before NC205 stops it;
+# straight-line blocks run the first time are free. NCTRANS_MAX_STEPS overrides it.
+MAX_STEPS = 2_000_000
 # Elements of one declared array (DEF REAL A[n,m]): REP() and SET() walk them all.
 MAX_ARRAY_ELEMENTS = 1_000_000
 

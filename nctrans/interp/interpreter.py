@@ -153,7 +153,10 @@ def _default_cutting_edge(dialect) -> int:
 
 class Interpreter(LatheMixin, RunChecks):
     def __init__(self, program: n.Program, machine=None, *, diagnostics: list, resolver=None,
-                 max_steps: int = 2_000_000, flatten_hook=None, preload=(), fast_sink=None):
+                 max_steps: Optional[int] = None, flatten_hook=None, preload=(), fast_sink=None):
+        if max_steps is None:
+            from nctrans import limits
+            max_steps = limits.setting("MAX_STEPS", limits.MAX_STEPS)
         if machine is None:
             from nctrans.machine import default_mill
             machine = default_mill()
@@ -2320,7 +2323,7 @@ class Interpreter(LatheMixin, RunChecks):
 
 
 def interpret(program: n.Program, machine=None, *, diagnostics: list, resolver=None,
-              max_steps: int = 2_000_000, flatten_hook=None, preload=(),
+              max_steps: Optional[int] = None, flatten_hook=None, preload=(),
               fast_sink: Optional[str] = None) -> Iterator[ToolpathRecord]:
     """Run `program` and yield its canonical motions one by one (see the module docstring).
     preload: programs whose declarations (VarDecl) run first as global variables, such as the
