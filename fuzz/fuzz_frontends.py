@@ -18,7 +18,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 CRASHES = ROOT / "tests" / "data" / "fuzz-crashes"
 CORPUS = ROOT.parent / "shared" / "corpus"
-SEEDS = {"iso-m": "iso-mill", "sinumerik": "sinumerik"}
+# Seed programs of each front end: the shared corpus where it has the dialect, else the repository's.
+SEEDS = {"iso-m": CORPUS / "iso-mill", "iso-t": CORPUS / "iso-turn", "sinumerik": CORPUS / "sinumerik",
+         "fagor": ROOT / "corpus" / "fagor"}
+RUNS_PER_DIALECT = 5        # fuzzing restarts after each crash kept, at most this often
 
 
 def one_input(dialect: str, data: bytes) -> None:
@@ -66,10 +69,11 @@ def main() -> int:
     seconds = int(sys.argv[1]) if len(sys.argv) > 1 else 60
     status = 0
     for dialect, sub in SEEDS.items():
+        runs = 0
         with tempfile.TemporaryDirectory() as work:
             seeds = Path(work) / "seeds"
             seeds.mkdir()
-            for p in sorted((CORPUS / sub).glob("*"))[:60]:     # heads: short seeds mutate fast
+            for p in sorted(sub.glob("*"))[:60]:     # heads: short seeds mutate fast
                 (seeds / p.name).write_bytes(p.read_bytes()[:4096])
             # each dialect in its own process: libFuzzer stops at the first crash, the loop goes on
             while True:
@@ -81,7 +85,8 @@ def main() -> int:
                     if art.is_file() and art.name.split("-")[0] in ("crash", "timeout", "oom"):
                         print(f"kept {keep(dialect, art.read_bytes())} ({art.name})", flush=True)
                         art.unlink()
-                if r.returncode == 0:
+                runs += 1
+                if r.returncode == 0 or runs >= RUNS_PER_DIALECT:
                     break
                 status = 1                      # a crash was kept; fuzz on from the seeds
                 seconds = max(10, seconds // 2)
