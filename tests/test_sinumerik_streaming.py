@@ -96,11 +96,26 @@ def test_cam_program_streams_through_the_kernel():
 
 def test_lint_streamed_matches_full_parse():
     text = ("%_N_PART_MPF\n;$PATH=/_N_MPF_DIR\nG71 G17 G90\nT1 M6 ; tool\nD1\nS1000 M3\n"
-            "G0 X0 Y0 Z5\nG1 Z-1 F100\nX10\nY10\nX0\nG2 X10 Y0 I5 J-5\nG1 G41 X5\nM30\nG1 X99\n")
+            "G0 X0 Y0 Z5\nG1 Z-1 F100\nX10\nY10\nX0\nG2 X10 Y0 I5 J-5\nG1 G41 X5\nM30\nG1 X99\nX98\n")
     assert streamable(text)
     full = run(text, stream=False, lint=True)
     assert run(text, stream=True, lint=True)[1] == full[1]
     assert run(text, stream=True, kernel=False, lint=True)[1] == full[1]
+
+
+def test_lint_report_streamed_matches_full_parse():
+    """What `nctrans lint` reports (with the IR analyses; NC112 after M30 comes from them for a
+    whole program and from watching the stream go by for a streamed one): the same words."""
+    from nctrans import linting
+    text = "G0 X0 Y0\nG1 X10 F100\nM30\nG1 X99\nX98\n"
+    reports = []
+    for stream in (False, True):
+        ld = pipeline.load_source(source.decode(text.encode(), "t.mpf"), "t.mpf", "sinumerik", stream=stream)
+        assert (ld.streamed is not None) == stream
+        reports.append([(d.rule, d.line, d.message) for d in linting.lint_loaded(ld)])
+    assert reports[0] == reports[1]
+    assert reports[0] == [("NC112", 4, "never runs: 2 block(s) after the program end at line 3, "
+                                       "and no jump reaches them")]
 
 
 def test_streamed_program_starts_from_the_power_on_modes():

@@ -292,6 +292,7 @@ class _Tail:
     def __init__(self, body):
         self.first = None
         self.count = 0
+        self.end_line = 0
         self._gen = self._watch(iter(body))
 
     def _watch(self, items):
@@ -300,6 +301,7 @@ class _Tail:
             if b.__class__ is block_type:
                 for st in b.body:
                     if st.__class__ is end_type and st.kind in ("end", "end_rewind"):
+                        self.end_line = b.span.line
                         yield b
                         break
                 else:
@@ -328,8 +330,9 @@ class _Tail:
     def report(self, label: str) -> list[Diagnostic]:
         if self.first is None:
             return []
-        return [at_span("NC112", "warning", f"never runs: {self.count} block(s) after the program end",
-                        self.first)]
+        # the full parse's wording (unreachable): a streamed program has no jumps
+        return [at_span("NC112", "warning", f"never runs: {self.count} block(s) after the program end "
+                        f"at line {self.end_line}, and no jump reaches them", self.first)]
 
 
 def _watch_tail(ld: pipeline.Loaded) -> Optional[_Tail]:
