@@ -23,7 +23,7 @@ run: $(STAMP)
 	@echo "backplot viewer: $(CURDIR)/out/sample-backplot.html"
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider --basetemp=$(CURDIR)/.pytest-tmp
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider --basetemp=$(CURDIR)/.pytest-tmp
 
 # compileall: an editable install writes no bytecode, and where PYTHONDONTWRITEBYTECODE is set no
 # run does either; every CLI run would then compile the package again (~70 ms of start-up).

@@ -20,6 +20,9 @@ import pytest
 
 from conftest import CORPUS
 
+# One xdist worker runs this module (make test passes --dist loadgroup), so the wheel is built once.
+pytestmark = pytest.mark.xdist_group("wheel")
+
 ROOT = Path(__file__).resolve().parents[1]
 DATA_DIRS = ("rules", "grammars", "backplot")
 
@@ -42,7 +45,12 @@ def installed(outside):
     """(venv bin directory, wheel path, clean environment) with nctrans installed from its wheel."""
     base = outside
     dist = base / "dist"
-    build = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(dist), str(ROOT)], cwd=base)
+    # Built from a copy: pip builds in the source tree's build/ folder, which a concurrent or an
+    # interrupted build in the checkout would leave half-written.
+    source = base / "source"
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(
+        ".git", ".venv", ".pytest-tmp", "build", "dist", "out", "*.egg-info", "__pycache__", "*.so"))
+    build = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(dist), str(source)], cwd=base)
     assert build.returncode == 0, build.stderr
     (wheel,) = dist.glob("nctrans-*.whl")
     venv = base / "venv"
