@@ -15,8 +15,10 @@ from nctrans.interp.evaluate import UNKNOWN
 
 
 def index_reader(dialect: str, groups: dict, spelt: dict,
-                 unmodelled_motion: Callable[[], Optional[str]]) -> Optional[Callable[[tuple], Any]]:
-    """A reader of `$P_GG[n]` over the live modal `groups` (neutral group -> value), `spelt`
+                 unmodelled_motion: Callable[[], Optional[str]]
+                 ) -> Optional[tuple[str, Callable[[tuple], Any]]]:
+    """(the variable's spelling, a reader of it) for the dialect's G-group index variable
+    (Sinumerik `$P_GG[n]`, named by options.g_group_index_variable) over the live modal `groups` (neutral group -> value), `spelt`
     (neutral group -> the code spelt last) and `unmodelled_motion()` (the motion code in force that
     the interpreter does not model, such as G331, or None), or None when the dialect has no index
     table."""
@@ -26,7 +28,8 @@ def index_reader(dialect: str, groups: dict, spelt: dict,
     except Exception:            # no table for this dialect
         return None
     lists = table.options.get("g_group_index")
-    if not isinstance(lists, dict):
+    variable = table.options.get("g_group_index_variable")
+    if not isinstance(lists, dict) or not variable:
         return None
     # per G group: [(code, neutral group, neutral value)] in index order (None: not in the table)
     meaning: dict[int, list] = {}
@@ -63,4 +66,4 @@ def index_reader(dialect: str, groups: dict, spelt: dict,
             if first is None:
                 first = float(i)
         return UNKNOWN if first is None else first
-    return read
+    return str(variable), read

@@ -1945,7 +1945,8 @@ class Interpreter(LatheMixin, RunChecks):
         gg = ggroups.index_reader(self.program.dialect, st.groups, self.spelt_codes,
                                   lambda: self.unmodelled_motion)
         if gg is not None:
-            self.ev.indexed_system["$P_GG"] = gg
+            variable, reader = gg
+            self.ev.indexed_system[variable.upper()] = reader
 
     # ================================================================ the loop
     def run(self) -> Iterator[ToolpathRecord]:
