@@ -83,3 +83,11 @@ def test_converting_sinumerik_g33_to_iso_writes_the_lead_as_f_and_restores_the_f
                          "sinumerik", "iso-m")
     lines = conv.text.splitlines()
     assert "G33 Z-10. F1.5" in lines and "G1 F100. X5." in lines
+
+
+def test_m29_rigid_tap_mode_has_no_motion_effect_and_the_tap_keeps_its_lead():
+    # Fusion 360 / Haas rigid tapping: M29 S500 then G84 F750 -> lead 750/500 = 1.5
+    text = "G21 G17 G90 G94 G0 X0 Y0 Z20 S500 M3\nM29 S500\nG99 G84 X5 Y5 Z-8 R2 F750\nG80\nM30\n"
+    recs, diags = run(text, "iso-m")
+    assert not [d for d in diags if d.severity in ("error", "warning")]
+    assert feeds(recs) == [(5.0, -8.0, 750.0, 1.5), (5.0, 2.0, 750.0, 1.5)]

@@ -356,9 +356,17 @@ class CycleSignature:
 class HolePattern:
     __pydantic_config__ = {"extra": "forbid"}
     name: str
-    shape: Literal["row", "circle"]
+    shape: Literal["row", "circle", "grid"]
     params: list[str]
     meaning: str = ""
+
+
+@dataclass
+class UnmodelledCycle:
+    __pydantic_config__ = {"extra": "forbid"}
+    name: str
+    meaning: str
+    moves: bool = True           # False: a settings cycle with no effect on the programmed path
 
 
 @dataclass
@@ -388,6 +396,7 @@ class CycleTable:
     swivel_mode: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "axis"}))
     swivel_retract: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "none"}))
     positioning: dict[str, Literal["clear_level", "current"]] = field(default_factory=dict)
+    unmodelled: list[UnmodelledCycle] = field(default_factory=list)
     metric_coarse_pitch: dict[str, float] = field(default_factory=dict)
 
     @classmethod
@@ -402,6 +411,7 @@ class CycleTable:
                    swivel_mode=SwivelModes(**d["swivel_mode"]),
                    swivel_retract=SwivelModes(**d["swivel_retract"]),
                    positioning=dict(d.get("positioning", {})),
+                   unmodelled=[UnmodelledCycle(**u) for u in d.get("unmodelled", [])],
                    metric_coarse_pitch=dict(d.get("metric_coarse_pitch", {})))
 
     def position_at(self, dialect: str) -> str:
@@ -417,6 +427,14 @@ class CycleTable:
 def cycle_table() -> CycleTable:
     """rules/cycles.toml, validated by pydantic (once per content: see nctrans.tables)."""
     return tables.load(RULES_DIR / "cycles.toml", CycleTable, CycleTable.from_data)
+
+
+def unmodelled_cycle(name: str) -> Optional[UnmodelledCycle]:
+    """A standard cycle nctrans knows by name but does not model ([[unmodelled]]), or None."""
+    for u in cycle_table().unmodelled:
+        if u.name == name.upper():
+            return u
+    return None
 
 
 def named_cycles() -> dict[str, CycleSignature]:
@@ -466,16 +484,34 @@ def hole_pattern(name: str, args: Sequence[float | None]) -> list[tuple[float, f
         return []
     v = {p: (float(a) if a is not None else 0.0) for p, a in zip(pat.params, args)}
     v.update({p: 0.0 for p in pat.params if p not in v})
-    num = int(v["NUM"])
+    num = int(v["NUM"]) if "NUM" in v else int(v["NUM1"]) * int(v["NUM2"])
     if num < 1 or num > MAX_PECKS:
         return []
     if pat.shape == "row":
         ang = math.radians(v["STA1"])
         return [(v["SPCA"] + (v["FDIS"] + i * v["DBH"]) * math.cos(ang),
                  v["SPCO"] + (v["FDIS"] + i * v["DBH"]) * math.sin(ang)) for i in range(num)]
+    if pat.shape == "grid":
+        return grid_positions(v)
     inda = v["INDA"] if v["INDA"] else 360.0 / num
     return [(v["CPA"] + v["RAD"] * math.cos(math.radians(v["STA1"] + i * inda)),
              v["CPO"] + v["RAD"] * math.sin(math.radians(v["STA1"] + i * inda))) for i in range(num)]
+
+
+def grid_positions(v: dict[str, float]) -> list[tuple[float, float]]:
+    """CYCLE801 [GK, Siemens cycles manual]: NUM2 rows of NUM1 holes from the reference point
+    (SPCA, SPCO); columns DIS1 apart along the direction STA (degrees from the abscissa), rows
+    DIS2 apart at right angles to it; drilled in a meander (every other row backwards)."""
+    ang = math.radians(v["STA"])
+    c, s = math.cos(ang), math.sin(ang)
+    n1, n2 = int(v["NUM1"]), int(v["NUM2"])
+    out = []
+    for j in range(n2):
+        for k in range(n1):
+            i = n1 - 1 - k if j % 2 else k
+            x, y = i * v["DIS1"], j * v["DIS2"]
+            out.append((v["SPCA"] + x * c - y * s, v["SPCO"] + x * s + y * c))
+    return out
 
 
 # ---------------------------------------------------------------------------------------------

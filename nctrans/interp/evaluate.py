@@ -307,6 +307,7 @@ class Evaluator:
         # system variables by spelling (a name, or an int for a numbered one): filled from `meanings`
         # through the rules tables (rules.system_meaning) on first read, and by writes
         self.global_lengths: dict[str, int] = {}   # declared STRING[n] lengths of global_names
+        self.limits: dict[str, tuple] = {}         # declared LLI/ULI of names (lower, upper)
         self.system: dict[Any, Callable[[], Any]] = {}
         # indexed system variables read with their subscripts ($P_GG[n]), by spelling
         self.indexed_system: dict[str, Callable[[tuple], Any]] = {}
@@ -748,9 +749,25 @@ class Evaluator:
                         arr.data[key] = v
             store[name] = arr
         else:
+            if decl.limits:
+                self.limits[name] = tuple(decl.limits)
+                if inits:
+                    self._check_limits(name, inits[0])
+            else:
+                self.limits.pop(name, None)
             store[name] = inits[0] if inits else default
             if inits and typ == "STRING":
                 self._cap_string(store, lengths, name, store[name])
+
+    def _check_limits(self, name: str, value: Any) -> None:
+        """A value outside a name's declared LLI/ULI is refused as the control refuses it (an
+        alarm): NC223, and the variable keeps its value."""
+        lo, hi = self.limits[name]
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and (
+                (lo is not None and value < lo) or (hi is not None and value > hi)):
+            raise EvalError("NC223", f"{value:g} assigned to {name} is outside its declared limits "
+                            f"(LLI {'-' if lo is None else f'{lo:g}'}, ULI "
+                            f"{'-' if hi is None else f'{hi:g}'}); the value is not taken")
 
     @staticmethod
     def _cap_string(store: dict, lengths: dict, name: str, value: Any) -> None:
@@ -855,6 +872,8 @@ class Evaluator:
                         raise EvalError("NC104", f"array {name} assigned without an index")
                     cur.set(self._indices(fns), v)
                 else:
+                    if name in self.limits:
+                        self._check_limits(name, v)
                     store[name] = v
                     if type(v) is str and len(v) > 0:
                         lengths = (self.global_lengths if store is self.global_names

@@ -53,7 +53,7 @@ from nctrans.toolpath_io import _spell, _str as _json_str    # the kernel writes
 
 from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
 from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, expand_cycle, hole_pattern,
-                                   plane_cycle_levels, swivel_plan, tap_steps)
+                                   plane_cycle_levels, swivel_plan, tap_steps, unmodelled_cycle)
 
 BLOCK, JUMP, JFALSE, EXEC, CASE, PLAIN = range(6)
 SHARED_SCOPE_CALLS = frozenset(("m98", "shared"))
@@ -216,6 +216,7 @@ class Interpreter(LatheMixin, RunChecks):
         self.spelt_codes: dict[str, str] = {}   # neutral group -> the code spelt last ($P_GG)
         self.stack: list[Frame] = []
         self.sections = 0               # REPEAT section frames on the stack (not call levels)
+        self.in_modal = 0               # frames of the modal subprogram (MCALL/G66) on the stack
         self.span: Optional[n.Span] = None
         self._rc_init()                 # run_checks: NC210-NC214
         self._register_system()
@@ -1479,9 +1480,8 @@ class Interpreter(LatheMixin, RunChecks):
             return self._turning_cycle(s)
         if s.name and s.kind != "swivel_plane" and self._find_unit(s.name) is not None:
             return self._cycle_code(s)
-        if s.kind in ("holes_line", "holes_circle"):
-            self._hole_pattern(s)
-            return
+        if s.kind in ("holes_line", "holes_circle", "holes_grid"):
+            return self._hole_pattern(s)
         if s.kind == "swivel_plane":
             self._swivel_plane(s)
             return
@@ -1506,9 +1506,11 @@ class Interpreter(LatheMixin, RunChecks):
             return None
         return ("call", n.SubCall(s.name, args, kind="proc"))
 
-    def _hole_pattern(self, s: n.CycleCall) -> None:
-        """Sinumerik HOLES1/HOLES2: the modally called cycle at each position of the pattern
-        (only positioning when no cycle is modal)."""
+    def _hole_pattern(self, s: n.CycleCall):
+        """Sinumerik HOLES1/HOLES2/CYCLE801: the modally called cycle at each position of the
+        pattern (only positioning when no cycle is modal). Under a modal subprogram call (MCALL
+        of a PROC, such as a CYCLE81.SPF beside the program) the positions run as blocks of
+        their own, so the call follows each of them as it follows any block that moves."""
         pat = {p.name: p for p in cycle_table().pattern}.get((s.name or "").upper())
         if pat is None:
             self.diag("NC103", "warning", f"hole pattern {s.name or s.kind} is not known")
@@ -1519,13 +1521,27 @@ class Interpreter(LatheMixin, RunChecks):
             args.append(None if e is None else self._value(self.ev.compile(e), p))
         a1, a2, _ = PLANE_AXES[self.st.plane]
         sc = self.st.scale
-        for p1, p2 in hole_pattern(pat.name, args):
+        holes = hole_pattern(pat.name, args)
+        if self.modal_call is not None and self.modal_cycle is None and holes:
+            positions = Unit(pat.name, self.span.file if self.span else "", [])
+            positions.code = [(BLOCK, [(self._h_pattern_position, (a1, a2, p1 * sc, p2 * sc))],
+                               None, self.span) for p1, p2 in holes]
+            positions.seen = bytearray(b"\x01" * len(holes))
+            return ("pattern", positions)
+        for p1, p2 in holes:
             hole = dict(self.pos)
             hole[a1], hole[a2] = p1 * sc, p2 * sc
+            self._move("rapid", hole)        # the pattern's positioning block, even when there
             if self.modal_cycle is not None:
-                self._run_cycle_call(self.modal_cycle, hole)
-            else:
-                self._move("rapid", hole)
+                self._run_cycle_call(self.modal_cycle)
+
+    def _h_pattern_position(self, d) -> None:
+        """One position of a hole pattern under a modal subprogram call: a rapid in the plane."""
+        a1, a2, p1, p2 = d
+        hole = dict(self.pos)
+        hole[a1], hole[a2] = p1, p2
+        self.moved = True
+        self._move("rapid", hole)            # a positioning block, even when already there
 
     def _run_cycle_call(self, s: n.CycleCall, hole: Optional[dict] = None) -> None:
         st = self.st
@@ -2034,8 +2050,7 @@ class Interpreter(LatheMixin, RunChecks):
                     if ctl is None:
                         sidx = 0
                         pc += 1
-                        if self.moved and self.modal_call is not None and \
-                                len(self.stack) - self.sections <= self.modal_call[2]:
+                        if self.moved and self.modal_call is not None and not self.in_modal:
                             ctl = ("modal_call",)
                     if ctl is not None:
                         unit, code, pc, sidx = self._control(ctl, unit, pc, sidx)
@@ -2232,6 +2247,15 @@ class Interpreter(LatheMixin, RunChecks):
                 s, args, _ = self.modal_call
             callee = self._find_unit(s.name)
             if callee is None:
+                what = unmodelled_cycle(s.name)
+                if what is not None and not what.moves:
+                    return unit, unit.code, pc, sidx      # settings only (CYCLE832): no path effect
+                if what is not None:
+                    self.diag("NC103", "warning", f"{s.name} ({what.meaning}) is a standard "
+                              f"cycle nctrans does not model, and no {s.name} PROC was found "
+                              "beside the program or on the search path: the call is skipped and "
+                              "moves nothing in the analysed toolpath")
+                    return unit, unit.code, pc, sidx
                 self.diag("NC103", "warning", f"subprogram {s.name} not found; the call is skipped")
                 return unit, unit.code, pc, sidx
             if len(self.stack) >= MAX_CALL_DEPTH:
@@ -2252,10 +2276,17 @@ class Interpreter(LatheMixin, RunChecks):
                 return unit, unit.code, pc, sidx
             make = self._make_scope(s, callee, args)
             saved = self._save_state() if callee.save else None
+            modal = kind == "modal_call"
             self.stack.append(Frame(unit, pc, sidx, self.ev.scope, callee, rep - 1, make,
-                                    saved=saved))
+                                    modal=modal, saved=saved))
+            self.in_modal += modal
             self.ev.scope = make()
             return callee, callee.code, 0, 0
+        if kind == "pattern":
+            scope = self.ev.scope
+            self.stack.append(Frame(unit, pc, sidx, scope, ctl[1], 0, lambda: scope, section=True))
+            self.sections += 1
+            return ctl[1], ctl[1].code, 0, 0
         return unit, unit.code, pc, sidx
 
     def _return(self, to_label):
@@ -2265,8 +2296,11 @@ class Interpreter(LatheMixin, RunChecks):
             self.ev.scope = fr.make_scope()
             return fr.callee, fr.callee.code, 0, 0
         self.stack.pop()
+        self.moved = False       # the caller's block resumes after the call: no motion of its own
         if fr.section:
             self.sections -= 1
+        if fr.modal:
+            self.in_modal -= 1
         self.ev.scope = fr.scope
         if fr.saved is not None:
             self._restore_state(fr.saved)

@@ -315,13 +315,15 @@ class Assign:
 
 @node
 class VarDecl:
-    """Sinumerik DEF: type in {INT, REAL, BOOL, CHAR, STRING, AXIS, FRAME}; dims for arrays."""
+    """Sinumerik DEF: type in {INT, REAL, BOOL, CHAR, STRING, AXIS, FRAME}; dims for arrays.
+    limits: the declared lower and upper limit (Sinumerik LLI / ULI; None where not given)."""
     name: str
     type: str
     dims: list[int] = field(default_factory=list)
     init: Optional[list[Expr]] = None
     length: Optional[int] = None
     scope: str = "local"
+    limits: Optional[list[Optional[float]]] = None
 
 
 @node

@@ -531,7 +531,7 @@ class Emitter:
         name = c.name if c.name in entries else next(
             (x.name for x in t.cycle if x.kind == c.kind), None)
         if name is None:
-            name = {"holes_line": "HOLES1", "holes_circle": "HOLES2",
+            name = {"holes_line": "HOLES1", "holes_circle": "HOLES2", "holes_grid": "CYCLE801",
                     "swivel_plane": "CYCLE800"}.get(c.kind)
         if name is None:
             self.refuse(f"cycle kind {c.kind!r} has no Sinumerik standard cycle")
@@ -685,6 +685,9 @@ class Emitter:
         d0 = ds[0]
         scope = "" if d0.scope in ("local", "", None) else d0.scope.upper() + " "
         typ = d0.type + (f"[{d0.length}]" if d0.length is not None else "")
+        for word, v in zip(("LLI", "ULI"), d0.limits or ()):
+            if v is not None:
+                typ += f" {word} {v:g}"
         parts = []
         for d in ds:
             s = d.name
@@ -713,8 +716,8 @@ class Emitter:
         line = _Line(only=len(rest) == 1, join=self.p.dialect == DIALECT)
         groups: list[list] = []
         for d in decls:
-            if groups and (groups[-1][0].type, groups[-1][0].length, groups[-1][0].scope) == (
-                    d.type, d.length, d.scope):
+            if groups and (groups[-1][0].type, groups[-1][0].length, groups[-1][0].scope,
+                           groups[-1][0].limits) == (d.type, d.length, d.scope, d.limits):
                 groups[-1].append(d)
             else:
                 groups.append([d])

@@ -86,7 +86,7 @@ def _cycles():
         out[c.name] = (c.kind, [t.neutral(p) for p in c.params], c.kind_by and (
             t.neutral(c.kind_by.param), c.kind_by.values))
     for p in t.pattern:
-        out[p.name] = ("holes_line" if p.shape == "row" else "holes_circle",
+        out[p.name] = ({"row": "holes_line", "grid": "holes_grid"}.get(p.shape, "holes_circle"),
                        [t.neutral(x) for x in p.params], None)
     for c in t.swivel:                   # CYCLE800 swivel plane: a frame change, not a hole
         out[c.name] = (c.kind, [t.neutral(x) for x in c.params], None)
@@ -632,7 +632,7 @@ class Lowerer:
             elif d == "goto_stmt":
                 w.out.append(_goto(ch[0], ch[1], None))
             elif d == "def_stmt":
-                w.out.extend(self.vardecls(st))
+                w.out.extend(self.vardecls(st, code))
             elif d == "extern_stmt":
                 w.out.append(ir.Passthrough(_t(text), "declaration", DIALECT))
                 self.meta.setdefault("externs", []).append(str(ch[1]))
@@ -696,8 +696,13 @@ class Lowerer:
             w.out.append(ir.Passthrough(f"{code} S", "spindle speed limit", DIALECT))
             w.speed = []
 
-    def vardecls(self, st: Tree) -> list:
+    def vardecls(self, st: Tree, code: str = "") -> list:
         ch = st.children
+        limits = None
+        found = {k.upper(): number_value(v) for k, v in _LIMIT.findall(code)}
+        if found:
+            # DEF CHAN INT LLI 0 ULI 4 NAME (spec 1.8): the limits of every name of the DEF
+            limits = [found.get("LLI"), found.get("ULI")]
         scope = "local"
         type_spec = None
         decls = []
@@ -728,10 +733,11 @@ class Lowerer:
                     init = [ir.Num(0.0, "0") if is_omitted(a) else a for a in v.args]
                 else:
                     init = [v]
-            out.append(ir.VarDecl(name, typ, dims, init, length, scope))
+            out.append(ir.VarDecl(name, typ, dims, init, length, scope, limits))
         return out
 
 
+_LIMIT = re.compile(r"\b(LLI|ULI)\s+([+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?)", re.IGNORECASE)
 _KW = {"if_stmt": "IF", "else_stmt": "ELSE", "endif_stmt": "ENDIF", "while_stmt": "WHILE",
        "endwhile_stmt": "ENDWHILE", "for_stmt": "FOR", "endfor_stmt": "ENDFOR", "loop_stmt": "LOOP",
        "endloop_stmt": "ENDLOOP", "repeat_stmt": "REPEAT", "until_stmt": "UNTIL", "case_stmt": "CASE",

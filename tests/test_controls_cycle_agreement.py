@@ -1,0 +1,263 @@
+"""Built-in cycle models against cycle code run by nctrans (issue 8, "Done when"): for each modelled
+Sinumerik drilling cycle and hole pattern, a program runs three ways and must give the same records
+move for move: with the built-in models only; with the drilling cycle's PROC beside it; and with the
+pattern's PROC beside it too. The Siemens cycle sources are not public in this project (the shared
+corpus holds no PROC CYCLE8x / HOLES / CYCLE801), so the PROCs below are written here in the
+Sinumerik language to do what the control's cycles do as the models understand it (the same
+[GK] sources); they exercise the interpreter on real cycle-style code (loops, IF, AX[..], $P_AXN,
+$P_F, SAVE) where the models are plain Python.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from nctrans import pipeline
+
+from test_controls_cycle_code import CYCLE81
+
+CYCLE82 = """PROC CYCLE82(REAL RTP, REAL RFP, REAL SDIS, REAL DP, REAL DPR, REAL DTB) SAVE
+DEF REAL _ZSD
+DEF AXIS _AX
+_AX=$P_AXN3
+_ZSD=DP
+IF DPR<>0
+  _ZSD=RFP-DPR
+ENDIF
+G0 AX[_AX]=RFP+SDIS
+G1 AX[_AX]=_ZSD
+G4 F=DTB
+G0 AX[_AX]=RTP
+RET
+"""
+
+CYCLE83 = """PROC CYCLE83(REAL RTP, REAL RFP, REAL SDIS, REAL DP, REAL DPR, REAL FDEP, REAL FDPR, REAL DAM, REAL DTB, REAL DTS, REAL FRF, INT VARI, INT _AXN, REAL _MDEP, REAL _VRT, REAL _DTD, REAL _DIS1) SAVE
+; deep-hole drilling downwards: first depth FDEP (absolute) or FDPR (relative), strokes less DAM
+; down to DAM; VARI=1 back to RFP+SDIS and down again to the anticipation distance above the last
+; depth, VARI=0 back by _VRT (1 mm)
+DEF REAL _ZSD, _Z, _STROKE, _LAST, _F, _ANT, _BACK, _TOT, _FAC, _D
+DEF INT _I
+DEF AXIS _AX
+_AX=$P_AXN3
+_F=$P_F
+_ZSD=DP
+IF DPR<>0
+  _ZSD=RFP-DPR
+ENDIF
+_TOT=RFP-_ZSD
+_D=ABS(DAM)
+IF FDPR<>0
+  _STROKE=ABS(FDPR)
+ELSE
+  _STROKE=RFP-FDEP
+ENDIF
+IF _STROKE<=0
+  _STROKE=_D
+  IF _STROKE==0
+    _STROKE=_TOT
+  ENDIF
+ENDIF
+_ANT=0.6
+IF _TOT>30
+  _ANT=MINVAL(_TOT/50, 7)
+ENDIF
+_BACK=1
+IF _VRT<>0
+  _BACK=ABS(_VRT)
+ENDIF
+_FAC=1
+IF (FRF>0) AND (FRF<=1)
+  _FAC=FRF
+ENDIF
+G0 AX[_AX]=RFP+SDIS
+_Z=RFP
+_I=0
+LOOP
+  IF _Z-_ZSD > _STROKE+0.000000001
+    _Z=_Z-_STROKE
+    IF _D>0
+      IF _STROKE-_D > _D
+        _STROKE=_STROKE-_D
+      ELSE
+        _STROKE=_D
+      ENDIF
+    ENDIF
+  ELSE
+    _Z=_ZSD
+  ENDIF
+  IF _I==0
+    G1 F=_F*_FAC AX[_AX]=_Z
+    F=_F
+  ELSE
+    IF VARI==1
+      G0 AX[_AX]=RFP+SDIS
+      IF DTS>0
+        G4 F=DTS
+      ENDIF
+      G0 AX[_AX]=_LAST+_ANT
+    ELSE
+      G1 AX[_AX]=_LAST+_BACK
+    ENDIF
+    G1 AX[_AX]=_Z
+  ENDIF
+  IF DTB>0
+    G4 F=DTB
+  ENDIF
+  _LAST=_Z
+  _I=_I+1
+  IF _Z==_ZSD GOTOF _OUT
+ENDLOOP
+_OUT:
+IF RTP>RFP+SDIS
+  G0 AX[_AX]=RTP
+ELSE
+  G0 AX[_AX]=RFP+SDIS
+ENDIF
+RET
+"""
+
+HOLES1 = """PROC HOLES1(REAL SPCA, REAL SPCO, REAL STA1, REAL FDIS, REAL DBH, INT NUM) SAVE
+DEF INT _I
+DEF REAL _D
+DEF AXIS _A1, _A2
+_A1=$P_AXN1
+_A2=$P_AXN2
+FOR _I=0 TO NUM-1
+  _D=FDIS+_I*DBH
+  G0 AX[_A1]=SPCA+_D*COS(STA1) AX[_A2]=SPCO+_D*SIN(STA1)
+ENDFOR
+RET
+"""
+
+HOLES2 = """PROC HOLES2(REAL CPA, REAL CPO, REAL RAD, REAL STA1, REAL INDA, INT NUM) SAVE
+DEF INT _I
+DEF REAL _STEP
+DEF AXIS _A1, _A2
+_A1=$P_AXN1
+_A2=$P_AXN2
+_STEP=INDA
+IF INDA==0
+  _STEP=360/NUM
+ENDIF
+FOR _I=0 TO NUM-1
+  G0 AX[_A1]=CPA+RAD*COS(STA1+_I*_STEP) AX[_A2]=CPO+RAD*SIN(STA1+_I*_STEP)
+ENDFOR
+RET
+"""
+
+CYCLE801 = """PROC CYCLE801(REAL SPCA, REAL SPCO, REAL STA, REAL DIS1, REAL DIS2, INT NUM1, INT NUM2) SAVE
+; grid: NUM2 rows of NUM1 holes, in a meander (every other row backwards)
+DEF INT _J, _K, _I
+DEF REAL _X, _Y
+DEF AXIS _A1, _A2
+_A1=$P_AXN1
+_A2=$P_AXN2
+FOR _J=0 TO NUM2-1
+  FOR _K=0 TO NUM1-1
+    _I=_K
+    IF _J MOD 2 == 1
+      _I=NUM1-1-_K
+    ENDIF
+    _X=_I*DIS1
+    _Y=_J*DIS2
+    G0 AX[_A1]=SPCA+_X*COS(STA)-_Y*SIN(STA) AX[_A2]=SPCO+_X*SIN(STA)+_Y*COS(STA)
+  ENDFOR
+ENDFOR
+RET
+"""
+
+SOURCES = {"CYCLE81": CYCLE81, "CYCLE82": CYCLE82, "CYCLE83": CYCLE83, "HOLES1": HOLES1,
+           "HOLES2": HOLES2, "CYCLE801": CYCLE801}
+START = "G17 G90 G0 X0 Y0 Z50 F100 S1000 M3\n"
+
+# name -> (program, drilling cycle, pattern or None)
+PROGRAMS = {
+    "81-positions": (START + "MCALL CYCLE81(10, 0, 2, -5)\nX10\nY10\nX20 Y5\nMCALL\nX0\nM30\n",
+                     "CYCLE81", None),
+    "82-dpr": (START + "CYCLE82(10, 1, 2, , 7, 0.5)\nM30\n", "CYCLE82", None),
+    "82-positions": (START + "MCALL CYCLE82(8, 0, 1, -4, , 1)\nX5 Y5\nG1 X15\nMCALL\nM30\n",
+                     "CYCLE82", None),
+    # VARI=0 chip breaking: FDEP -10, DAM 4: strokes 10, 6, 4, 4 then the rest to -30
+    "83-vari0": (START + "CYCLE83(10, 0, 2, -30, , -10, , 4, , , 1, 0)\nM30\n", "CYCLE83", None),
+    # VARI=1 swarf removal, FDPR 8, DAM 3, DTB and DTS, first feed factor 0.5, deep (>30)
+    "83-vari1": (START + "CYCLE83(10, 0, 2, , 40, , 8, 3, 0.5, 1, 0.5, 1)\nM30\n", "CYCLE83", None),
+    "83-vari1-vrt": (START + "MCALL CYCLE83(5, 0, 1, -12, , -4, , 2, , , 1, 0, , , 0.5)\nX10\n"
+                     "Y10\nMCALL\nM30\n", "CYCLE83", None),
+    "holes1": (START + "MCALL CYCLE81(10, 0, 2, -5)\nHOLES1(5, 5, 30, 10, 8, 4)\nMCALL\nM30\n",
+               "CYCLE81", "HOLES1"),
+    "holes2": (START + "MCALL CYCLE82(10, 0, 2, , 6, 0.2)\nHOLES2(50, 40, 25, 15, 0, 5)\nMCALL\n"
+               "M30\n", "CYCLE82", "HOLES2"),
+    "holes2-inda": (START + "MCALL CYCLE83(10, 0, 2, -20, , -6, , 3, , , 1, 1)\n"
+                    "HOLES2(0, 0, 30, 0, 45, 3)\nMCALL\nM30\n", "CYCLE83", "HOLES2"),
+    "cycle801": (START + "MCALL CYCLE81(10, 0, 2, -5)\nCYCLE801(10, 20, 0, 15, 12, 3, 3)\nMCALL\n"
+                 "M30\n", "CYCLE81", "CYCLE801"),
+    "cycle801-rotated": (START + "MCALL CYCLE82(10, 0, 2, , 3, 0.5)\nCYCLE801(0, 0, 30, 10, 10, 2, 4)"
+                         "\nMCALL\nM30\n", "CYCLE82", "CYCLE801"),
+    "pattern-no-mcall": (START + "CYCLE801(0, 0, 0, 5, 5, 2, 2)\nHOLES1(0, 0, 90, 0, 4, 3)\nM30\n",
+                         None, "CYCLE801"),
+}
+
+
+def records(where: Path, text: str):
+    path = where / "MAIN.MPF"
+    path.write_text(text)
+    ld = pipeline.load(str(path), "sinumerik")
+    recs = list(pipeline.toolpath_of(ld))
+    bad = [d.format_text() for d in ld.diagnostics if d.severity in ("error", "warning")]
+    out = []
+    for r in recs:
+        if r.kind in ("rapid", "linear", "arc"):
+            out.append((r.kind, {a: round(v, 6) for a, v in r.end.items()}, r.feed))
+        elif r.kind == "dwell":
+            out.append(("dwell", r.dwell_s))
+    return out, bad
+
+
+@pytest.mark.parametrize("name", sorted(PROGRAMS))
+def test_builtin_models_agree_with_cycle_code(tmp_path, name):
+    text, cycle, pattern = PROGRAMS[name]
+    runs = {}
+    for how, files in (("builtin", ()), ("cycle", (cycle,)), ("cycle+pattern", (cycle, pattern))):
+        d = tmp_path / how
+        d.mkdir()
+        for f in files:
+            if f is not None:
+                (d / f"{f}.SPF").write_text(SOURCES[f])
+        runs[how] = records(d, text)
+    want, bad = runs["builtin"]
+    assert bad == [] and len(want) > 3
+    for how in ("cycle", "cycle+pattern"):
+        got, bad = runs[how]
+        assert bad == [], (how, bad)
+        assert got == want, how
+
+
+def test_cycle83_vari0_strokes_by_hand(tmp_path):
+    # RFP 0, SDIS 2, FDEP -10, DAM 4, DP -30: depths -10, -16 (6), -20 (4), -24, -28, -30;
+    # chip breaking goes back 1 mm with G1 between strokes
+    got, bad = records(tmp_path, PROGRAMS["83-vari0"][0])
+    assert bad == []
+    z = [m[1]["Z"] for m in got if m[0] != "dwell"][1:]
+    assert z == [2, -10, -9, -16, -15, -20, -19, -24, -23, -28, -27, -30, 10]
+
+
+def test_cycle801_meander_by_hand(tmp_path):
+    # 3 x 3 grid at (10, 20), columns 15 apart, rows 12 apart: rows alternate direction
+    got, _ = records(tmp_path, PROGRAMS["cycle801"][0])
+    bottoms = [(m[1]["X"], m[1]["Y"]) for m in got if m[0] == "linear"]
+    assert bottoms == [(10, 20), (25, 20), (40, 20), (40, 32), (25, 32), (10, 32),
+                       (10, 44), (25, 44), (40, 44)]
+
+
+def test_modal_call_follows_moves_in_called_subprograms_not_in_itself(tmp_path):
+    # seed L5053-5057: MCALL L70 then L80, whose blocks move: L70 is called after each of them.
+    # L70 itself moves (Z-1, back with G0) without calling itself again.
+    (tmp_path / "L70.SPF").write_text("G91 G1 Z-1 F50\nG0 Z1\nG90\nM17\n")
+    (tmp_path / "L80.SPF").write_text("G0 X10 Y10\nX20\nM17\n")
+    (tmp_path / "MAIN.MPF").write_text("G17 G90 G0 X0 Y0 Z5\nMCALL L70\nL80\nMCALL\nX0\nM30\n")
+    got, bad = records(tmp_path, (tmp_path / "MAIN.MPF").read_text())
+    assert bad == []
+    assert [(m[0], m[1]["X"], m[1]["Z"]) for m in got] == [
+        ("rapid", 0, 5), ("rapid", 10, 5), ("linear", 10, 4), ("rapid", 10, 5),
+        ("rapid", 20, 5), ("linear", 20, 4), ("rapid", 20, 5), ("rapid", 0, 5)]
