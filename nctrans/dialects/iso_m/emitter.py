@@ -601,7 +601,10 @@ class IsoEmitter:
         lines: list[_Line] = [_Line()]
         for s in body:
             try:
-                words = getattr(self, "w_" + type(s).__name__)(s)
+                write = getattr(self, "w_" + type(s).__name__, None)
+                if write is None:           # a statement this emitter has no spelling for: say so
+                    raise NotExpressible(f"the statement {type(s).__name__}")
+                words = write(s)
             except NotExpressible as err:
                 self.refuse(f"{type(s).__name__}: {err}")
                 continue
