@@ -32,6 +32,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/bench.py
 	$(BIN)/python bench/bench_check.py
 	$(BIN)/python bench/bench_backplot.py
+	$(BIN)/python bench/bench_structure.py
 
 # FUZZ_SECONDS: coverage-guided (atheris) time per front end; crashes are kept as regression cases
 # under tests/data/fuzz-crashes (run by tests/test_fuzz_crashes.py in `make test`).

@@ -259,7 +259,8 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                 result = _transpile_flat_stream(ld, target, strict, out, flat_machine)
             if result is None:
                 result = convert(program, target, flatten=flatten, strict_mode=strict,
-                                 flatten_with=flatten_with)
+                                 flatten_with=flatten_with, machine=flat_machine,
+                                 resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
             diags.extend(result.diagnostics)
             out_text = result.text
         elif strict:

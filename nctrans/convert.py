@@ -2,13 +2,15 @@
 
 The policy, in one place (sqlglot's "unsupported level"):
 - the target emitter first writes the program structurally (loops, variables, calls and cycles kept
-  where the target has them), recording NC401 for each construct it lowered on the way;
-- when the emitter cannot express something (NC402), the whole program is lowered to plain motion
-  (`nctrans.lower.flatten`: loops unrolled, calls and cycles expanded, expressions evaluated, frames
-  folded) and emitted again; each refusal becomes an NC401 info naming the construct and its line,
-  so nothing is dropped silently and the output still drives the same toolpath;
-- what even plain motion cannot carry (an unresolved call, a synchronized action ...) stays an NC402
-  error and the conversion is refused;
+  where the target has them), recording NC401 for each construct it lowered on the way, and NC404
+  for each call it keeps of a subprogram that is not there (the target control must provide it);
+- when the emitter cannot express a construct (NC402), that construct alone (its block, its loop or
+  branch, its modal cycle with the blocks it runs at) is lowered to plain motion
+  (`nctrans.lower.constructs`), the rest keeps its structure, and the program is emitted again; each
+  refusal becomes an NC401 info naming the construct, its line and the lines lowered;
+- what cannot be lowered on its own (inside a subprogram, jumped into, setting variables the rest
+  reads, or holding what plain motion cannot carry) stays an NC402 error saying why, and the
+  conversion is refused; `--flatten` lowers the whole program instead;
 - `strict` turns every lowering into an error.
 """
 from __future__ import annotations
@@ -19,6 +21,12 @@ from typing import Callable, Iterable, Optional
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import Dialect
 from nctrans.ir.nodes import Block, Program
+
+
+# Words of the NC401 messages that tell the two kinds of lowering to plain motion apart (the
+# structural-share benchmark counts them).
+WHOLE_PROGRAM_NOTE = "the program was lowered to plain motion"
+CONSTRUCT_NOTE = "lowered to plain motion here"
 
 
 @dataclass
@@ -32,12 +40,6 @@ class Conversion:
 
 def _is_refusal(d: Diagnostic) -> bool:
     return d.rule == "NC402" and d.severity == "error"
-
-
-def _as_lowering(d: Diagnostic, target: str) -> Diagnostic:
-    return Diagnostic("NC401", "info",
-                      f"{d.message} — {target} cannot express it, so the program was lowered to plain "
-                      f"motion (as with --flatten)", d.file, d.line, d.column, d.end_line, d.end_column)
 
 
 def _library_entry(program: Program) -> Optional[str]:
@@ -82,9 +84,12 @@ def strict(diags: list[Diagnostic]) -> list[Diagnostic]:
 
 
 def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callable[[list], Program]],
-            flatten: bool = False, strict_mode: bool = False) -> Conversion:
+            flatten: bool = False, strict_mode: bool = False, machine=None,
+            resolver: Optional[Callable] = None) -> Conversion:
     """Emit `program` in `target`. `flatten_with(diagnostics) -> Program` lowers it to plain motion
-    (it closes over the machine and the subprogram resolver); None when lowering is unavailable."""
+    (it closes over the machine and the subprogram resolver); None when lowering is unavailable
+    (single constructs are then not lowered either). `machine` and `resolver` serve the run that
+    lowers single constructs."""
     diags: list[Diagnostic] = []
     flattened = False
     library = _library_entry(program)
@@ -100,14 +105,24 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
         diags.extend(result.diagnostics)
         diags.append(_library_refusal(program, library, target.name))
     elif refusals and not flattened and flatten_with is not None and not strict_mode:
-        lowered = [_as_lowering(d, target.name) for d in refusals]
-        flat_diags: list[Diagnostic] = []
-        flat = lower_for(flatten_with(flat_diags), target, flat_diags)
-        again = target.emit(flat)
-        diags.extend(lowered)
-        diags.extend(flat_diags)
-        diags.extend(again.diagnostics)
-        result, flattened = again, True
+        from nctrans.lower.constructs import lower_constructs
+        lowered, notes, remaining = lower_constructs(program, refusals, target.name, machine=machine,
+                                                     resolver=resolver)
+        others = [d for d in result.diagnostics if not _is_refusal(d)]
+        if lowered is not None:
+            again = target.emit(lowered)
+            kept = {(d.file, d.line) for d in remaining}
+            # the second emission repeats the first one's notes; its refusals are the ones left
+            diags.extend(others)
+            diags.extend(notes)
+            diags.extend(remaining)
+            diags.extend(d for d in again.diagnostics
+                         if _is_refusal(d) and (d.file, d.line) not in kept)
+            result = again
+        else:
+            diags.extend(others)
+            diags.extend(notes)
+            diags.extend(remaining)
     else:
         diags.extend(result.diagnostics)
     if strict_mode:

@@ -3,7 +3,7 @@ refusal only when even plain motion cannot carry it; --strict refuses every lowe
 from pathlib import Path
 
 from nctrans import equivalence as equiv
-from nctrans.convert import convert
+from nctrans.convert import CONSTRUCT_NOTE, convert
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.lower.flatten import flatten
@@ -33,12 +33,16 @@ def _convert(text, src, dst, **kw):
     return program, res
 
 
-def test_construct_the_target_lacks_lowers_the_program_with_a_located_info():
+def test_construct_the_target_lacks_is_lowered_alone_with_a_located_info():
+    # X=AC(20) has no ISO word: its label loop (lines 5-9) becomes plain motion, the rest stays
     program, res = _convert(SIN, "sinumerik", "iso-m")
-    assert res.text is not None and res.flattened
-    infos = [d for d in res.diagnostics if d.rule == "NC401"]
-    assert infos and all(d.severity == "info" for d in infos)
-    assert any(d.line > 1 for d in infos)          # points at the construct, not the file
+    assert res.text is not None and not res.flattened
+    infos = [d for d in res.diagnostics if d.rule == "NC401" and CONSTRUCT_NOTE in d.message]
+    assert [(d.line, d.severity) for d in infos] == [(7, "info")]
+    assert "lines 5-9" in infos[0].message
+    lines = res.text.splitlines()
+    assert "#100=2" in lines and "N20 T1 M6" in lines and "N80 G0 Z5." in lines   # kept as written
+    assert "GOTO" not in res.text                    # the loop itself was run out
     out = get("iso-m").parse(res.text, "p.nc").program
     assert equiv.compare(_records(program), _records(out)) is None
 

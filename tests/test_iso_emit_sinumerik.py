@@ -17,7 +17,8 @@ import rs274 as h
 from conftest import CORPUS
 from nctrans import equivalence as equiv
 from nctrans import source as _source
-from nctrans.convert import convert
+from nctrans.convert import CONSTRUCT_NOTE, convert
+from nctrans.dialects.iso_m.plan import stable_number
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.lower.flatten import flatten
@@ -100,12 +101,13 @@ G0 X0 Y0 Z5
 M30
 """
 
-STILL_FLAT = {
-    "g500": "G17 G90 G71 T1 D1 M6\nG54\nG0 X10 Y0\nG500\nG0 X0 Y0\nM30\n",
-    "arot": "G17 G90 G71 T1 D1 M6\nG0 X0 Y0 Z5\nROT RPL=10\nAROT RPL=20\nG1 X10 F100\nM30\n",
-    "var-param": "%_N_M_MPF\nDEF REAL W=1\nG0 X0 Y0\nGROW(W)\nG0 X=W\nM30\n%_N_GROW_SPF\n"
-                 "PROC GROW(VAR REAL WID)\nWID=WID+2\nRET\n",
+ALONE = {   # what ISO cannot say exactly: that construct alone becomes plain motion
+    "g500": ("G17 G90 G71 T1 D1 M6\nG54\nG0 X10 Y0\nG500\nG0 X0 Y0\nM30\n", "line 4 was"),
+    "arot": ("G17 G90 G71 T1 D1 M6\nG0 X0 Y0 Z5\nROT RPL=10\nAROT RPL=20\nG1 X10 F100\nM30\n",
+             "lines 3-6 were"),
 }
+VAR_PARAM = ("%_N_M_MPF\nDEF REAL W=1\nG0 X0 Y0\nGROW(W)\nG0 X=W\nM30\n%_N_GROW_SPF\n"
+             "PROC GROW(VAR REAL WID)\nWID=WID+2\nRET\n")
 
 
 def _convert(text: str, name: str = "p.mpf"):
@@ -168,13 +170,26 @@ def test_plain_lowerings_run_in_rs274(text, expect, rs274, rs274_cache):
     assert problem is None, problem
 
 
-@pytest.mark.parametrize("key", sorted(STILL_FLAT))
-def test_what_iso_cannot_say_exactly_still_flattens(key):
-    program, res = _convert(STILL_FLAT[key])
-    assert res.flattened and res.text is not None
-    assert any(d.rule == "NC401" and "cannot express" in d.message for d in res.diagnostics)
-    assert get("iso-m").emit(program).diagnostics and any(
-        d.rule == "NC402" for d in get("iso-m").emit(program).diagnostics)
+@pytest.mark.parametrize("key", sorted(ALONE))
+def test_what_iso_cannot_say_exactly_is_lowered_alone(key):
+    text, lines = ALONE[key]
+    program, res = _convert(text)
+    assert res.text is not None and not res.flattened
+    notes = [d.message for d in res.diagnostics if d.rule == "NC401" and CONSTRUCT_NOTE in d.message]
+    assert notes and all(lines in m for m in notes), notes
+    assert any(d.rule == "NC402" for d in get("iso-m").emit(program).diagnostics)
+    assert res.text.splitlines()[1] == "G17 G90 G21 T1 D1 M6"        # the rest as written
+    back = get("iso-m").parse(res.text, "p.nc").program
+    assert equiv.compare(_records(program), _records(back)) is None
+
+
+def test_by_reference_parameter_goes_through_the_spill_stack():
+    # GROW(VAR REAL WID): the caller writes W to the callee's frame slot, reads it back after
+    _, res = _structural(VAR_PARAM, "kept on the spill stack")
+    lines = res.text.splitlines()
+    call = lines.index("G65 P" + str(stable_number("GROW", set())))
+    assert lines[call - 1] == "#[#149+150]=#100" and lines[call + 1] == "#100=#[#149+150]"
+    assert "#149=#149+1" in lines and "#149=#149-1" in lines
 
 
 def test_cip_from_an_unknown_start_is_refused():

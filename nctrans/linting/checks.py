@@ -357,7 +357,8 @@ def portability(ld: pipeline.Loaded, machine, target: str) -> list[Diagnostic]:
         return flatten(p, machine, diagnostics=into,
                        resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
     try:
-        result = convert(ld.program, dialect, flatten_with=flatten_with)
+        result = convert(ld.program, dialect, flatten_with=flatten_with, machine=machine,
+                         resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
     except Exception as e:          # the emitter's bug must not hide the lint report
         return [Diagnostic("NC402", "error", f"--target {target}: the conversion failed: "
                            f"{type(e).__name__}: {e}", ld.label)]

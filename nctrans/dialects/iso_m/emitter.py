@@ -26,6 +26,7 @@ defines); by-reference (VAR) and array parameters (G65 passes values only).
 """
 from __future__ import annotations
 
+import itertools
 import math
 from decimal import Decimal
 from typing import Any, Optional
@@ -195,6 +196,10 @@ class IsoEmitter:
         self.targets: dict[Optional[str], set[str]] = {}
         self.sub_numbers: dict[str, int] = {}
         self.arrays: dict[tuple, pl.ArrayPlan] = {}
+        # (unit, array parameter) -> its dimensions
+        self._slot_dims: dict[tuple, list[int]] = {
+            (key, prm.name.upper()): list(prm.dims)
+            for key, sub in program.subprograms.items() for prm in sub.params if prm.dims}
         top_r, dynamic_r = pl.max_r_used(program)
         self.next_array = 900 if dynamic_r else 500 + top_r + 1
         # what is known at emit time: constant programmed position, plane, the constant
@@ -245,11 +250,14 @@ class IsoEmitter:
             arr = self.arrays.get((self.unit, key)) or self.arrays.get((None, key))
             if arr is not None:
                 return self._element(arr, v)
-            local = self.plans[self.unit].locals.get(key) if self.unit in self.plans else None
+            plan = self.plans.get(self.unit)
+            local = plan.locals.get(key) if plan is not None else None
             if local is not None:
                 if v.indices:
                     raise NotExpressible(f"indexing the scalar {v.key}")
                 return f"#{local}"
+            if plan is not None and key in plan.slots:
+                return self._slot_var(plan, key, v)
         if v.space == "R" and v.key is None and v.indices and len(v.indices) == 1:
             self.lowered("R[expr] written as #[500+expr]")
             return f"#[500+{format_expr(v.indices[0], self)}]"
@@ -273,6 +281,30 @@ class IsoEmitter:
         self.lowered(f"system variable {v.key}{f'[{axis}]' if axis else ''} written as {found[0]}")
         return found[0]
 
+    def _slot_var(self, plan: pl.UnitPlan, key: str, v: n.Var) -> str:
+        """A spilled parameter or local: its slot of the unit's spill frame (an array parameter
+        takes consecutive slots, indexed row-major by its declared dimensions)."""
+        offset, size = plan.slots[key]
+        base = pl.SPILL_BASE - plan.frame + offset
+        if not v.indices:
+            if size != 1:
+                raise NotExpressible(f"the array parameter {v.key} used without its indices")
+            return plan.slot_text(offset)
+        dims = self._slot_dims.get((self.unit, key))
+        if dims is None:
+            raise NotExpressible(f"indexing the scalar {v.key}")
+        if len(v.indices) != len(dims):
+            raise NotExpressible(f"the array parameter {v.key} used without all {len(dims)} indices")
+        flat = v.indices[0]
+        for e, dim in zip(v.indices[1:], dims[1:]):
+            flat = n.Binary("+", n.Binary("*", flat, n.Num(float(dim))), e)
+        c = constant(flat)
+        if c is not None:
+            if c != int(c) or not 0 <= c < size:
+                raise NotExpressible(f"index {format_number(c)} of the parameter {v.key} (size {size})")
+            return plan.slot_text(offset + int(c))
+        return f"#[#{pl.SPILL_POINTER}+{base}+{format_expr(flat, self)}]"
+
     def _element(self, arr: pl.ArrayPlan, v: n.Var) -> str:
         idx = v.indices or []
         if len(idx) != len(arr.dims):
@@ -295,7 +327,8 @@ class IsoEmitter:
             if v.space == "R" and isinstance(v.key, int) and 0 <= v.key < 400:
                 self.var_map[key] = 500 + v.key
             elif v.space in ("name", "R", "arg", "local"):
-                while self.next_common in self.var_map.values():
+                while self.next_common in self.var_map.values() or \
+                        pl.SPILL_POINTER <= self.next_common <= pl.SPILL_END:
                     self.next_common += 1
                 self.var_map[key] = self.next_common
                 self.next_common += 1
@@ -334,6 +367,20 @@ class IsoEmitter:
         if meta.get("archive_header"):
             self.out.append(str(meta["archive_header"]))
         head = self._program_word(p.name, meta.get("program_number"))
+        library = self._library_entry()
+        if library is not None:
+            # a file that only defines a subprogram (a Sinumerik PROC file) is that subprogram:
+            # O<its number>, the body, M99; callers elsewhere call the same number
+            self.out.append(f"O{self.sub_numbers[library]} {self._comment(library)}")
+            self.lowered(f"subprogram file {library} written as O{self.sub_numbers[library]}")
+            self._subprogram(library, p.subprograms[library])
+            for key, sub in p.subprograms.items():
+                if key != library:
+                    self.out.append(f"O{self.sub_numbers.get(key, pl.iso_number(key))}")
+                    self._subprogram(key, sub)
+            if percent:
+                self.out.append("%")
+            return "\n".join(self.out) + "\n"
         if self.sub_numbers and (head is None or p.dialect != self.dialect):
             # an O block after a headless main program would be read as the main program's number
             head = f"O{pl.stable_number('MAIN ' + (p.name or ''), set(self.sub_numbers.values()))}"
@@ -344,8 +391,6 @@ class IsoEmitter:
         names_at = len(self.out)
         self.nodes(p.body)
         for key, sub in p.subprograms.items():
-            self.unit = key
-            self.forget()
             self.span = sub.span
             if key in self.sub_numbers:
                 word = f"O{self.sub_numbers[key]}"
@@ -356,16 +401,7 @@ class IsoEmitter:
                 self.refuse(f"subprogram name {key!r} (ISO programs are O numbers)")
                 word = f"({key})"
             self.out.append(word)
-            unit = self.plans[key]
-            if unit.refusal:
-                self.refuse(unit.refusal)
-            elif sub.params:
-                self.lowered(f"parameters of {key} passed as G65 arguments: " + ", ".join(
-                    f"{prm.name}={letter} (#{pl.ARG_LOCALS[letter]})"
-                    for prm, letter in zip(sub.params, unit.params)))
-            self.nodes(sub.body)
-            if key in self.sub_numbers and not walk.ends_with_return(sub.body):
-                self.out.append("M99")
+            self._subprogram(key, sub)
         self.out[names_at:names_at] = self._name_table()
         if percent:
             self.out.append("%")
@@ -387,6 +423,46 @@ class IsoEmitter:
             dims = ",".join(str(d) for d in arr.dims)
             lines.append(f"(VAR {name}[{dims}]{where} = #{arr.base}..#{arr.base + arr.size - 1})")
         return lines
+
+    def _library_entry(self) -> Optional[str]:
+        """The subprogram a file from another dialect exists to define (its main body does
+        nothing), else None."""
+        p = self.program
+        entry = (p.meta or {}).get("entry")
+        if p.dialect == self.dialect or entry not in p.subprograms or entry not in self.sub_numbers:
+            return None
+        if any(not isinstance(b, n.Block) or b.body for b in p.body):
+            return None
+        return str(entry)
+
+    def _subprogram(self, key: str, sub: n.Subprogram) -> None:
+        """A subprogram's body after its O word: the spill frame pushed, the body, M99."""
+        self.unit = key
+        self.forget()
+        self.span = sub.span
+        unit = self.plans[key]
+        if unit.refusal:
+            self.refuse(unit.refusal)
+        elif sub.params:
+            self.lowered(f"parameters of {key} passed as G65 arguments: " + ", ".join(
+                f"{prm.name}={letter} (#{pl.ARG_LOCALS[letter]})" if letter else
+                f"{prm.name}=spill slot {unit.slots[prm.name.upper()][0]}"
+                for prm, letter in zip(sub.params, unit.params)))
+        if unit.frame:
+            self.lowered(f"{unit.frame} parameters and locals of {key} kept on the spill stack "
+                         f"#{pl.SPILL_BASE}..#{pl.SPILL_END} (pointer #{pl.SPILL_POINTER})")
+            self.out.append(f"#{pl.SPILL_POINTER}=#{pl.SPILL_POINTER}+{unit.frame}")
+        self.nodes(sub.body)
+        if (key in self.sub_numbers or unit.frame) and not walk.ends_with_return(sub.body):
+            self.out.extend(self._pop_frame())
+            self.out.append("M99")
+
+    def _pop_frame(self) -> list[str]:
+        """What leaving the current unit must do first: release its spill frame."""
+        plan = self.plans.get(self.unit)
+        if plan is None or not plan.frame:
+            return []
+        return [f"#{pl.SPILL_POINTER}=#{pl.SPILL_POINTER}-{plan.frame}"]
 
     def _plan(self) -> None:
         """Labels, locals and O numbers of every unit, before any jump or call is written."""
@@ -1103,8 +1179,7 @@ class IsoEmitter:
         if self.program.dialect != self.dialect and s.name and pl.iso_number(s.name) is None:
             callee = self._callee(s.name)
             if callee is None:
-                raise NotExpressible(f"a call of {s.name!r}: it is not in this program, so it has no "
-                                     "O number here")
+                return self._external_call(s)
         if callee is not None:
             return self._named_call(s, *callee)
         kind = s.kind if s.kind in ("m98", "g65", "g66") else ("g66" if s.modal != "none" else "m98")
@@ -1160,13 +1235,93 @@ class IsoEmitter:
             kind = "G66"
         else:
             kind = "G65" if unit.uses_locals else "M98"
+        self.lowered(f"call of {s.name} written as {kind} P{number}")
+        return self._call_lines(s, kind, number, unit, self._callee_params(s.name))
+
+    def _external_call(self, s: n.SubCall):
+        """A call by name of a subprogram this program does not define: kept as G65 P<the number
+        its own file converts to> (pl.stable_number of the name), so the converted caller and the
+        converted subprogram file meet; NC404 says the control must provide it. Its parameters
+        are laid out as its declaration (Sinumerik EXTERN) says, else as the arguments look:
+        array variables by reference in spill slots, other values as G65 letters."""
+        if s.named_args or s.kind in ("isocall", "extcall", "pcall"):
+            raise NotExpressible(f"a call of {s.name!r} ({s.kind or 'named arguments'}) to a subprogram "
+                                 "that is not in this program")
+        taken = {num for num in self.sub_numbers.values()}
+        taken.update(pl.iso_number(k) for k in self.program.subprograms if pl.iso_number(k) is not None)
+        number = pl.stable_number(s.name, taken)
+        params = self._extern_params(s)
+        unit = pl.unit_plan(n.Subprogram(s.name, self._where(), [], params), [], self.fresh_label)
+        if unit.refusal:
+            raise NotExpressible(unit.refusal)
+        kind = "G66" if s.modal != "none" else "G65"
+        self.diags.append(at_span(
+            "NC404", "warning", f"the call of {s.name} is kept as {kind} P{number}: {s.name} is not in "
+            f"this program nor found beside it, so the target control must provide O{number} "
+            f"(convert {s.name}'s own file to get it)", self._where()))
+        return self._call_lines(s, kind, number, unit, params)
+
+    def _extern_params(self, s: n.SubCall) -> list:
+        declared = ((self.program.meta or {}).get("extern_params") or {}).get(s.name.upper())
+        if declared is not None and len(declared) >= len(s.args):
+            return [n.Param(f"P{i}", p.get("type", "REAL"), bool(p.get("by_ref")), list(p.get("dims") or []))
+                    for i, p in enumerate(declared)]
+        params = []
+        for i, arg in enumerate(s.args):
+            key = str(arg.key).upper() if type(arg) is n.Var and arg.space == "name" else None
+            arr = (self.arrays.get((self.unit, key)) or self.arrays.get((None, key))) if key else None
+            if arr is not None and not arg.indices:
+                params.append(n.Param(f"P{i}", "REAL", True, list(arr.dims)))
+            else:
+                params.append(n.Param(f"P{i}"))
+        return params
+
+    def _callee_params(self, name: str) -> Optional[list]:
+        for key, sub in self.program.subprograms.items():
+            if key.upper() == name.upper():
+                return sub.params
+        return None
+
+    def _call_lines(self, s: n.SubCall, kind: str, number: int, unit: pl.UnitPlan, params):
+        """The call and, around it, the spill-stack traffic of its arguments: parameters passed in
+        the callee's spill frame are written to #[#149+150+slot] first, by-reference ones read
+        back from there after the call."""
         words = [("G:12" if kind == "G66" else "", kind), ("P", f"P{number}")]
         if s.repeat is not None:
             words.append(("L", "L" + self.val(s.repeat)))
-        for letter, arg in zip(unit.params, s.args):
-            words.append(("", self.addr(letter, arg)))
-        self.lowered(f"call of {s.name} written as {kind} P{number}")
-        return words
+        before: list = []
+        after: list = []
+        for i, (letter, arg) in enumerate(zip(unit.params, s.args)):
+            if type(arg) is n.Num and arg.text == "":
+                continue                    # an omitted argument stays vacant
+            if letter:
+                words.append(("", self.addr(letter, arg)))
+                continue
+            prm = params[i]
+            offset, size = unit.slots[prm.name.upper()]
+            for k, element in enumerate(self._elements(arg, size, s.name)):
+                slot = f"#[#{pl.SPILL_POINTER}+{pl.SPILL_BASE + offset + k}]"
+                before.append([("#", f"{slot}={format_expr(element, self)}")])
+                if prm.by_ref and type(element) is n.Var:
+                    after.append([("#", f"{self.val(element)}={slot}")])
+        if not before and not after:
+            return words
+        return _Lines([*before, words, *after])
+
+    def _elements(self, arg, size: int, callee: str) -> list:
+        """The argument expressions filling `size` slots: the value itself, or each element of an
+        array variable in row-major order."""
+        if size == 1:
+            return [arg]
+        if type(arg) is not n.Var or arg.indices:
+            raise NotExpressible(f"an array argument of {callee} that is not an array variable")
+        key = str(arg.key).upper()
+        arr = self.arrays.get((self.unit, key)) or self.arrays.get((None, key))
+        dims = arr.dims if arr is not None else self._slot_dims.get((self.unit, key))
+        if dims is None or math.prod(dims) != size:
+            raise NotExpressible(f"the argument {arg.key} of {callee}: not an array of {size} elements")
+        return [n.Var(arg.space, arg.key, [n.Num(float(i)) for i in idx])
+                for idx in itertools.product(*(range(d) for d in dims))]
 
     def w_ModalCallOff(self, s):
         if self.named_cycle is not None:
@@ -1177,6 +1332,9 @@ class IsoEmitter:
         words = [("", "M99")]
         if s.to_label is not None:
             words.append(("P", "P" + self._goto_target(s.to_label)))
+        pop = self._pop_frame()
+        if pop:
+            return _Lines([[("#", pop[0])], words])
         return words
 
     def w_ProgramEnd(self, s):
@@ -1218,7 +1376,11 @@ class IsoEmitter:
         if s.dims:
             return self._array(s)
         var = n.Var("name", s.name)
-        local = self.plans[self.unit].locals.get(s.name.upper()) if self.unit in self.plans else None
+        plan = self.plans.get(self.unit)
+        local = plan.locals.get(s.name.upper()) if plan is not None else None
+        if plan is not None and s.name.upper() in plan.slots:
+            init = s.init[0] if s.init else n.Num(0.0)
+            return [("#", f"{self.var_text(var)}={format_expr(init, self)}")]
         if local is not None:
             # a G65 local starts vacant; DEF starts at its initial value or 0
             init = s.init[0] if s.init else n.Num(0.0)
@@ -1265,6 +1427,13 @@ class IsoEmitter:
     def w_Passthrough(self, s: n.Passthrough):
         self.forget()
         if s.dialect not in ("", self.dialect):
+            from nctrans.interp.unmodelled import no_motion_effect
+            if no_motion_effect(s.reason):
+                # a declaration, preprocessing stop, attribute ...: nothing to do on an ISO control,
+                # kept in sight as a comment
+                self.lowered(f"{s.dialect} {s.reason} {s.text.strip()!r} kept as a comment (no effect on "
+                             "the path)")
+                return [("", self._comment(s.text.strip()))]
             raise NotExpressible(f"{s.dialect} text {s.text!r}")
         return [("", s.text)]
 

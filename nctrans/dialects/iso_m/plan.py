@@ -24,6 +24,17 @@ ARG_LOCALS = {"A": 1, "B": 2, "C": 3, "D": 7, "E": 8, "F": 9, "H": 11, "M": 13, 
               "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24, "Y": 25, "Z": 26}
 LOCALS = range(1, 34)
 COMMON_END = 999                 # last common variable of the #500 block
+# The spill stack: what a subprogram cannot keep in its 33 locals (parameters past the 18 G65
+# letters, by-reference and array parameters, DEF locals past #33) lives in a frame on a stack of
+# common variables, so nested and recursive calls each keep their own (save and restore by moving
+# the pointer). #149 holds the stack height (vacant reads as 0); a subprogram with a frame of K
+# slots adds K to it on entry and takes K off before each M99, and slot i of its frame is
+# #[#149+(150-K+i)]. A caller passes such parameters by writing #[#149+(150+i)] just before the
+# call (the callee's frame starts where the caller's ends) and reads by-reference ones back from
+# the same variables after it. Named variables of the main program take #100..#148.
+SPILL_POINTER = 149
+SPILL_BASE = 150
+SPILL_END = 199
 PLANE = {"XY": ("X", "Y", "Z"), "ZX": ("Z", "X", "Y"), "YZ": ("Y", "Z", "X")}
 _ISO_NUMBER = re.compile(r"O?\d+$", re.I)
 
@@ -60,6 +71,17 @@ class UnitPlan:
     params: list[str] = field(default_factory=list)             # G65 letter per parameter
     uses_locals: bool = False                                   # called with G65 (own local level)
     refusal: Optional[str] = None                               # why its calls cannot be written
+    # the spill frame: name -> (slot, size); params[i] is "" for a parameter passed in a slot
+    slots: dict[str, tuple[int, int]] = field(default_factory=dict)
+    frame: int = 0
+
+    def slot_text(self, offset: int) -> str:
+        """The common variable of frame slot `offset` (an expression in the stack pointer)."""
+        return f"#[#{SPILL_POINTER}+{SPILL_BASE - self.frame + offset}]"
+
+    def take_slots(self, name: str, size: int) -> None:
+        self.slots[name] = (self.frame, size)
+        self.frame += size
 
 
 def circle_through(p1, p2, p3) -> Optional[tuple[float, float, bool]]:
@@ -137,23 +159,28 @@ def unit_plan(sub: Optional[n.Subprogram], body, fresh_number) -> UnitPlan:
     if not sub.params and not decls:
         return plan
     plan.uses_locals = True
-    if len(sub.params) > len(ARG_LETTERS):
-        plan.refusal = f"{len(sub.params)} parameters of {sub.name} (G65 passes {len(ARG_LETTERS)})"
-        return plan
-    for p, letter in zip(sub.params, ARG_LETTERS):
-        if p.by_ref:
-            plan.refusal = f"the by-reference (VAR) parameter {p.name} of {sub.name}"
-        elif p.dims:
-            plan.refusal = f"the array parameter {p.name} of {sub.name}"
+    letters = iter(ARG_LETTERS)
+    for p in sub.params:
+        letter = None if p.by_ref or p.dims else next(letters, None)
+        if letter is None:
+            # by reference, an array, or past the G65 letters: a slot of the spill frame
+            plan.params.append("")
+            plan.take_slots(p.name.upper(), math.prod(p.dims) if p.dims else 1)
+            if p.dims and not all(isinstance(d, int) and d > 0 for d in p.dims):
+                plan.refusal = f"the array parameter {p.name} of {sub.name} without constant dimensions"
+            continue
         plan.params.append(letter)
         plan.locals[p.name.upper()] = ARG_LOCALS[letter]
     free = [i for i in LOCALS if i not in plan.locals.values()]
     for d in decls:
         key = d.name.upper()
-        if key in plan.locals:
+        if key in plan.locals or key in plan.slots:
             continue
-        if not free:
-            plan.refusal = f"more than 33 parameters and local variables in {sub.name}"
-            break
-        plan.locals[key] = free.pop(0)
+        if free:
+            plan.locals[key] = free.pop(0)
+        else:
+            plan.take_slots(key, 1)
+    if plan.frame > SPILL_END - SPILL_BASE + 1:
+        plan.refusal = (f"{plan.frame} spilled parameters and locals of {sub.name} (the spill stack "
+                        f"#{SPILL_BASE}..#{SPILL_END} holds {SPILL_END - SPILL_BASE + 1})")
     return plan

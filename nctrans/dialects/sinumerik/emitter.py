@@ -653,8 +653,20 @@ class Emitter:
             return fixed if re.match(r"[A-Za-z_]", fixed) else "_" + fixed[:30]
         return name
 
+    def _defined(self, name: str) -> bool:
+        """Whether this program defines the subprogram `name` (ISO O1000 and 1000 are one)."""
+        def key(x: str) -> str:
+            m = _SUB_NUM.match(x)
+            return str(int(m.group(1))) if m else x.upper()
+        return any(key(k) == key(name) for k in self.p.subprograms)
+
     def subcall(self, c: ir.SubCall, out: "_Line") -> None:
         name = self.subname(c.name)
+        if self.p.dialect != DIALECT and c.name and not self._defined(c.name):
+            self.diags.append(at_span(
+                "NC404", "warning", f"the call of {c.name} is kept as a call of {name}: it is not in "
+                f"this program nor found beside it, so the target control must provide {name} "
+                f"(convert {c.name}'s own file to get it)", self.span))
         pre = []
         if c.bindings:
             self.info("g65", "macro call arguments passed in R parameters (global: a nested call can "

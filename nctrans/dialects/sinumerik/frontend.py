@@ -636,6 +636,9 @@ class Lowerer:
             elif d == "extern_stmt":
                 w.out.append(ir.Passthrough(_t(text), "declaration", DIALECT))
                 self.meta.setdefault("externs", []).append(str(ch[1]))
+                signature = _extern_signature(_t(text))
+                if signature is not None:
+                    self.meta.setdefault("extern_params", {})[str(ch[1]).upper()] = signature
             else:
                 self.error("NC002", f"{_KW.get(d, d)} must stand in its own block", line.lineno,
                            line.col)
@@ -1506,3 +1509,24 @@ def _zone(low: Lowerer, start: str, lines: list[Line]) -> dict:
                         el[k] = v.value.value
                 zone["contour"].append(el)
     return zone
+
+
+_EXTERN = re.compile(r"^\s*EXTERN\s+\w+\s*\((.*)\)\s*$", re.IGNORECASE)
+_EXTERN_PARAM = re.compile(r"^(VAR\s+)?([A-Z]+)\s*(?:\[([^\]]*)\])?$", re.IGNORECASE)
+
+
+def _extern_signature(text: str) -> Optional[list]:
+    """The parameters an EXTERN declaration gives a subprogram (by reference, type, constant
+    dimensions), as plain data for emitters that lay out calls: None when it does not read."""
+    m = _EXTERN.match(text.split(";")[0])
+    if m is None:
+        return None
+    params = []
+    parts = re.split(r",(?![^\[]*\])", m.group(1)) if m.group(1).strip() else []
+    for part in (p.strip() for p in parts):
+        pm = _EXTERN_PARAM.match(part)
+        if pm is None:
+            return None
+        dims = [int(d) if d.strip().isdigit() else 0 for d in pm.group(3).split(",")] if pm.group(3) else []
+        params.append({"by_ref": bool(pm.group(1)), "type": pm.group(2).upper(), "dims": dims})
+    return params

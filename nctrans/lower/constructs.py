@@ -1,0 +1,427 @@
+"""Per-construct lowering: a construct the target cannot express becomes plain motion on its own,
+and the rest of the program keeps its structure.
+
+The target's emitter names each construct it cannot write (NC402 at its line). Each one is widened
+to a *segment* of the main program's top-level nodes that can be replaced on its own:
+- the top-level node holding the line (a block, or a whole loop / branch: "its loop");
+- a modal canned cycle or modal call together with every block it runs at, from the block that
+  selects it to the block that cancels it ("its cycle call").
+The program then runs once through the interpreter with a zero dwell as marker before and after
+each segment; the records between a segment's markers are written back as plain-motion blocks
+(`flatten._Flattener`), framed by the modes they need (mm, absolute, incremental arc centres) and
+followed by the source's modes as they stand at the segment's end marker (units, distance, plane,
+motion, feed, feed mode, work offset, tool length), so what follows runs as in the source.
+
+A segment is left as a refusal (NC402, saying why) when replacing it alone would be wrong: it is not
+in the main program (a subprogram's body runs once per call), jumps cross its border, it sets
+variables read elsewhere, it runs more or less than once, cutter compensation, a programmable frame,
+G92 or a local offset is active at its border, or it holds what plain motion cannot carry (an
+unresolved call, an unmodelled construct).
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+from nctrans.diagnostics import Diagnostic
+from nctrans.interp.interpreter import Interpreter
+from nctrans.lower.flatten import ISO_OFFSETS, _Flattener, _Walker
+from nctrans.ir import nodes as n
+from nctrans.ir.walk import blocks, walk
+
+from nctrans.convert import CONSTRUCT_NOTE as NOTE
+
+MARKER_FILE = "<nctrans:segment>"
+
+
+@dataclass
+class Segment:
+    first: int                          # top-level node indices, inclusive
+    last: int
+    refusals: list[Diagnostic] = field(default_factory=list)
+    why_not: Optional[str] = None       # set when it cannot be lowered on its own
+    # filled by the run
+    starts: int = 0
+    ends: int = 0
+    flattener: object = None
+    end_state: Optional[dict] = None
+    notes: list[Diagnostic] = field(default_factory=list)    # what plain motion leaves out (NC401/NC403)
+    diag_mark: int = 0                  # interpreter diagnostics before it started
+
+
+def _line_index(body: list, file: str) -> dict[int, int]:
+    """Source line -> index of the top-level node that holds it."""
+    index: dict[int, int] = {}
+    for i, node in enumerate(body):
+        for inner in walk([node]):
+            sp = getattr(inner, "span", None)
+            if sp is not None and sp.file == file:
+                index.setdefault(sp.line, i)
+    return index
+
+
+def _modal_runs(body: list) -> list[tuple[int, int]]:
+    """(first, last) top-level indices of each modal cycle or modal call run: from the block that
+    selects it to the block that cancels it (the end of the body when nothing does). An ISO canned
+    cycle ends at G80 or a motion code of group 01; a modal call (G66, MCALL) at its cancel only; a
+    programmable frame or G92 shift at a frame cancel (the run's end checks the frame is gone)."""
+    runs = []
+    start: Optional[int] = None
+    kind = ""
+    for i, node in enumerate(body):
+        if type(node) is not n.Block:
+            continue
+        for s in node.body:
+            t = type(s)
+            if t is n.ModeChange and s.group == "cycle" and s.value != "off":
+                if start is None:
+                    start, kind = i, "cycle"
+            elif (t is n.CycleCall and s.modal) or (t is n.SubCall and s.modal != "none"):
+                if start is None:
+                    start, kind = i, "call"
+            elif (t is n.FrameOp and not s.clear) or t is n.SetPosition:
+                if start is None:
+                    start, kind = i, "frame"
+            elif start is not None and kind == "frame" and (
+                    (t is n.FrameOp and s.clear) or t is n.ResetSetPosition):
+                runs.append((start, i))
+                start = None
+            elif start is not None and (
+                    (kind == "cycle" and t is n.ModeChange and (s.group == "motion" or s.group == "cycle"))
+                    or (kind == "call" and t is n.ModalCallOff)):
+                runs.append((start, i))
+                start = None
+    if start is not None:
+        runs.append((start, len(body) - 1))
+    return runs
+
+
+def _vars(obj, out: set) -> None:
+    """Every variable (space, key) an IR object mentions."""
+    if obj is None or isinstance(obj, (str, int, float, bool, n.Num, n.Str, n.Span)):
+        return
+    if type(obj) is n.Var:
+        out.add((obj.space, str(obj.key).upper() if obj.space == "name" else obj.key))
+        for e in obj.indices or ():
+            _vars(e, out)
+        return
+    if isinstance(obj, dict):
+        for v in obj.values():
+            _vars(v, out)
+        return
+    if isinstance(obj, (list, tuple)):
+        for v in obj:
+            _vars(v, out)
+        return
+    for name in getattr(obj, "__slots__", ()):
+        _vars(getattr(obj, name, None), out)
+
+
+def _written(nodes: list) -> set:
+    out: set = set()
+    for node in walk(nodes):
+        if type(node) is n.Block:
+            for s in node.body:
+                if type(s) is n.Assign:
+                    _vars(s.target, out)
+                elif type(s) is n.VarDecl:
+                    out.add(("name", s.name.upper()))
+        elif type(node) is n.ForLoop:
+            _vars(node.var, out)
+    return {(sp, k) for sp, k in out if sp != "system"}
+
+
+def _local(space: str, key, program: n.Program) -> bool:
+    """A variable that ends with the program: a DEF local of its main body or an ISO local #1-#33
+    of the main program. Anything else (R parameters, GUD names, common variables) is seen by the
+    next program, so a lowering that drops its assignment would change what happens there."""
+    if space == "num":
+        return isinstance(key, int) and 1 <= key <= 33
+    if space == "name":
+        return any(type(s) is n.VarDecl and s.name.upper() == key and s.scope in ("local", "", None)
+                   for b in blocks(program.body) for s in b.body)
+    return False
+
+
+def _labels(nodes: list) -> set[str]:
+    return {x for b in blocks(nodes) for x in (b.label, b.number) if x is not None}
+
+
+def _jumps(nodes: list) -> set[str]:
+    out: set[str] = set()
+    for node in walk(nodes):
+        if type(node) is n.Block:
+            out.update(str(s.target) for s in node.body if type(s) is n.Goto)
+            out.update(str(s.to_label) for s in node.body if type(s) is n.Return and s.to_label)
+        elif type(node) is n.Case:
+            out.update(str(t) for _, t in node.branches)
+            if node.default:
+                out.add(str(node.default))
+    return out
+
+
+def _segments(program: n.Program, refusals: list[Diagnostic]) -> tuple[list[Segment], list[Diagnostic]]:
+    """Group the refusals into segments of the main body; refusals outside it stay as they are."""
+    body = program.body
+    index = _line_index(body, program.file)
+    found: list[Segment] = []
+    outside: list[Diagnostic] = []
+    for d in refusals:
+        i = index.get(d.line) if d.file == program.file else None
+        if i is None:
+            outside.append(d)
+            continue
+        found.append(Segment(i, i, [d]))
+    for a, b in _modal_runs(body):
+        for seg in found:
+            if seg.first <= b and seg.last >= a:
+                seg.first, seg.last = min(seg.first, a), max(seg.last, b)
+    found.sort(key=lambda s: s.first)
+    merged: list[Segment] = []
+    for seg in found:
+        if merged and seg.first <= merged[-1].last + 1:
+            merged[-1].last = max(merged[-1].last, seg.last)
+            merged[-1].refusals.extend(seg.refusals)
+        else:
+            merged.append(seg)
+    return merged, outside
+
+
+def _widen_over_jumps(body: list, segments: list[Segment]) -> list[Segment]:
+    """Each segment grown until no jump of the main body crosses its border: a jump into it, out
+    of it, back over it or forward past it takes the jump's whole span with it, so a label loop
+    (LBL: ... GOTOB LBL) around a construct is lowered whole, as its loop."""
+    where: dict[str, int] = {}
+    for i, node in enumerate(body):
+        for lab in _labels([node]):
+            where.setdefault(lab, i)
+    spans = [(min(i, where[t]), max(i, where[t])) for i, node in enumerate(body)
+             for t in _jumps([node]) if t in where]
+    for seg in segments:
+        changed = True
+        while changed:
+            changed = False
+            for lo, hi in spans:
+                overlaps = lo <= seg.last and hi >= seg.first
+                if overlaps and (lo < seg.first or hi > seg.last):
+                    seg.first, seg.last = min(seg.first, lo), max(seg.last, hi)
+                    changed = True
+    segments.sort(key=lambda s: s.first)
+    merged: list[Segment] = []
+    for seg in segments:
+        if merged and seg.first <= merged[-1].last + 1:
+            merged[-1].last = max(merged[-1].last, seg.last)
+            merged[-1].refusals.extend(seg.refusals)
+        else:
+            merged.append(seg)
+    return merged
+
+
+def _static_checks(program: n.Program, segments: list[Segment]) -> None:
+    body = program.body
+    subs = [s.body for s in program.subprograms.values()]
+    for seg in segments:
+        inside = body[seg.first:seg.last + 1]
+        rest = body[:seg.first] + body[seg.last + 1:]
+        if _jumps(rest + [x for s in subs for x in s]) & _labels(inside):
+            seg.why_not = "a jump from elsewhere lands inside it"
+        elif not _jumps(inside) <= _labels(inside):
+            seg.why_not = "it jumps out of itself"
+        else:
+            read: set = set()
+            _vars(rest, read)
+            for sb in subs:
+                _vars(sb, read)
+            written = _written(inside)
+            shared = sorted(str(k) for _, k in written & read)
+            lasting = sorted(str(k) for sp, k in written if not _local(sp, k, program))
+            if shared:
+                seg.why_not = f"it sets {', '.join(shared[:3])}, which the rest of the program reads"
+            elif lasting:
+                seg.why_not = (f"it sets {', '.join(lasting[:3])}, which outlives the program "
+                               "(a global, common or R variable)")
+
+
+def _mode_state(interp: Interpreter) -> dict:
+    st = interp.st
+    return {"units": st.groups.get("units"), "distance": st.groups.get("distance"),
+            "plane": st.plane, "motion": st.motion, "feed_mode": st.feed_mode, "feed": st.feed,
+            "scale": st.scale, "work_offset": st.work_offset, "length_mode": st.length_mode,
+            "length_index": st.length_index, "arc_absolute": st.arc_absolute,
+            "comp": st.comp_side != "off" or interp.comp is not None,
+            "frame": not interp.frame.identity or any(v for v in interp.off.g92.values())}
+
+
+def _restore(seg: Segment, span: n.Span) -> n.Block:
+    """The source's modes at the segment's end, where the plain motion left others."""
+    st, fl = seg.end_state, seg.flattener
+    body: list = []
+    if st["units"] == "inch":
+        body.append(n.ModeChange("units", "inch"))
+    if st["distance"] == "incremental":
+        body.append(n.ModeChange("distance", "incremental"))
+    if st["arc_absolute"]:
+        body.append(n.ModeChange("arc_distance", "absolute"))
+    if fl.plane is not None and fl.plane != st["plane"]:
+        body.append(n.ModeChange("plane", st["plane"]))
+    settable = st["work_offset"] in ISO_OFFSETS or str(st["work_offset"]).startswith("G54.1P")
+    # no settable offset in the source (Sinumerik G500): the plain motion ran under G54, the
+    # target's power-on offset, as the structural part around it does
+    if fl.sel is not None and settable and st["work_offset"] != fl.sel:
+        body.append(n.ModeChange("work_offset", st["work_offset"]))
+    length = (st["length_mode"], st["length_index"])
+    if fl.length[0] != "unknown" and (length[0] != fl.length[0]
+                                      or (length[0] != "off" and length[1] != fl.length[1])):
+        body.append(n.ModeChange("tool_length", length[0]))
+        if length[0] != "off" and length[1] is not None:
+            body.append(n.OffsetSelect("length", n.Num(float(length[1]))))
+    if fl.feed_mode is not None and st["feed_mode"] != fl.feed_mode:
+        body.append(n.ModeChange("feed_mode", st["feed_mode"]))
+    if fl.motion is not None and st["motion"] != fl.motion and \
+            st["motion"] in ("rapid", "linear", "arc_cw", "arc_ccw"):
+        body.append(n.ModeChange("motion", st["motion"]))
+    if st["feed"] is not None and fl.feed is not None and (st["feed"] != fl.feed or st["units"] == "inch"):
+        scale = st["scale"] if st["feed_mode"] != "inverse_time" else 1.0
+        body.append(n.Feed(n.Num(round(st["feed"] / scale, 9))))
+    return n.Block(span, body, comment="nctrans: modes of the source restored" if body else None)
+
+
+def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name: str, *,
+                     machine=None, resolver: Optional[Callable] = None
+                     ) -> tuple[Optional[n.Program], list[Diagnostic], list[Diagnostic]]:
+    """(program with each lowerable segment replaced by plain motion or None when none is, NC401/
+    NC403 notes, refusals that remain)."""
+    if type(program.body) is not list:
+        return None, [], refusals
+    if machine is None:
+        from nctrans.machine import default_mill
+        machine = default_mill()
+    segments, remaining = _segments(program, refusals)
+    segments = _widen_over_jumps(program.body, segments)
+    _static_checks(program, segments)
+    notes: list[Diagnostic] = []
+    for seg in segments:
+        if seg.why_not is None:
+            found: list[Diagnostic] = []
+            _Walker(found, getattr(machine, "kind", "mill")).nodes(program.body[seg.first:seg.last + 1])
+            blocked = [d for d in found if d.severity == "error"]
+            if blocked:
+                seg.why_not = blocked[0].message.replace("--flatten", "plain motion")
+            else:
+                seg.notes = [dataclasses.replace(d, message=d.message.replace("--flatten", "plain motion"))
+                             for d in found]
+    live = [s for s in segments if s.why_not is None]
+    if live:
+        _run(program, live, machine, resolver)
+    new_body: list = []
+    done = 0
+    lowered_any = False
+    for k, seg in enumerate(segments):
+        ended = seg.flattener is not None and seg.flattener.ended
+        if seg.why_not is None and (seg.starts != 1 or seg.ends != (0 if ended else 1)):
+            seg.why_not = ("it does not run exactly once" if seg.starts else "it never runs")
+        if seg.why_not is None and seg.end_state is not None and seg.end_state["comp"]:
+            seg.why_not = "cutter radius compensation is on at its end"
+        if seg.why_not is not None:
+            remaining.extend(dataclasses.replace(d, message=f"{d.message}; it cannot be lowered to "
+                                                 f"plain motion on its own: {seg.why_not}")
+                             for d in seg.refusals)
+            continue
+        nodes = program.body[seg.first:seg.last + 1]
+        lines = [b.span.line for b in blocks(nodes)] or [nodes[0].span.line]
+        first_line, last_line = min(lines), max(lines)
+        what = "line " + str(first_line) if first_line == last_line else f"lines {first_line}-{last_line}"
+        for d in seg.refusals:
+            notes.append(Diagnostic("NC401", "info", f"{d.message} — {target_name} cannot express it, so "
+                                    f"{what} {'was' if first_line == last_line else 'were'} {NOTE} "
+                                    "(the rest keeps its structure)", d.file, d.line, d.column,
+                                    d.end_line, d.end_column))
+        notes.extend(seg.notes)
+        new_body.extend(program.body[done:seg.first])
+        new_body.extend(seg.flattener.blocks)
+        last_span = n.Span(program.file, last_line)
+        restore = _restore(seg, last_span) if not ended else None
+        if restore is not None and restore.body:
+            new_body.append(restore)
+        done = seg.last + 1
+        lowered_any = True
+    if not lowered_any:
+        return None, notes, remaining
+    new_body.extend(program.body[done:])
+    return dataclasses.replace(program, body=new_body), notes, remaining
+
+
+def _marker(k: int) -> n.Block:
+    return n.Block(n.Span(MARKER_FILE, k), [n.Dwell(seconds=n.Num(0.0))])
+
+
+def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None:
+    """One run of the program with markers around the segments, each segment's records written
+    as plain motion by its own flattener."""
+    body: list = []
+    done = 0
+    for k, seg in enumerate(segments):
+        body.extend(program.body[done:seg.first])
+        body.append(_marker(2 * k))
+        body.extend(program.body[seg.first:seg.last + 1])
+        body.append(_marker(2 * k + 1))
+        done = seg.last + 1
+    body.extend(program.body[done:])
+    marked = dataclasses.replace(program, body=body)
+    interp_diags: list[Diagnostic] = []
+    current: list[Optional[Segment]] = [None]
+    interp: list[Optional[Interpreter]] = [None]
+
+    def hook(rec, work_end, work_center):
+        if rec.file == MARKER_FILE:
+            seg = segments[rec.line // 2]
+            it = interp[0]
+            state = _mode_state(it)
+            if rec.line % 2 == 0:
+                seg.starts += 1
+                seg.diag_mark = len(interp_diags)
+                if state["comp"]:
+                    seg.why_not = "cutter radius compensation is on where it starts"
+                elif state["frame"]:
+                    seg.why_not = "a programmable frame, G92 or local offset is active where it starts"
+                fl = _Flattener(program, machine, seg.notes)
+                fl.interp = it
+                fl.sel, fl.length, fl.motion, fl.plane = None, ("unknown", None), None, None
+                fl.feed, fl.feed_mode, fl.speed, fl.spindle_dir = None, None, it.st.spindle_speed, it.st.spindle_dir
+                fl.mpos = dict(it.mpos)
+                start = [n.ModeChange("units", "mm"), n.ModeChange("distance", "absolute")]
+                if state["arc_absolute"]:
+                    start.append(n.ModeChange("arc_distance", "incremental"))
+                fl.blocks.append(n.Block(_first_span(program, seg), start,
+                                         comment="nctrans: plain motion of a construct the target lacks"))
+                seg.flattener = fl
+                current[0] = seg
+            else:
+                seg.ends += 1
+                seg.end_state = state
+                if state["frame"] and seg.why_not is None:
+                    seg.why_not = "a programmable frame, G92 or local offset is active where it ends"
+                for d in interp_diags[seg.diag_mark:]:
+                    if d.rule == "NC103" or (d.rule == "NC205" and d.severity == "error"):
+                        seg.why_not = seg.why_not or d.message
+                current[0] = None
+            return
+        seg = current[0]
+        if seg is not None and seg.flattener is not None:
+            seg.flattener.hook(rec, work_end, work_center)
+
+    it = Interpreter(marked, machine, diagnostics=interp_diags, resolver=resolver, flatten_hook=hook)
+    interp[0] = it
+    for _ in it.run():
+        pass
+    for seg in segments:
+        if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
+            for d in interp_diags[seg.diag_mark:]:
+                if d.rule == "NC103" or (d.rule == "NC205" and d.severity == "error"):
+                    seg.why_not = seg.why_not or d.message
+
+
+def _first_span(program: n.Program, seg: Segment) -> n.Span:
+    node = program.body[seg.first]
+    return n.Span(program.file, node.span.line)

@@ -1,0 +1,69 @@
+"""Calls kept across dialects: a call of a subprogram that is not in the program is written as a
+call in the target (NC404), and a Sinumerik PROC file becomes the ISO O-number subprogram that call
+reaches, so the two converted files together run as the two sources did."""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+import nctrans
+from conftest import CORPUS
+from nctrans.dialects.iso_m.plan import stable_number
+
+CALLER = "G17 G90 G71\nG0 X0 Y0 Z10\nWIDEN(3, 4)\nG0 X1\nM30\n"
+PROC = "PROC WIDEN(REAL A, REAL B)\nG1 X=A Y=B F100\nG0 Z=A+B\nRET\n"
+
+
+def test_unknown_call_is_kept_with_a_warning_not_refused():
+    conv = nctrans.transpile(CALLER, read="sinumerik", write="iso-m")
+    assert conv.ok, [d.format_text() for d in conv.diagnostics]
+    number = stable_number("WIDEN", set())
+    assert f"G65 P{number} A3. B4." in conv.text.splitlines()
+    warn = [d for d in conv.diagnostics if d.rule == "NC404"]
+    assert [(d.line, d.severity) for d in warn] == [(3, "warning")]
+    assert f"O{number}" in warn[0].message
+
+
+def test_proc_file_and_its_caller_convert_to_files_that_run_together(tmp_path):
+    src = tmp_path / "sin"
+    out = tmp_path / "iso"
+    src.mkdir()
+    out.mkdir()
+    (src / "MAIN.MPF").write_text(CALLER)
+    (src / "WIDEN.SPF").write_text(PROC)
+    number = stable_number("WIDEN", set())
+    proc = nctrans.transpile(src / "WIDEN.SPF", read="sinumerik", write="iso-m")
+    assert proc.ok and proc.text.splitlines()[1] == f"O{number} (WIDEN)"
+    # converted on its own, the caller keeps the call (NC404) to the number the PROC file took
+    main = nctrans.transpile(CALLER, read="sinumerik", write="iso-m")
+    (out / "main.nc").write_text(main.text)
+    (out / f"O{number}.nc").write_text(proc.text)
+    same = nctrans.equiv(src / "MAIN.MPF", out / "main.nc", read_a="sinumerik", read_b="iso-m")
+    assert same, same.message
+    # moves of the subprogram are there: X3 Y4, then Z7
+    records = [r for r in nctrans.toolpath(out / "main.nc", dialect="iso-m") if r.kind in ("linear", "rapid")]
+    assert any(r.end["X"] == 3.0 and r.end["Y"] == 4.0 for r in records)
+    assert any(r.end["Z"] == 7.0 for r in records)
+
+
+def test_corpus_caller_and_proc_file_are_equivalent_converted(tmp_path):
+    daily, warmup = CORPUS / "sinumerik" / "syil-DAILY.MPF", CORPUS / "sinumerik" / "syil-WARMUP_CYCLE.SPF"
+    if not (daily.is_file() and warmup.is_file()):
+        pytest.skip("syil programs not in the shared corpus")
+    src, out = tmp_path / "sin", tmp_path / "iso"
+    src.mkdir()
+    out.mkdir()
+    shutil.copy(daily, src / "DAILY.MPF")
+    shutil.copy(warmup, src / "WARMUP_CYCLE.SPF")
+    number = stable_number("WARMUP_CYCLE", set())
+    main = nctrans.transpile(daily, read="sinumerik", write="iso-m")      # WARMUP_CYCLE not beside it
+    assert main.ok, [d.format_text() for d in main.diagnostics if d.severity == "error"]
+    assert any(d.rule == "NC404" for d in main.diagnostics)
+    proc = nctrans.transpile(warmup, read="sinumerik", write="iso-m")
+    assert proc.ok
+    (out / "daily.nc").write_text(main.text)
+    (out / f"O{number}.nc").write_text(proc.text)
+    same = nctrans.equiv(src / "DAILY.MPF", out / "daily.nc", read_a="sinumerik", read_b="iso-m")
+    assert same, same.message

@@ -1,0 +1,40 @@
+"""The structural-conversion share on the real corpus (bench/bench_structure.py measures it for
+`make bench`; here it is held, not timed). The issue's goals are ISO -> Sinumerik >= 85% and
+Sinumerik -> ISO >= 80%; the floors below are what is reached now, so a change that loses ground
+fails here. Raise them as the share grows."""
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import CORPUS
+
+_SPEC = importlib.util.spec_from_file_location(
+    "bench_structure", Path(__file__).resolve().parents[1] / "bench" / "bench_structure.py")
+bench_structure = importlib.util.module_from_spec(_SPEC)
+sys.modules["bench_structure"] = bench_structure        # its dataclasses look their module up
+_SPEC.loader.exec_module(bench_structure)
+
+FLOORS = {("iso-m", "sinumerik"): 23, ("sinumerik", "iso-m"): 10}
+
+
+@pytest.fixture(scope="module")
+def shares():
+    if not CORPUS.is_dir():
+        pytest.skip("shared corpus not found")
+    return {(s.source, s.target): s for s in bench_structure.structure_share(CORPUS)}
+
+
+@pytest.mark.parametrize("direction", sorted(FLOORS), ids=lambda d: f"{d[0]}->{d[1]}")
+def test_structural_share_holds(shares, direction):
+    share = shares[direction]
+    assert share.count("structural") >= FLOORS[direction], [
+        (o.file, o.state, o.why) for o in share.outcomes if o.state != "structural"]
+
+
+def test_no_program_is_lowered_whole(shares):
+    # the whole-program fallback is gone: a construct is lowered alone or refused at its line
+    assert all(s.count("flattened") == 0 for s in shares.values())
