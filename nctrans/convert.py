@@ -63,6 +63,21 @@ def _library_refusal(program: Program, entry: str, target: str) -> Diagnostic:
                       f"(with --flatten) instead", sub.span.file, sub.span.line, sub.span.col)
 
 
+def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list[Diagnostic]):
+    """(emission, diagnostics) of the whole program lowered to plain motion, the last resort when
+    a construct cannot be lowered on its own; None when that is refused too."""
+    flat_diags: list[Diagnostic] = []
+    flat = lower_for(flatten_with(flat_diags), target, flat_diags)
+    again = target.emit(flat)
+    found = [*(Diagnostic("NC401", "info", f"{d.message} — {target.name} cannot express it, so "
+                          f"{WHOLE_PROGRAM_NOTE} (as with --flatten)", d.file, d.line, d.column,
+                          d.end_line, d.end_column) for d in refusals),
+             *flat_diags, *again.diagnostics]
+    if any(d.severity == "error" for d in found):
+        return None
+    return again, found
+
+
 def lower_for(program: Program, target: Dialect, diags: list[Diagnostic]) -> Program:
     """Run the IR -> IR passes the target lists (Dialect.lowering_passes), in order; each returns
     the new program and its NC401 diagnostics."""
@@ -109,20 +124,22 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
         lowered, notes, remaining = lower_constructs(program, refusals, target.name, machine=machine,
                                                      resolver=resolver)
         others = [d for d in result.diagnostics if not _is_refusal(d)]
-        if lowered is not None:
-            again = target.emit(lowered)
+        again = target.emit(lowered) if lowered is not None else None
+        if again is not None:
             kept = {(d.file, d.line) for d in remaining}
-            # the second emission repeats the first one's notes; its refusals are the ones left
-            diags.extend(others)
-            diags.extend(notes)
-            diags.extend(remaining)
-            diags.extend(d for d in again.diagnostics
-                         if _is_refusal(d) and (d.file, d.line) not in kept)
-            result = again
+            remaining = remaining + [d for d in again.diagnostics
+                                     if _is_refusal(d) and (d.file, d.line) not in kept]
+        whole = _lower_whole(program, target, flatten_with, remaining) if remaining else None
+        if whole is not None:
+            # some construct could not be lowered on its own: the whole program as plain motion
+            diags.extend(whole[1])
+            result, flattened = whole[0], True
         else:
             diags.extend(others)
             diags.extend(notes)
             diags.extend(remaining)
+            if again is not None:
+                result = again
     else:
         diags.extend(result.diagnostics)
     if strict_mode:

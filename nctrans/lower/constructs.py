@@ -154,6 +154,9 @@ def _jumps(nodes: list) -> set[str]:
         if type(node) is n.Block:
             out.update(str(s.target) for s in node.body if type(s) is n.Goto)
             out.update(str(s.to_label) for s in node.body if type(s) is n.Return and s.to_label)
+            # a turning cycle's contour (G71 P.. Q..): the blocks it reads and runs past
+            out.update(str(int(v.value)) for s in node.body if type(s) is n.CycleCall
+                       for k, v in s.params.items() if k in ("start", "end") and type(v) is n.Num)
         elif type(node) is n.Case:
             out.update(str(t) for _, t in node.branches)
             if node.default:
@@ -369,6 +372,9 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
         done = seg.last + 1
     body.extend(program.body[done:])
     marked = dataclasses.replace(program, body=body)
+    homing = {(b.span.file, b.span.line) for seg in segments
+              for b in blocks(program.body[seg.first:seg.last + 1])
+              if any(type(x) is n.HomeReturn for x in b.body)}
     interp_diags: list[Diagnostic] = []
     current: list[Optional[Segment]] = [None]
     interp: list[Optional[Interpreter]] = [None]
@@ -383,6 +389,8 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
                 seg.diag_mark = len(interp_diags)
                 if state["comp"]:
                     seg.why_not = "cutter radius compensation is on where it starts"
+                elif it.st.diameter or getattr(it, "css_surface", None) is not None:
+                    seg.why_not = "diameter programming or constant surface speed is on where it starts"
                 elif state["frame"]:
                     seg.why_not = "a programmable frame, G92 or local offset is active where it starts"
                 fl = _Flattener(program, machine, seg.notes)
@@ -408,8 +416,12 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
                 current[0] = None
             return
         seg = current[0]
-        if seg is not None and seg.flattener is not None:
-            seg.flattener.hook(rec, work_end, work_center)
+        if seg is None or seg.flattener is None:
+            return
+        if (rec.file, rec.line) in homing and rec.kind == "rapid" and rec.start is not None and \
+                rec.end is not None and all(abs(rec.end[a] - rec.start.get(a, rec.end[a])) < 1e-9 for a in rec.end):
+            return      # G28's intermediate point where the tool already is: LinuxCNC does not move
+        seg.flattener.hook(rec, work_end, work_center)
 
     it = Interpreter(marked, machine, diagnostics=interp_diags, resolver=resolver, flatten_hook=hook)
     interp[0] = it
