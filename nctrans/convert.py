@@ -78,6 +78,13 @@ def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list
     return again, found
 
 
+def header(program: Program) -> str:
+    """The header comment of a converted program: what it was converted from, and by what."""
+    from nctrans import __version__
+    file = program.file.replace("(", "[").replace(")", "]")
+    return f"converted by nctrans {__version__} from {program.dialect}: {file}"
+
+
 def lower_for(program: Program, target: Dialect, diags: list[Diagnostic]) -> Program:
     """Run the IR -> IR passes the target lists (Dialect.lowering_passes), in order; each returns
     the new program and its NC401 diagnostics."""
@@ -145,7 +152,8 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
     if strict_mode:
         diags = strict(diags)
     refused = any(d.severity == "error" for d in diags)
-    return Conversion(None if refused else result.text, diags, flattened)
+    text = None if refused else target.with_header(result.text, header(program))
+    return Conversion(text, diags, flattened)
 
 
 # Blocks handed to a streaming emitter at a time: large enough that per-chunk costs vanish,
@@ -187,8 +195,16 @@ def convert_stream(program: Program, target: Dialect, write: Callable[[str], Non
     if not all(getattr(p, "structural_only", False) for p in target.lowering_passes):
         return None             # a pass that may rewrite plain blocks needs the whole program
     from nctrans.dialects.base import CannotStream
+    first = [True]
+
+    def write_with_header(text: str) -> None:
+        if first[0]:
+            first[0] = False
+            text = target.with_header(text, header(program))
+        write(text)
+
     try:
-        found = target.emit_stream(program, stream_chunks(program.body), write)
+        found = target.emit_stream(program, stream_chunks(program.body), write_with_header)
     except CannotStream:
         return Conversion(None, [], retry_whole=True)
     if found is None:

@@ -149,7 +149,7 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
 
     def changed(key: str, value) -> bool:
         nonlocal run
-        if key in state and _close(state[key], value) and key not in ("dwell", "stop", "tool_change"):
+        if key in state and _close(state[key], value) and key not in ("dwell", "stop", "tool_change", "call"):
             return False
         state[key] = value
         run = None
@@ -197,6 +197,10 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
         elif k == "stop":
             if changed("stop", r.stop_kind):
                 yield ("E", "stop", r.stop_kind, r)
+        elif k == "call":
+            call = KeptCall(r.call or "", tuple(r.args or ()))
+            if changed("call", call):
+                yield ("E", "call", call, r)
 
 
 class _Stream:
@@ -436,6 +440,25 @@ def _out_of_step(A: _Run, B: _Run, ab: _Walk, ba: _Walk, tol: float) -> Differen
 
 
 # --------------------------------------------------------------------------- gaps
+
+class KeptCall:
+    """A call event: the same call (nctrans.calls: WARMUP_CYCLE and its O number are one) with the
+    same evaluated arguments."""
+    __slots__ = ("name", "args")
+
+    def __init__(self, name: str, args: tuple):
+        self.name, self.args = name, args
+
+    def __eq__(self, other) -> bool:
+        from nctrans.calls import same_call
+        return (isinstance(other, KeptCall) and same_call(self.name, other.name)
+                and len(self.args) == len(other.args)
+                and all((a is None) == (b is None) and (a is None or _close(float(a), float(b)))
+                        for a, b in zip(self.args, other.args)))
+
+    def __repr__(self) -> str:
+        return f"{self.name}({', '.join('' if a is None else f'{a:g}' for a in self.args)})"
+
 
 def _fmt_event(key: str, value) -> str:
     if key == "feed":

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Optional
 
-KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant", "stop", "limits")
+KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant", "stop", "limits", "call")
 # "limits": programmable travel limits from here on, in machine coordinates (Fagor G198/G199,
 # Sinumerik G25/G26 under WALIMON, ISO G22), of two sorts that replace only their own sort:
 # - without `zone`: `start` holds the lower limits, `end` the upper ones, by axis; an axis absent
@@ -17,6 +17,10 @@ KINDS = ("rapid", "linear", "arc", "dwell", "tool_change", "spindle", "coolant",
 # - with zone "inside": the box from `start` to `end` is forbidden (neither: no zone any more);
 # - with zone "unmodelled": limits are switched here that the interpreter does not model (Sinumerik
 #   protection zones); the check reports that it cannot judge them.
+# "call": a call of a subprogram that is neither in the program nor found (kept as a call when
+# converting): an opaque event at its point of the toolpath, with the name as written (`call`)
+# and the evaluated arguments in the order the callee binds them (`args`; None for one omitted).
+# An extension of CONTRACT's toolpath section; `equiv` compares these events like tool changes.
 
 
 @dataclass(slots=True)
@@ -48,6 +52,8 @@ class ToolpathRecord:
     spindle_limit: Optional[float] = None
     css_axis: Optional[float] = None
     zone: Optional[str] = None             # limits records: "inside" (a forbidden box), "unmodelled"
+    call: Optional[str] = None
+    args: Optional[list] = None
 
     def to_dict(self) -> dict:
         out = {}

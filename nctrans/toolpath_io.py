@@ -164,6 +164,10 @@ def to_json_line(r: ToolpathRecord) -> str:
         s += ',"css_axis":' + _spell(r.css_axis)
     if r.zone is not None:
         s += f',"zone":"{r.zone}"'
+    if r.call is not None:
+        s += ',"call":' + _str(r.call)
+    if r.args is not None:
+        s += ',"args":[' + ",".join("null" if a is None else _spell(a) for a in r.args) + "]"
     s += "}"
     if "nan" in s or "inf" in s:      # a non-finite number (or a file name containing the letters)
         return _safe_json_line(r)

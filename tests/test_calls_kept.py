@@ -67,3 +67,43 @@ def test_corpus_caller_and_proc_file_are_equivalent_converted(tmp_path):
     (out / f"O{number}.nc").write_text(proc.text)
     same = nctrans.equiv(src / "DAILY.MPF", out / "daily.nc", read_a="sinumerik", read_b="iso-m")
     assert same, same.message
+
+
+# ---------------------------------------------------------------- equiv with kept calls
+
+def test_unresolved_call_is_an_opaque_event_in_the_toolpath():
+    records = list(nctrans.toolpath(CALLER, dialect="sinumerik"))
+    kinds = [r.kind for r in records]
+    call = records[kinds.index("call")]
+    assert (call.call, call.args, call.line) == ("WIDEN", [3.0, 4.0], 3)
+    assert kinds.index("call") > 0 and "rapid" in kinds[kinds.index("call"):]
+
+
+def test_equiv_compares_kept_calls_by_identity_and_arguments():
+    conv = nctrans.transpile(CALLER, read="sinumerik", write="iso-m")
+    same = nctrans.equiv(CALLER, conv.text, read_a="sinumerik", read_b="iso-m")
+    assert same, same.message
+    number = stable_number("WIDEN", set())
+    changed = conv.text.replace(f"G65 P{number} A3. B4.", f"G65 P{number} A3. B5.")
+    assert changed != conv.text
+    other = nctrans.equiv(CALLER, changed, read_a="sinumerik", read_b="iso-m")
+    assert not other and "call" in other.message
+    elsewhere = conv.text.replace(f"G65 P{number}", f"G65 P{number + 1}")
+    assert not nctrans.equiv(CALLER, elsewhere, read_a="sinumerik", read_b="iso-m")
+
+
+# ---------------------------------------------------------------- M99 at the end of a main program
+
+def test_m99_main_program_repeats_as_a_loop_never_one_pass():
+    conv = nctrans.transpile("G0 X0 Y0\nG1 X10 F100\nG0 X0\nM99\n", read="iso-m", write="sinumerik")
+    assert conv.ok, [d.format_text() for d in conv.diagnostics]
+    lines = [ln.strip() for ln in conv.text.splitlines()]
+    assert lines.index("LOOP") < lines.index("F100 G1 X10") < lines.index("ENDLOOP")
+    assert not any(ln in ("M30", "M2", "M17") for ln in lines)
+    assert any(d.rule == "NC401" and "LOOP" in d.message for d in conv.diagnostics)
+
+
+def test_m99_of_a_macro_reading_its_arguments_is_its_return():
+    conv = nctrans.transpile("G1 X#24 Y#25 F100\nM99\n", read="iso-m", write="sinumerik")
+    assert conv.ok, [d.format_text() for d in conv.diagnostics]
+    assert "LOOP" not in conv.text and conv.text.splitlines()[-1].strip() in ("M17", "RET")

@@ -133,6 +133,21 @@ class Dialect:
     def emit(self, program: Program) -> EmitResult:
         raise NotImplementedError(f"dialect {self.name} has no emitter")
 
+    # A whole-line comment (the header of a converted program), and the lines that must open a
+    # program before anything else (tape marks, program number, archive header).
+    line_comment: ClassVar[str] = "; {}"
+    opening_lines: ClassVar[str] = r"%"
+
+    def with_header(self, text: str, comment: str) -> str:
+        """`text` with the comment line `comment` after its opening lines."""
+        lines = text.split("\n")
+        opening = re.compile(self.opening_lines)
+        i = 0
+        while i < len(lines) and opening.match(lines[i]):
+            i += 1
+        lines.insert(i, self.line_comment.format(comment))
+        return "\n".join(lines)
+
     def emit_stream(self, program: Program, chunks, write) -> Optional[list[Diagnostic]]:
         """Emit a program that runs straight through, its body given as `chunks` (lists of Blocks
         from a streamed parse), handing the text to `write` as it is produced: emit()'s text and

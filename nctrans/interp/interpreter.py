@@ -2258,6 +2258,7 @@ class Interpreter(LatheMixin, RunChecks):
                               "moves nothing in the analysed toolpath")
                     return unit, unit.code, pc, sidx
                 self.diag("NC103", "warning", f"subprogram {s.name} not found; the call is skipped")
+                self._opaque_call(s)
                 return unit, unit.code, pc, sidx
             if len(self.stack) >= MAX_CALL_DEPTH:
                 self.diag("NC105", "error", f"subprogram calls nested deeper than "
@@ -2289,6 +2290,26 @@ class Interpreter(LatheMixin, RunChecks):
             self.sections += 1
             return ctl[1], ctl[1].code, 0, 0
         return unit, unit.code, pc, sidx
+
+    def _opaque_call(self, s: n.SubCall) -> None:
+        """A call nothing here defines: a "call" record (name, evaluated arguments in binding
+        order: positional ones, then named ones by the local they bind), so a conversion that keeps
+        the call can be compared with its source."""
+        exprs = list(s.args)
+        named = sorted(s.named_args.items(), key=lambda kv: (
+            s.bindings[kv[0]].key if kv[0] in s.bindings and isinstance(s.bindings[kv[0]].key, int)
+            else 1000, kv[0]))
+        exprs += [e for _, e in named]
+        values = []
+        for e in exprs:
+            if type(e) is n.Num and e.text == "":
+                values.append(None)             # an omitted argument
+                continue
+            try:
+                values.append(self._value(self.ev.compile(e), "call argument"))
+            except EvalError:
+                values.append(None)
+        self._record("call", call=s.name, args=values)
 
     def _return(self, to_label):
         fr = self.stack[-1]

@@ -80,6 +80,8 @@ class IsoFamily(Dialect):
     subclasses of frontend.Lowering and emitter.IsoEmitter with the same table and the handlers
     that differ overridden."""
     markers = ISO_MARKERS
+    line_comment = "({})"
+    opening_lines = r"%|[Oo]\d+\b|:\d+\b"
     comment_evidence = {"paren_comment": (1.0, 3)}
     subprogram_endings = (".nc", ".NC", ".tap", ".TAP", ".ngc", ".cnc", ".iso", ".eia", ".txt")
     streams = True

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import math
 import re
-import zlib
 from dataclasses import dataclass, field
 from typing import Optional
 
+from nctrans import calls
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks, walk
 
@@ -45,12 +45,9 @@ def iso_number(name: str) -> Optional[int]:
 
 
 def stable_number(name: str, taken: set[int]) -> int:
-    """O9000..O9999 from the name alone (the same name gets the same number in every file that
-    defines it), the next free one on a clash within this program."""
-    num = 9000 + zlib.crc32(name.upper().encode()) % 1000
-    while num in taken:
-        num = 9000 + (num - 9000 + 1) % 1000
-    return num
+    """O9000..O9999 from the name alone: the documented mapping of nctrans.calls, so a converted
+    caller and the converted subprogram file meet."""
+    return calls.stable_number(name, taken)
 
 
 @dataclass

@@ -56,6 +56,7 @@ MARKERS = (
 
 class Sinumerik(Dialect):
     name = "sinumerik"
+    opening_lines = r"%|;\$PATH="
     description = "Siemens Sinumerik 840D/840Di/810D (SW 6)"
     extensions = (".mpf", ".spf", ".MPF", ".SPF")
     markers = MARKERS

@@ -379,7 +379,8 @@ class Emitter:
                 out.words.append("RET" if out.only else "M17")
         elif isinstance(s, ir.ProgramEnd):
             if s.kind == "restart":
-                self.refuse("program restart (M99 in a main program) has no Sinumerik equivalent")
+                self.refuse("program restart (M99) in the middle of a main program has no Sinumerik "
+                            "equivalent")
             out.words.append("M30" if s.kind == "end_rewind" else "M2")
         elif isinstance(s, ir.Stop):
             out.words.append("M1" if s.optional else "M0")
@@ -899,9 +900,34 @@ class Emitter:
 
     def program(self) -> str:
         self.head()
-        self.unit(self.p.body)
+        self.unit(self.restart_as_loop(self.p.body))
         self.subprograms()
         return "\n".join(self.lines) + "\n"
+
+    def restart_as_loop(self, body: list) -> list:
+        """ISO M99 at the end of a main program from another dialect. In a program that reads G65
+        arguments (#1-#33 it never sets) it is the macro's return: M17. Otherwise the control starts
+        the program again for ever: the body runs inside LOOP ... ENDLOOP (never one pass)."""
+        if self.p.dialect == DIALECT or type(body) is not list:
+            return body
+        last = next((i for i in range(len(body) - 1, -1, -1)
+                     if isinstance(body[i], ir.Block) and body[i].body), None)
+        if last is None or not any(isinstance(s, ir.ProgramEnd) and s.kind == "restart"
+                                   for s in body[last].body):
+            return body
+        b = body[last]
+        self.span = b.span
+        if _reads_arguments(body):
+            self.info("m99-return", "M99 at the end of a program that reads G65 arguments is its "
+                                    "return: written M17")
+            new = [ir.Return() if isinstance(s, ir.ProgramEnd) else s for s in b.body]
+            return body[:last] + [ir.Block(b.span, new, b.number, b.label, b.skip, b.comment)] + body[last + 1:]
+        self.info("m99-loop", "M99 in a main program (it starts again for ever) written as "
+                              "LOOP ... ENDLOOP")
+        rest = [s for s in b.body if not (isinstance(s, ir.ProgramEnd) and s.kind == "restart")]
+        inner = body[:last] + ([ir.Block(b.span, rest, b.number, b.label, b.skip, b.comment)]
+                               if rest or b.number or b.comment else [])
+        return [ir.Loop(body[0].span if body else b.span, inner)] + body[last + 1:]
 
     def head(self) -> None:
         """What comes before the main body: archive header, path, power-on modes."""
@@ -941,6 +967,43 @@ class Emitter:
                 self.lines.append(head)
             self.st = _State()
             self.unit(sub.body)
+
+
+def _reads_arguments(body: list) -> bool:
+    """Whether a program reads ISO locals #1-#33 it never sets: the G65 arguments of a macro."""
+    read: set = set()
+    written: set = set()
+
+    def expr(e) -> None:
+        if isinstance(e, ir.Var):
+            if e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= 33:
+                read.add(e.key)
+            for i in e.indices or ():
+                expr(i)
+        elif isinstance(e, (list, tuple)):
+            for x in e:
+                expr(x)
+        elif isinstance(e, dict):
+            for x in e.values():
+                expr(x)
+        elif hasattr(e, "__slots__") and not isinstance(e, (ir.Num, ir.Str, ir.Span)):
+            for f in e.__slots__:
+                expr(getattr(e, f, None))
+
+    for node in walk.walk(body):
+        if isinstance(node, ir.Block):
+            for s in node.body:
+                if isinstance(s, ir.Assign):
+                    if s.target.space == "num" and isinstance(s.target.key, int):
+                        written.add(s.target.key)
+                    expr(s.value)
+                    expr(s.target.indices)
+                else:
+                    expr(s)
+        else:
+            for attr in ("cond", "subject", "start", "end", "step"):
+                expr(getattr(node, attr, None))
+    return bool(read - written)
 
 
 def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
