@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+import nctrans
 from nctrans import cli
 from nctrans.dialects import base
 from nctrans.dialects.base import Dialect, EmitResult, ParseResult
@@ -264,9 +265,10 @@ def test_convert_to_stdout_file_and_out_dir(fake, capsys):
     Path("a.fk").write_text("G0 X1\nG1 X2 F100\n")
     Path("b.fk").write_text("G0 X5\n")
     rc, out, _ = run(capsys, "convert", "a.fk", "--to", "fake")
-    assert rc == 0 and out == "N1 ; 2 statements\nN2 ; 3 statements\n"
+    head = f"; converted by nctrans {nctrans.__version__} from fake: a.fk\n"     # the header comment
+    assert rc == 0 and out == head + "N1 ; 2 statements\nN2 ; 3 statements\n"
     rc, out, _ = run(capsys, "convert", "a.fk", "--to", "fake", "-o", "out/x.txt")
-    assert rc == 0 and out == "" and Path("out/x.txt").read_text().startswith("N1 ;")
+    assert rc == 0 and out == "" and Path("out/x.txt").read_text().startswith(head + "N1 ;")
     rc, _, _ = run(capsys, "convert", "a.fk", "b.fk", "--to", "fake", "--out-dir", "conv")
     assert rc == 0 and sorted(p.name for p in Path("conv").iterdir()) == ["a.nc", "b.nc"]
     assert not [p for p in Path("conv").iterdir() if p.name.startswith(".")]   # no temp files left

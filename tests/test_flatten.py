@@ -382,7 +382,8 @@ def test_flattened_toolpath_equals_source(key):
     # lowering); the record comparison applies it to the source, equiv below checks geometry
     problem = record_differences(_split(c.records), c.flat_records)
     assert problem is None, problem
-    diff = equiv.compare(c.records, c.flat_records)
+    # an unresolved call (NC402 for --flatten) is an event of the source only
+    diff = equiv.compare([r for r in c.records if r.kind != "call"], c.flat_records)
     assert diff is None, diff.format()
     # nothing new goes wrong in the flattened program
     assert not [d for d in c.flat_diags if d.severity == "error"], c.flat_diags

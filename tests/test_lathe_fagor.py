@@ -29,7 +29,8 @@ def test_iso_t_program_written_structurally_with_lathe_modes_and_g192():
     assert conv.ok, conv.diagnostics
     lines = _lines(conv.text)
     assert "flattened" not in conv.text
-    assert lines[1] == "G18 G95 G151"                   # before anything reads a word
+    assert lines[1].startswith("(converted by nctrans")   # the header comment
+    assert lines[2] == "G18 G95 G151"                   # before anything reads a word
     assert "G192 S2000" in lines and "G96 S200 M3" in lines and "G00 X40 Z2" in lines
     assert bool(nctrans.equiv(TURN, conv.text, read_a="iso-t", read_b="fagor"))
     back = nctrans.transpile(conv.text, read="fagor", write="iso-t")
@@ -73,7 +74,7 @@ def test_flattened_lathe_program_says_g152_and_round_trips(path):
     src = path.read_text(encoding="utf-8")
     conv = nctrans.transpile(src, read="iso-t", write="fagor")
     assert conv.ok, conv.diagnostics
-    assert _lines(conv.text)[1] == "G152" and "flattened" in conv.text
+    assert _lines(conv.text)[2] == "G152" and "flattened" in conv.text   # [1]: the header
     assert bool(nctrans.equiv(src, conv.text, read_a="iso-t", read_b="fagor"))
     back = nctrans.transpile(conv.text, read="fagor", write="iso-t")
     assert back.ok, back.diagnostics
