@@ -234,7 +234,15 @@ def convert_flat_stream(program: Program, target: Dialect, blocks: Callable[[lis
     flat_diags: list[Diagnostic] = []
     shell = Program(program.file, program.dialect, [], {}, meta, None)
     try:
-        found = target.emit_stream(shell, stream_chunks(blocks(flat_diags)), write)
+        first = [True]
+
+        def write_with_header(text: str) -> None:
+            if first[0]:
+                first[0] = False
+                text = target.with_header(text, header(program))
+            write(text)
+
+        found = target.emit_stream(shell, stream_chunks(blocks(flat_diags)), write_with_header)
     except CannotStream:
         return None
     if found is None:
