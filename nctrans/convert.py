@@ -195,16 +195,9 @@ def convert_stream(program: Program, target: Dialect, write: Callable[[str], Non
     if not all(getattr(p, "structural_only", False) for p in target.lowering_passes):
         return None             # a pass that may rewrite plain blocks needs the whole program
     from nctrans.dialects.base import CannotStream
-    first = [True]
-
-    def write_with_header(text: str) -> None:
-        if first[0]:
-            first[0] = False
-            text = target.with_header(text, header(program))
-        write(text)
-
     try:
-        found = target.emit_stream(program, stream_chunks(program.body), write_with_header)
+        found = target.emit_stream(program, stream_chunks(program.body),
+                                   _with_header(target, program, write))
     except CannotStream:
         return Conversion(None, [], retry_whole=True)
     if found is None:
@@ -215,6 +208,19 @@ def convert_stream(program: Program, target: Dialect, write: Callable[[str], Non
         return Conversion(None, diags, retry_whole=True)
     refused = any(d.severity == "error" for d in diags)
     return Conversion(None if refused else "", diags)
+
+
+def _with_header(target: Dialect, program: Program,
+                 write: Callable[[str], None]) -> Callable[[str], None]:
+    """`write` that puts the conversion's header comment into the first chunk a stream writes."""
+    first = [True]
+
+    def write_with_header(text: str) -> None:
+        if first[0]:
+            first[0] = False
+            text = target.with_header(text, header(program))
+        write(text)
+    return write_with_header
 
 
 def convert_flat_stream(program: Program, target: Dialect, blocks: Callable[[list], Iterable],
@@ -234,15 +240,8 @@ def convert_flat_stream(program: Program, target: Dialect, blocks: Callable[[lis
     flat_diags: list[Diagnostic] = []
     shell = Program(program.file, program.dialect, [], {}, meta, None)
     try:
-        first = [True]
-
-        def write_with_header(text: str) -> None:
-            if first[0]:
-                first[0] = False
-                text = target.with_header(text, header(program))
-            write(text)
-
-        found = target.emit_stream(shell, stream_chunks(blocks(flat_diags)), write_with_header)
+        found = target.emit_stream(shell, stream_chunks(blocks(flat_diags)),
+                                   _with_header(target, program, write))
     except CannotStream:
         return None
     if found is None:
