@@ -134,7 +134,8 @@ def test_tool_change_that_stops_the_spindle():
 UNITS = {
     "iso-m": ("G21 G17 G0 X0 Y0 Z0\nG1 X10 F250\nG20\nG1 X1\nM30\n", "G20", "G21"),
     "fagor": ("G71 G17 G0 X0 Y0 Z0\nG1 X10 F250\nG70\nG1 X1\nM30\n", "G70", "G71"),
-    "sinumerik": ("G71 G17 G0 X0 Y0 Z0\nG1 X10 F250\nG70\nG1 X1\nM30\n", "G70", "G71"),
+    # Sinumerik G70/G71 leave feeds in the basic system; G700/G710 switch them too
+    "sinumerik": ("G710 G17 G0 X0 Y0 Z0\nG1 X10 F250\nG700\nG1 X1\nM30\n", "G700", "G710"),
     "iso-t": ("G21 G18 G99\nG0 X20 Z2\nG1 Z0 F0.1\nG20\nG1 Z-0.1\nM30\n", "G20", "G21"),
 }
 
@@ -149,6 +150,11 @@ def test_feed_after_a_unit_switch(dialect):
     assert found("\n".join(lines) + "\n", dialect) == []                 # F restated
     back = text.replace(f"{inch}\n", f"{inch}\nG0 Z5\n{metric}\n")        # switched back first
     assert found(back, dialect) == []
+
+
+def test_sinumerik_g70_keeps_the_feed_unit():
+    """G70 changes lengths only: F250 still means 250 mm/min, so nothing to report."""
+    assert found("G71 G17 G0 X0 Y0 Z0\nG1 X10 F250\nG70\nG1 X1\nM30\n", "sinumerik") == []
 
 
 def test_unit_switch_in_a_run_of_plain_blocks():

@@ -269,7 +269,7 @@ def test_ac_ic_per_word():
 def test_modes_map_to_neutral_values():
     s = stmts("G18 G42 G70 G91 G95 G64 G9 DIAMON")
     assert [(x.group, x.value) for x in s] == [
-        ("plane", "ZX"), ("cutter_comp", "right"), ("units", "inch"), ("distance", "incremental"),
+        ("plane", "ZX"), ("cutter_comp", "right"), ("units", "inch_geometry"), ("distance", "incremental"),
         ("feed_mode", "per_rev"), ("path_mode", "continuous"), ("exact_stop_once", "on"),
         ("diameter", "diameter")]
     assert stmts("G700")[0] == ir.ModeChange("units", "inch", "G700")
@@ -426,3 +426,13 @@ def test_motion_word_table_names_real_parts_of_a_block():
     assert table
     for name, part in table.items():
         assert part.startswith("polar.") or part in fields, (name, part)
+
+
+def test_g70_inch_lengths_keep_feeds_metric_g700_converts_both():
+    """Seed group 13: G70/G71 switch geometry only, feeds stay in the basic system (metric here);
+    G700/G710 switch feeds too. 1 inch = 25.4 mm; F100 in/min = 2540 mm/min."""
+    import nctrans
+    text = "G70 G1 X1 F100\nG700 G1 X2 F100\nG71 G1 X0 F100\nM30\n"
+    moves = [r for r in nctrans.toolpath(text, "sinumerik") if r.kind == "linear"]
+    assert [(round(m.end["X"], 6), m.feed) for m in moves] == [
+        (25.4, 100.0), (50.8, 2540.0), (0.0, 100.0)]

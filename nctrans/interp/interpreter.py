@@ -123,7 +123,7 @@ class Frame:
 # Modal groups a SAVE subprogram does not restore: not G codes (spindle, coolant, tool length),
 # or state whose restoring mid-path would need its own approach (cutter compensation, cycles).
 NOT_SAVED_GROUPS = frozenset(("spindle", "coolant", "tool_length", "cutter_comp", "cycle"))
-SAVED_ATTRS = ("motion", "plane", "incremental", "arc_absolute", "scale", "feed_mode",
+SAVED_ATTRS = ("motion", "plane", "incremental", "arc_absolute", "scale", "feed_scale", "feed_mode",
                "work_offset", "cycle_retract")
 
 
@@ -743,7 +743,7 @@ class Interpreter(LatheMixin, RunChecks):
             self.diag("NC105", "error", f"negative feed {v:g}")
             return
         st = self.st
-        st.feed = v if st.feed_mode == "inverse_time" else v * st.scale
+        st.feed = v if st.feed_mode == "inverse_time" else v * st.feed_scale
         self.feed_reported = False
         self._rc_feed_set()
 
@@ -1426,7 +1426,7 @@ class Interpreter(LatheMixin, RunChecks):
                 steps=None) -> None:
         st = self.st
         feed = p.get("feed")
-        feed = feed * st.scale if feed is not None else (st.feed or 0.0)
+        feed = feed * st.feed_scale if feed is not None else (st.feed or 0.0)
         if not feed:
             self._need_feed()
         if repeat < 1:
@@ -2136,7 +2136,8 @@ class Interpreter(LatheMixin, RunChecks):
                 or self.comp is not None or self.comp_exit or st.comp_side != "off"
                 or not self.frame.identity or self.modal_call is not None or self.hook is not None
                 or st.feed_mode not in ("per_min", "per_rev") or self.out
-                or self.unmodelled_motion is not None or self.spindle_stopped or self.watch):
+                or self.unmodelled_motion is not None or self.spindle_stopped or self.watch
+                or st.feed_scale != st.scale):     # the kernel scales F as it scales lengths
             return False
         axes = "".join(self.pos)
         return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)
@@ -2172,7 +2173,7 @@ class Interpreter(LatheMixin, RunChecks):
             if feed_seen:
                 st.feed = feed
                 self.feed_reported = False
-                self._rc_feed_scale = st.scale
+                self._rc_feed_scale = st.feed_scale
             if records:
                 if write:
                     self.out.append(JsonChunk(chunk, records))

@@ -80,9 +80,9 @@ class RunChecks:
             elif prev != "off" and value == "off":
                 self._rc_entry, self._rc_exit = False, True
         elif group == "units":
-            new = INCH if value == "inch" else 1.0
+            new = INCH if value == "inch" else 1.0      # the feed unit (inch_geometry: mm)
             fed = self._rc_feed_scale
-            if new == st.scale:
+            if new == st.feed_scale:
                 return
             if fed is None or fed == new or not st.feed or st.feed_mode == "inverse_time":
                 self._rc_feed_units = None      # no feed, or back in the units it was read in
@@ -97,7 +97,7 @@ class RunChecks:
 
     def _rc_feed_set(self) -> None:
         """An F word: the feed in force is programmed in the units in force."""
-        self._rc_feed_scale = self.st.scale
+        self._rc_feed_scale = self.st.feed_scale
         if self._rc_feed_units is not None:
             self._rc_feed_units = None
             self._rc_rewatch()
@@ -110,7 +110,7 @@ class RunChecks:
             self._rc_feed_units = None
             st = self.st
             number = st.feed / scale
-            now = "inch" if st.scale != 1.0 else "mm"
+            now = "inch" if st.feed_scale != 1.0 else "mm"
             per = "mm/rev" if st.feed_mode == "per_rev" else "mm/min"
             self.diag("NC214", "warning",
                       f"feed move after the switch to {now} (line {line}) with the feed rate read in {unit}: "

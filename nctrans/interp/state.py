@@ -15,7 +15,7 @@ BASE_AXES = ("X", "Y", "Z")
 
 
 class ModalState:
-    __slots__ = ("groups", "motion", "plane", "incremental", "arc_absolute", "scale", "feed_mode",
+    __slots__ = ("groups", "motion", "plane", "incremental", "arc_absolute", "scale", "feed_scale", "feed_mode",
                  "feed", "spindle_speed", "spindle_dir", "tool", "tool_selected", "length_mode",
                  "length_index", "comp_side", "radius_index", "work_offset", "cycle",
                  "cycle_retract", "coolant", "diameter")
@@ -27,6 +27,7 @@ class ModalState:
         self.incremental = False
         self.arc_absolute = False
         self.scale = 1.0                  # program length unit -> mm
+        self.feed_scale = 1.0             # program feed unit -> mm (Sinumerik G70: feeds stay mm)
         self.feed_mode = "per_min"
         self.feed: Optional[float] = None         # mm/min (or mm/rev, or 1/min inverse time)
         self.spindle_speed: Optional[float] = None
@@ -57,7 +58,8 @@ class ModalState:
         elif group == "arc_distance":
             self.arc_absolute = value == "absolute"
         elif group == "units":
-            self.scale = INCH if value == "inch" else 1.0
+            self.scale = INCH if value in ("inch", "inch_geometry") else 1.0
+            self.feed_scale = INCH if value == "inch" else 1.0
         elif group == "feed_mode":
             self.feed_mode = value
         elif group == "tool_length":

@@ -12,7 +12,9 @@ MODAL_GROUPS: dict[str, tuple[str, ...]] = {
     "plane": ("XY", "ZX", "YZ"),
     "distance": ("absolute", "incremental"),
     "arc_distance": ("incremental", "absolute"),          # ISO G91.1 / G90.1
-    "units": ("mm", "inch"),
+    # inch_geometry: lengths in inch, feeds in the basic system (mm) - Sinumerik G70; "inch" also
+    # reads feeds in inch (ISO G20, Sinumerik G700)
+    "units": ("mm", "inch", "inch_geometry"),
     "feed_mode": ("per_min", "per_rev", "inverse_time"),
     "cutter_comp": ("off", "left", "right"),
     "tool_length": ("off", "plus", "minus"),

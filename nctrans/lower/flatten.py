@@ -161,7 +161,7 @@ class _Walker:
             if s.indirect:
                 self.note("expr", span)
         elif t is n.ModeChange:
-            if s.group == "units" and s.value == "inch":
+            if s.group == "units" and s.value in ("inch", "inch_geometry"):
                 self.note("units", span)
             elif s.group == "cutter_comp" and s.value != "off":
                 self.note("comp", span)
