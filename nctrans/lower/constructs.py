@@ -97,6 +97,31 @@ def _modal_runs(body: list) -> list[tuple[int, int]]:
     return runs
 
 
+def _inch_geometry_runs(body: list) -> list[tuple[int, int]]:
+    """(first, last) top-level indices from a node that selects inch geometry with metric feeds
+    (Sinumerik G70, neutral units=inch_geometry) to the node before the block that selects other
+    units (the end of the body when nothing does). A target without that mode (ISO, Fagor: their inch reads F in
+    inch too) lowers the whole run, so no F of the source is read in the wrong unit after it."""
+    runs = []
+    start: Optional[int] = None
+    for i, node in enumerate(body):
+        if start is None:
+            if any(type(s) is n.ModeChange and s.group == "units" and s.value == "inch_geometry"
+                   for x in walk([node]) if type(x) is n.Block for s in x.body):
+                start = i
+        elif type(node) is n.Block and any(type(s) is n.ModeChange and s.group == "units"
+                                           and s.value != "inch_geometry" for s in node.body):
+            runs.append((start, i - 1))
+            start = None
+    if start is not None:
+        runs.append((start, len(body) - 1))
+    return runs
+
+
+def _sets_units(node) -> bool:
+    return type(node) is n.Block and any(type(s) is n.ModeChange and s.group == "units" for s in node.body)
+
+
 def _vars(obj, out: set) -> None:
     """Every variable (space, key) an IR object mentions."""
     if obj is None or isinstance(obj, (str, int, float, bool, n.Num, n.Str, n.Span)):
@@ -180,6 +205,10 @@ def _segments(program: n.Program, refusals: list[Diagnostic]) -> tuple[list[Segm
         for seg in found:
             if seg.first <= b and seg.last >= a:
                 seg.first, seg.last = min(seg.first, a), max(seg.last, b)
+    for a, b in _inch_geometry_runs(body):
+        for seg in found:
+            if seg.first <= a <= seg.last:     # the target refused the mode itself
+                seg.last = max(seg.last, b)
     found.sort(key=lambda s: s.first)
     merged: list[Segment] = []
     for seg in found:
@@ -250,18 +279,19 @@ def _mode_state(interp: Interpreter) -> dict:
     st = interp.st
     return {"units": st.groups.get("units"), "distance": st.groups.get("distance"),
             "plane": st.plane, "motion": st.motion, "feed_mode": st.feed_mode, "feed": st.feed,
-            "scale": st.scale, "work_offset": st.work_offset, "length_mode": st.length_mode,
+            "scale": st.scale, "feed_scale": st.feed_scale, "work_offset": st.work_offset, "length_mode": st.length_mode,
             "length_index": st.length_index, "arc_absolute": st.arc_absolute,
             "comp": st.comp_side != "off" or interp.comp is not None,
             "frame": not interp.frame.identity or any(v for v in interp.off.g92.values())}
 
 
-def _restore(seg: Segment, span: n.Span) -> n.Block:
-    """The source's modes at the segment's end, where the plain motion left others."""
+def _restore(seg: Segment, span: n.Span, units_follow: bool) -> n.Block:
+    """The source's modes at the segment's end, where the plain motion left others (`units_follow`:
+    nothing of the main body follows, or the next block selects its own units)."""
     st, fl = seg.end_state, seg.flattener
     body: list = []
-    if st["units"] == "inch":
-        body.append(n.ModeChange("units", "inch"))
+    if st["units"] == "inch" or (st["units"] == "inch_geometry" and not units_follow):
+        body.append(n.ModeChange("units", st["units"]))
     if st["distance"] == "incremental":
         body.append(n.ModeChange("distance", "incremental"))
     if st["arc_absolute"]:
@@ -284,8 +314,8 @@ def _restore(seg: Segment, span: n.Span) -> n.Block:
     if fl.motion is not None and st["motion"] != fl.motion and \
             st["motion"] in ("rapid", "linear", "arc_cw", "arc_ccw"):
         body.append(n.ModeChange("motion", st["motion"]))
-    if st["feed"] is not None and fl.feed is not None and (st["feed"] != fl.feed or st["units"] == "inch"):
-        scale = st["scale"] if st["feed_mode"] != "inverse_time" else 1.0
+    if st["feed"] is not None and fl.feed is not None and (st["feed"] != fl.feed or st["feed_scale"] != 1.0):
+        scale = st["feed_scale"] if st["feed_mode"] != "inverse_time" else 1.0
         body.append(n.Feed(n.Num(round(st["feed"] / scale, 9))))
     return n.Block(span, body, comment="nctrans: modes of the source restored" if body else None)
 
@@ -344,7 +374,8 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
         new_body.extend(program.body[done:seg.first])
         new_body.extend(seg.flattener.blocks)
         last_span = n.Span(program.file, last_line)
-        restore = _restore(seg, last_span) if not ended else None
+        units_follow = seg.last == len(program.body) - 1 or _sets_units(program.body[seg.last + 1])
+        restore = _restore(seg, last_span, units_follow) if not ended else None
         if restore is not None and restore.body:
             new_body.append(restore)
         done = seg.last + 1
