@@ -197,7 +197,7 @@ def cmd_convert(args) -> int:
                                  "overwrite it (--overwrite replaces existing files)")
             written.update((key, s) for key in keys)
         outputs[s] = out
-    machine = pipeline.load_machine(args.machine, args.from_) if args.flatten else None
+    machine = pipeline.load_machine(args.machine, args.from_) if args.flatten or args.machine else None
     status = EXIT_OK
     bar = _progress(len(sources), "convert")
     for s in sources:

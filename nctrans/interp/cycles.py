@@ -386,6 +386,24 @@ class SwivelModes:
 
 
 @dataclass
+class MillingCycle:
+    """A milling cycle nctrans models ([[milling]]): `shape` picks the motion (milling_cycles.py)."""
+    __pydantic_config__ = {"extra": "forbid"}
+    name: str
+    shape: Literal["rect_pocket", "circ_pocket", "rect_spigot", "circ_spigot", "slots_circle",
+                   "arc_slots", "long_holes", "face", "thread_mill"]
+    params: list[str]
+    meaning: str = ""
+
+
+@dataclass
+class MillingParam:
+    __pydantic_config__ = {"extra": "forbid"}
+    unit: Literal["length", "feed", "angle", "code", "count", "speed"]
+    meaning: str
+
+
+@dataclass
 class CycleTable:
     """rules/cycles.toml: Siemens standard cycles, hole patterns and CYCLE800 (schema for pydantic)."""
     __pydantic_config__ = {"extra": "forbid"}
@@ -398,6 +416,9 @@ class CycleTable:
     positioning: dict[str, Literal["clear_level", "current"]] = field(default_factory=dict)
     unmodelled: list[UnmodelledCycle] = field(default_factory=list)
     metric_coarse_pitch: dict[str, float] = field(default_factory=dict)
+    milling: list[MillingCycle] = field(default_factory=list)
+    milling_param: dict[str, MillingParam] = field(default_factory=dict)
+    milling_model: dict[str, float] = field(default_factory=dict)
 
     @classmethod
     def from_data(cls, d: dict) -> "CycleTable":
@@ -412,7 +433,10 @@ class CycleTable:
                    swivel_retract=SwivelModes(**d["swivel_retract"]),
                    positioning=dict(d.get("positioning", {})),
                    unmodelled=[UnmodelledCycle(**u) for u in d.get("unmodelled", [])],
-                   metric_coarse_pitch=dict(d.get("metric_coarse_pitch", {})))
+                   metric_coarse_pitch=dict(d.get("metric_coarse_pitch", {})),
+                   milling=[MillingCycle(**m) for m in d.get("milling", [])],
+                   milling_param={k: MillingParam(**v) for k, v in d.get("milling_param", {}).items()},
+                   milling_model=dict(d.get("milling_model", {})))
 
     def position_at(self, dialect: str) -> str:
         """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle)."""
@@ -435,6 +459,11 @@ def unmodelled_cycle(name: str) -> Optional[UnmodelledCycle]:
         if u.name == name.upper():
             return u
     return None
+
+
+def milling_cycle(name: str) -> Optional[MillingCycle]:
+    """A milling cycle nctrans models ([[milling]]), or None."""
+    return next((m for m in cycle_table().milling if m.name == name.upper()), None)
 
 
 def named_cycles() -> dict[str, CycleSignature]:

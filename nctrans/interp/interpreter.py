@@ -52,6 +52,7 @@ from nctrans.toolpath import ToolpathRecord
 from nctrans.toolpath_io import _spell, _str as _json_str    # the kernel writes as the writer does
 
 from nctrans.interp.cutter_comp import CutterCompensator, PlannedMove
+from nctrans.interp.milling_cycles import run_milling_cycle
 from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, expand_cycle, hole_pattern,
                                    plane_cycle_levels, swivel_plan, tap_steps, unmodelled_cycle)
 
@@ -1485,6 +1486,8 @@ class Interpreter(LatheMixin, RunChecks):
         if s.kind == "swivel_plane":
             self._swivel_plane(s)
             return
+        if s.kind == "milling":
+            return run_milling_cycle(self, s)
         if s.modal:
             self.modal_cycle = s
             return
@@ -1496,7 +1499,8 @@ class Interpreter(LatheMixin, RunChecks):
         arguments in their places (omitted ones as the control passes them) instead of the
         built-in model. MCALL makes it a modal call like any subprogram's."""
         table = cycle_table()
-        spec = ({c.name: c for c in table.cycle} | {p.name: p for p in table.pattern}).get(s.name.upper())
+        spec = ({c.name: c for c in table.cycle} | {p.name: p for p in table.pattern}
+                | {m.name: m for m in table.milling}).get(s.name.upper())
         params = list(spec.params) if spec is not None else []
         args = [s.params.get(table.neutral(p), n.Num(0.0, "")) for p in params]
         if s.modal:

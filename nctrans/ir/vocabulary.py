@@ -74,7 +74,7 @@ VAR_SPACES = ("num", "R", "name", "system", "arg", "local")
 # CycleCall kinds beyond the "cycle" modal values: hole patterns that run the modal cycle at each
 # position (Sinumerik HOLES1/HOLES2, parameters in rules/cycles.toml [[pattern]]).
 CYCLE_CALL_KINDS = MODAL_GROUPS["cycle"] + ("holes_line", "holes_circle", "holes_grid",
-                                             "swivel_plane")
+                                             "swivel_plane", "milling")
 
 # Passthrough reasons for constructs known to have no effect on the programmed path (front ends
 # give these; nctrans.interp.unmodelled and --flatten pass over them without a warning). A reason

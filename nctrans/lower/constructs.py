@@ -26,7 +26,7 @@ from typing import Callable, Optional
 
 from nctrans.diagnostics import Diagnostic
 from nctrans.interp.interpreter import Interpreter
-from nctrans.lower.flatten import ISO_OFFSETS, _Flattener, _Walker
+from nctrans.lower.flatten import ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Walker
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks, walk
 
@@ -442,7 +442,7 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
                 if state["frame"] and seg.why_not is None:
                     seg.why_not = "a programmable frame, G92 or local offset is active where it ends"
                 for d in interp_diags[seg.diag_mark:]:
-                    if d.rule == "NC103" or (d.rule == "NC205" and d.severity == "error"):
+                    if d.rule in UNMODELLED_RULES or (d.rule == "NC205" and d.severity == "error"):
                         seg.why_not = seg.why_not or d.message
                 current[0] = None
             return
@@ -461,7 +461,7 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
     for seg in segments:
         if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
             for d in interp_diags[seg.diag_mark:]:
-                if d.rule == "NC103" or (d.rule == "NC205" and d.severity == "error"):
+                if d.rule in UNMODELLED_RULES or (d.rule == "NC205" and d.severity == "error"):
                     seg.why_not = seg.why_not or d.message
 
 

@@ -54,6 +54,9 @@ _EPS = 0.5 * 10 ** -DECIMALS
 ISO_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
 CENTRE_WORD = {"X": "I", "Y": "J", "Z": "K"}
 STRUCTURE = (n.If, n.While, n.ForLoop, n.Loop, n.RepeatUntil, n.Case)
+# Diagnostics saying a construct was skipped and moved nothing (NC103 not modelled; NC224/NC225 a
+# milling cycle that cannot run here): output lowered from that run would lack its motion.
+UNMODELLED_RULES = ("NC103", "NC224", "NC225")
 
 _M_FUNCTION = re.compile(r"^\s*(?:M\d+(?:\.\d+)?(?:\s*=\s*\d+)?\s*)+$", re.IGNORECASE)
 
@@ -511,7 +514,7 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
         walker.diags = diagnostics
     diagnostics.extend(interp_diags)
     for d in interp_diags:
-        if d.rule == "NC103" or (d.rule == "NC205" and "budget" in d.message):
+        if d.rule in UNMODELLED_RULES or (d.rule == "NC205" and "budget" in d.message):
             diagnostics.append(Diagnostic("NC402", "error", f"--flatten output would be incomplete: "
                                           f"{d.message}", d.file, d.line, d.column, d.end_line,
                                           d.end_column))

@@ -529,6 +529,7 @@ class Emitter:
         entries = {x.name: x.params for x in t.cycle}
         entries.update({x.name: x.params for x in t.pattern})
         entries.update({x.name: x.params for x in t.swivel})
+        entries.update({x.name: x.params for x in t.milling})
         name = c.name if c.name in entries else next(
             (x.name for x in t.cycle if x.kind == c.kind), None)
         if name is None:

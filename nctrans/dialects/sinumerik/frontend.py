@@ -90,6 +90,8 @@ def _cycles():
                        [t.neutral(x) for x in p.params], None)
     for c in t.swivel:                   # CYCLE800 swivel plane: a frame change, not a hole
         out[c.name] = (c.kind, [t.neutral(x) for x in c.params], None)
+    for c in t.milling:                  # POCKET1 ...: milling cycles (interp.milling_cycles)
+        out[c.name] = ("milling", [t.neutral(x) for x in c.params], None)
     return out
 
 
