@@ -232,3 +232,17 @@ def test_converted_without_a_tool_radius_is_refused():
     text = "G17 G90 G0 X50 Y50 Z20 F100 S1000 M3\nPOCKET2(10, 0, 2, -5, , 15, 50, 50, 100, 300)\nM30\n"
     conv = api.transpile(text, "sinumerik", "iso-m")
     assert conv.text is None and any(d.rule == "NC402" and d.line == 2 for d in conv.diagnostics)
+
+
+def test_inch_programs_scale_lengths_and_g70_keeps_feeds_in_mm():
+    # G700: lengths and feeds in inch; G70: lengths in inch, feeds in the basic system (mm)
+    for code, ffp1 in (("G700", 300 * 25.4), ("G70", 300)):
+        text = (f"G17 G90 G54 T1 D1 M6\nS2000 M3 F500\nG0 X0 Y0 Z1\n{code}\n"
+                "POCKET2(0.5, 0, 0.1, -0.2, , 1, 2, 2, 100, 300, 0, 3, 0, 1)\nM30\n")
+        ld = pipeline.load_source(from_text(text, "t.mpf"), "t.mpf", "sinumerik")
+        recs = [r for r in pipeline.toolpath_of(ld, _machine(3.0)) if r.line == 5]
+        # pocket radius 25.4 mm, tool 3: one circle of 22.4 / ceil(22.4 / 4.8) = 5 rings -> first 4.48
+        first = next(r for r in recs if r.kind == "linear" and r.end["Z"] == pytest.approx(-0.2 * 25.4)
+                     and r.end["X"] != pytest.approx(50.8))
+        assert first.end["X"] == pytest.approx(50.8 + 22.4 / 5) and first.feed == pytest.approx(ffp1)
+        assert recs[-1].end["Z"] == pytest.approx(0.5 * 25.4)

@@ -282,7 +282,7 @@ def _tool_radius(interp) -> Optional[float]:
 def call_values(interp, cyc, s) -> dict[str, float]:
     """The call's arguments by Siemens name, lengths and feeds in mm (rules: milling_param units)."""
     table = cycle_table()
-    scale = interp.st.scale
+    scales = {"length": interp.st.scale, "feed": interp.st.feed_scale}   # G70: inch lengths, mm feeds
     out: dict[str, float] = {}
     for name in cyc.params:
         e = s.params.get(table.neutral(name))
@@ -292,7 +292,7 @@ def call_values(interp, cyc, s) -> dict[str, float]:
         if v is None:
             continue
         unit = table.milling_param[name].unit if name in table.milling_param else "code"
-        out[name] = v * scale if unit in ("length", "feed") else v
+        out[name] = v * scales.get(unit, 1.0)
     return out
 
 
