@@ -53,13 +53,27 @@ typedef struct {
 static int clean_line(const Text *t, Py_ssize_t p, Py_ssize_t q, char *buf)
 {
     int n = 0;
-    for (Py_ssize_t i = p; i < q; i++) {
-        Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
-        if (c == ' ')
-            continue;
-        if (c >= 128 || c == '(' || c == ')' || c == ';' || n >= MAX_LINE - 1)
-            return -1;
-        buf[n++] = (char)c;
+    if (t->kind == PyUnicode_1BYTE_KIND) {
+        /* the usual text (Latin-1 storage): bytes read directly; one test per byte for the
+         * characters that stop a plain line ('(' ')' ';' and >= 128 have no other use here) */
+        const unsigned char *d = (const unsigned char *)t->data;
+        for (Py_ssize_t i = p; i < q; i++) {
+            unsigned char c = d[i];
+            if (c == ' ')
+                continue;
+            if (c >= 128 || c == '(' || c == ')' || c == ';' || n >= MAX_LINE - 1)
+                return -1;
+            buf[n++] = (char)c;
+        }
+    } else {
+        for (Py_ssize_t i = p; i < q; i++) {
+            Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
+            if (c == ' ')
+                continue;
+            if (c >= 128 || c == '(' || c == ')' || c == ';' || n >= MAX_LINE - 1)
+                return -1;
+            buf[n++] = (char)c;
+        }
     }
     if (n > 0 && buf[n - 1] == '\r')
         n--;
@@ -208,12 +222,44 @@ static int parse_block_as(const char *buf, int n, Block *b, int strict)
 
 static int parse_block(const char *buf, int n, Block *b) { return parse_block_as(buf, n, b, 0); }
 
-/* float() of a word's number (copied out: the next letter may be an E, which strtod would read
- * as an exponent). */
+/* Exact powers of ten: every 10^k with k <= 22 is a double without rounding. */
+static const double POW10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
+                               1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/* float() of a word's number [-+]?(\d+\.?\d*|\.\d+) (number_len's form, no exponent).
+ * The common case takes Clinger's exact fast path: when the digits without the point make an
+ * integer m < 2^53 and there are k <= 22 digits after the point, m and 10^k are both exact doubles,
+ * so m / 10^k is one correctly rounded IEEE division: the double float() returns. Anything
+ * longer goes to PyOS_string_to_double (what float() uses), copied out first: the next letter may
+ * be an E, which it would read as an exponent. */
 static int number_value(const char *buf, int at, int len, double *out)
 {
+    const char *s = buf + at;
+    int i = 0, neg = 0, frac = 0, point = 0;
+    unsigned long long m = 0;
+    if (s[0] == '-' || s[0] == '+') {
+        neg = s[0] == '-';
+        i++;
+    }
+    for (; i < len; i++) {
+        char c = s[i];
+        if (c == '.') {
+            point = 1;
+            continue;
+        }
+        if (m >= (1ULL << 49))          /* one more digit could pass 2^53: the slow path */
+            goto slow;
+        m = m * 10 + (unsigned long long)(c - '0');
+        frac += point;
+    }
+    if (frac > 22)
+        goto slow;
+    double v = (double)m / POW10[frac];
+    *out = neg ? -v : v;
+    return 0;
+slow:;
     char tmp[MAX_LINE + 1];
-    memcpy(tmp, buf + at, (size_t)len);
+    memcpy(tmp, s, (size_t)len);
     tmp[len] = '\0';
     *out = PyOS_string_to_double(tmp, NULL, NULL);
     if (*out == -1.0 && PyErr_Occurred())
@@ -237,6 +283,13 @@ static int get_text(PyObject *str, Text *t)
 
 static Py_ssize_t line_end(const Text *t, Py_ssize_t p, Py_UCS4 sep)
 {
+    if (t->kind == PyUnicode_1BYTE_KIND && sep < 256) {
+        if (p >= t->len)
+            return p;
+        const char *d = (const char *)t->data;
+        const char *hit = memchr(d + p, (int)sep, (size_t)(t->len - p));
+        return hit ? (Py_ssize_t)(hit - d) : t->len;
+    }
     while (p < t->len && PyUnicode_READ(t->kind, t->data, p) != sep)
         p++;
     return p;
@@ -428,6 +481,23 @@ static int spell_point(const double *v, int naxes, const char *axes, char *out)
     return n;
 }
 
+/* A count in decimal, as "%zd" writes it (no printf in the loop). */
+static int spell_int(Py_ssize_t v, char *out)
+{
+    char digits[24];
+    int k = 0, n = 0;
+    size_t u = v < 0 ? (size_t)0 - (size_t)v : (size_t)v;
+    if (v < 0)
+        out[n++] = '-';
+    do {
+        digits[k++] = (char)('0' + u % 10);
+        u /= 10;
+    } while (u);
+    while (k > 0)
+        out[n++] = digits[--k];
+    return n;
+}
+
 static int read_doubles(PyObject *seq, double *out, int n, const char *what)
 {
     if (!PyList_Check(seq) || PyList_GET_SIZE(seq) != n) {
@@ -469,6 +539,7 @@ static double hyp(double a, double b) { return hypot(a, b); }
         if (buf_put(&out, (s), (size_t)(n)) < 0)                                                   \
             goto fail;                                                                             \
     } while (0)
+#define PUTS(lit) PUT(lit, sizeof(lit) - 1)
 
 /* run(text, pos, end, sep, lineno, axes, prog, tot, mach, scale, incremental, motion, feed,
  *     feed_mode_json, rapid_tail, seq, file_json, max_blocks, write, plane, arc_absolute, inch_tol)
@@ -695,31 +766,41 @@ static PyObject *run(PyObject *self, PyObject *args)
                         break;
                     feed_spelled = new_feed;
                 }
-                static const char *KIND[] = {"rapid", "linear", "arc", "arc"};
-                char head[200];
-                int hl = snprintf(head, sizeof head, "{\"seq\":%zd,\"file\":", seq + 1);
-                PUT(head, hl);
+                static const char *KIND[] = {"\"rapid\"", "\"linear\"", "\"arc\"", "\"arc\""};
+                static const int KIND_LEN[] = {7, 8, 5, 5};
+                char num[24];
+                int nl;
+                PUTS("{\"seq\":");
+                nl = spell_int(seq + 1, num);
+                PUT(num, nl);
+                PUTS(",\"file\":");
                 PUT(file_json, file_len);
-                hl = snprintf(head, sizeof head, ",\"line\":%zd,\"kind\":\"%s\",\"start\":", lineno,
-                              KIND[new_motion]);
-                PUT(head, hl);
+                PUTS(",\"line\":");
+                nl = spell_int(lineno, num);
+                PUT(num, nl);
+                PUTS(",\"kind\":");
+                PUT(KIND[new_motion], KIND_LEN[new_motion]);
+                PUTS(",\"start\":");
                 PUT(start_json, start_len);
-                PUT(",\"end\":", 7);
+                PUTS(",\"end\":");
                 PUT(end_json, el);
                 if (arc) {
-                    PUT(",\"center\":", 10);
+                    PUTS(",\"center\":");
                     PUT(center_json, cl);
-                    hl = snprintf(head, sizeof head, ",\"direction\":\"%s\",\"plane\":\"%s\",\"turns\":0",
-                                  new_motion == MOTION_CW ? "cw" : "ccw", plane);
-                    PUT(head, hl);
+                    if (new_motion == MOTION_CW)
+                        PUTS(",\"direction\":\"cw\",\"plane\":\"");
+                    else
+                        PUTS(",\"direction\":\"ccw\",\"plane\":\"");
+                    PUT(plane, plane_len);
+                    PUTS("\",\"turns\":0");
                 }
                 if (new_motion != MOTION_RAPID) {
-                    PUT(",\"feed\":", 8);
+                    PUTS(",\"feed\":");
                     PUT(feed_json, feed_len);
                     PUT(fm_json, fm_len);
                 }
                 PUT(tail_json, tail_len);
-                PUT("}\n", 2);
+                PUTS("}\n");
                 memcpy(start_json, end_json, (size_t)el + 1);
                 start_len = el;
             }
@@ -790,7 +871,29 @@ static PyObject *spell_py(PyObject *self, PyObject *arg)
     return PyUnicode_DecodeASCII(out, n, NULL);
 }
 
+/* number(s) -> float: the kernel's reading of one word's number (number_len's form), for tests
+ * against float(); ValueError when s is not such a number. */
+static PyObject *number_py(PyObject *self, PyObject *arg)
+{
+    Py_ssize_t len;
+    const char *s = PyUnicode_Check(arg) ? PyUnicode_AsUTF8AndSize(arg, &len) : NULL;
+    if (s == NULL) {
+        if (!PyErr_Occurred())
+            PyErr_SetString(PyExc_TypeError, "number: str expected");
+        return NULL;
+    }
+    if (len == 0 || len > MAX_LINE - 1 || number_len(s) != len) {
+        PyErr_SetString(PyExc_ValueError, "number: not a plain number");
+        return NULL;
+    }
+    double v;
+    if (number_value(s, 0, (int)len, &v) < 0)
+        return NULL;
+    return PyFloat_FromDouble(v);
+}
+
 static PyMethodDef methods[] = {
+    {"number", number_py, METH_O, "number(s) -> float: the kernel's reading of a word's number"},
     {"spell", spell_py, METH_O, "spell(v) -> the JSON spelling of v, or None where only repr() spells it"},
     {"scan", scan, METH_VARARGS,
      "scan(text, pos, sep, motion, cycle_off, arc_abs[, strict]) -> (end, lines, blocks, motion)"},

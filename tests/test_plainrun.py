@@ -9,7 +9,9 @@ compiled extension these tests skip, except in CI, where the build must have pro
 from __future__ import annotations
 
 import io
+import math
 import os
+import re
 from pathlib import Path
 
 import pytest
@@ -241,6 +243,25 @@ def test_kernel_spells_numbers_as_the_jsonl_writer(v):
     got = NATIVE.spell(v)
     if got is not None:
         assert got == toolpath_io._spell(v)
+
+
+DIGITS = st.text("0123456789", min_size=0, max_size=24)
+WORD_NUMBER = st.one_of(
+    st.tuples(st.sampled_from(["", "-", "+"]), DIGITS, st.sampled_from(["", "."]), DIGITS)
+    .map(lambda t: t[0] + t[1] + (t[2] + t[3] if t[2] else "")),
+    NUMBER, COORD,
+    st.sampled_from(["9007199254740993", "9007199254740992.5", "0.1", "-0.", "+.0",
+                     "0." + "0" * 22 + "1", "1" + "0" * 30, "123456789012345678.9", ".0000000000000000000001"]),
+).filter(re.compile(r"[-+]?(\d+\.?\d*|\.\d+)").fullmatch)      # a word's number (number_len)
+
+
+@settings(max_examples=3000, deadline=None)
+@given(WORD_NUMBER)
+def test_kernel_reads_numbers_as_float_does(text):
+    """The kernel's exact fast path (integer digits / 10^k) and its fallback give float()'s double,
+    bit for bit (the sign of zero included)."""
+    got, want = NATIVE.number(text), float(text)
+    assert got == want and math.copysign(1.0, got) == math.copysign(1.0, want), (text, got, want)
 
 
 @pytest.mark.parametrize("budget", [1, 7, 50, 4100, 4400])
