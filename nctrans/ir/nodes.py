@@ -412,10 +412,15 @@ class TravelLimit:
 
 @node
 class Passthrough:
-    """A valid construct the IR has no concept for: kept verbatim (never dropped) with why."""
+    """A valid construct the IR has no concept for: kept verbatim (never dropped) with why.
+    `address`/`value`: when the construct is one code word with a computed value (ISO `M#501`,
+    Sinumerik `M=R501`), its address letter and value expression, so another dialect can write the
+    same word in its own expression syntax."""
     text: str
     reason: str = ""
     dialect: str = ""
+    address: str = ""
+    value: Optional[Expr] = None
 
 
 Statement = Union[

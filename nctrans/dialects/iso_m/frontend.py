@@ -645,7 +645,10 @@ class Lowering:
                 if type(v) is str:
                     self.warn_once(text, "NC403", "warning",
                                    f"{text} has no meaning in the IR; kept verbatim", line)
-                out.append((B_NONMODAL, self._pass(text, "machine-specific code")))
+                ps = self._pass(text, "machine-specific code")
+                if type(v) is not str:            # M#501: a computed code another dialect can write
+                    ps.address, ps.value = letter, v
+                out.append((B_NONMODAL, ps))
             elif rule.group in SIMPLE_GROUPS:
                 out.append((SIMPLE_GROUPS[rule.group], ModeChange(rule.group, rule.value, "M" + v)))
             else:

@@ -52,6 +52,9 @@ _OPS = {"==": "==", "!=": "<>", "<": "<", ">": ">", "<=": "<=", ">=": ">=", "con
 _DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
+# address letters whose value may be an expression written `M=R501` (seed "Indirect programming":
+# every address takes a variable except N, G and L)
+_COMPUTED_WORDS = frozenset("MH")
 _AMBIGUOUS = re.compile(r"^[A-Za-z](?:\d\w*)?$")
 
 
@@ -422,6 +425,11 @@ class Emitter:
         elif isinstance(s, ir.Passthrough):
             if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
                 out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
+            elif s.address and s.value is not None and s.address in _COMPUTED_WORDS:
+                # a code word with a computed value (ISO M#501): the same word, Sinumerik syntax
+                self.diags.append(at_span("NC403", "warning", f"kept from {s.dialect}: {s.text} "
+                                          f"({s.reason}) as {s.address}=<value>", self.span))
+                out.words.append(f"{s.address}={self.expr(s.value)}")
             elif _reads_as_sinumerik(s.text, moves_allowed=s.reason != "directive"):
                 self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
                                           f"{s.text} ({s.reason})", self.span))
