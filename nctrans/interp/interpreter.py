@@ -1925,6 +1925,9 @@ class Interpreter(LatheMixin, RunChecks):
                 sc.names, sc.args = caller.names, caller.args
             for p, v in zip(unit.params, pos):
                 sc.names[p.name.upper()] = v
+            for p in unit.params[len(pos):]:       # not programmed in the call: preset to zero (seed
+                if not p.by_ref and not p.dims:    # "Incomplete parameter transfer")
+                    sc.names.setdefault(p.name.upper(), "" if p.type.upper().startswith("STRING") else 0)
             for k, v in named.items():
                 var = s.bindings.get(k)
                 if var is None:

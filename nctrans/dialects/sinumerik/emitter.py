@@ -38,6 +38,7 @@ from nctrans.dialects.sinumerik.lexer import number_value
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
+from nctrans.lower import macro_procs
 from nctrans.rules import load_table, system_meaning, system_spelling
 
 DIALECT = "sinumerik"
@@ -109,6 +110,10 @@ class Emitter:
         self.span: Optional[ir.Span] = None
         self.pending = None
         self.targets = walk.program_jump_targets(program)
+        # G65 macros written as PROCs with named parameters (nctrans.lower.macro_procs), and while
+        # one is written, its locals #n by name
+        self.procs = macro_procs.plan(program) if program.dialect != DIALECT else {}
+        self.local_names: dict[int, str] = {}
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -213,6 +218,8 @@ class Emitter:
             return f"({v.key})"        # C or R1R2 alone would read back as address words
         if v.space in ("name", "system"):
             return f"{v.key}{idx}"
+        if v.space == "num" and v.key in self.local_names and not v.indices:
+            return self.local_names[v.key]
         if v.space == "num" and isinstance(v.key, int) and v.key >= 1000 and not v.indices:
             return self.system_var(v, target)
         if v.space == "num":
@@ -678,6 +685,10 @@ class Emitter:
                 f"this program nor found beside it, so the target control must provide {name} "
                 f"(convert {c.name}'s own file to get it)", self.span))
         pre = []
+        proc = self.procs.get(macro_procs.key(c.name)) if c.kind == "g65" else None
+        if proc is not None:
+            out.words.append(f"{name}({self.proc_args(proc, c)})")
+            return
         if c.bindings:
             self.info("g65", "macro call arguments passed in R parameters (global: a nested call can "
                              "overwrite them)")
@@ -702,6 +713,18 @@ class Emitter:
             text += " " + self.word("P", c.repeat)
         out.words.extend(pre)
         out.words.append(text)
+
+    def proc_args(self, proc: "macro_procs.MacroProc", c: ir.SubCall) -> str:
+        """A G65 call's arguments by the position of the PROC parameter each letter binds; a
+        parameter no letter passes stays empty (the PROC sees it unprogrammed)."""
+        at: dict[int, str] = {}
+        for letter, var in c.bindings.items():
+            pos = proc.position(var.key) if letter in c.named_args else None
+            if pos is None:
+                self.refuse(f"argument {letter} of {c.name} has no parameter of its PROC")
+                continue
+            at[pos] = self.expr(c.named_args[letter])
+        return ", ".join(at.get(i, "") for i in range(1, max(at, default=0) + 1))
 
     def vardecl(self, ds: list) -> str:
         d0 = ds[0]
@@ -966,6 +989,13 @@ class Emitter:
             elif name != entry:
                 self.lines.append(f"%_N_{sname}_SPF")
             params = []
+            proc = self.procs.get(macro_procs.key(name))
+            if proc is not None:
+                self.info("proc", f"G65 macro {name} written as PROC {sname} with named parameters "
+                          f"(#n -> ARG_<letter>, locals without a letter -> LOC<n>)")
+                self.local_names = {k: f"ARG_{letter}" for k, letter in proc.params}
+                self.local_names.update({k: f"LOC{k}" for k in proc.plain_locals})
+                params = [f"REAL ARG_{letter}" for _, letter in proc.params]
             for prm in sub.params:
                 dims = "[" + ",".join(str(x) if x else "" for x in prm.dims) + "]" if prm.dims else ""
                 params.append(("VAR " if prm.by_ref else "") + prm.type + " " + prm.name + dims)
@@ -974,8 +1004,11 @@ class Emitter:
                 head += " " + " ".join(sub.attrs)
             if name not in meta.get("members_without_proc", []):
                 self.lines.append(head)
+            if proc is not None and proc.plain_locals:
+                self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
             self.st = _State()
             self.unit(sub.body)
+            self.local_names = {}
 
 
 def _reads_arguments(body: list) -> bool:

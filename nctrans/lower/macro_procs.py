@@ -1,0 +1,118 @@
+"""Which numbered subprograms of a program can become procedures with named parameters.
+
+ISO G65 macros get their arguments as the locals #1-#33 of their own call level; a target with
+procedures (Sinumerik PROC) can pass the same values as named parameters instead of global
+registers. A subprogram qualifies when every call of it in the program is a plain G65 macro call
+(its own level of locals), its body reaches its locals only by number (no `#[expr]` that could land
+on one), calls nothing that shares its locals (M98), and every call passes every argument the body
+reads and never sets. That last condition is the vacant value: an argument left out is vacant in
+ISO (`#2 EQ 0` is false, `X#24` drops the word) but a PROC parameter left out is 0, so only calls
+that pass all arguments mean the same in both (a call from another file is the target's concern:
+the emitter's note says so). The letters come from the source dialect's
+table (`options.macro_arguments`, in the program's meta): #1 -> A ... #26 -> Z; a local without a
+letter (#10, #27-#33) is a plain local of the procedure. This module decides; the emitter spells.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from nctrans.ir import nodes as ir
+from nctrans.ir import walk
+
+LOCAL_MAX = 33
+_NUMBER = re.compile(r"^O?(\d+)$", re.IGNORECASE)
+
+
+@dataclass
+class MacroProc:
+    """params: (local number, argument letter) in local order, the procedure's parameters;
+    plain_locals: the locals without a letter the body uses."""
+    params: list[tuple[int, str]] = field(default_factory=list)
+    plain_locals: list[int] = field(default_factory=list)
+
+    def position(self, local: int) -> int | None:
+        """1-based parameter position of a local, as a call passes it."""
+        return next((i + 1 for i, (k, _) in enumerate(self.params) if k == local), None)
+
+
+def key(name: str) -> str:
+    """One spelling of a program name: ISO O1000 and 1000 are the same program."""
+    m = _NUMBER.match(name or "")
+    return str(int(m.group(1))) if m else (name or "").upper()
+
+
+def plan(program: ir.Program) -> dict[str, MacroProc]:
+    """The subprograms (by key()) that become procedures with named parameters."""
+    letters = ((program.meta or {}).get("options") or {}).get("macro_arguments") or {}
+    if not letters or not program.subprograms:
+        return {}
+    by_local = {int(k): str(letter) for letter, k in letters.items()}
+    calls: dict[str, list[ir.SubCall]] = {}
+    for body in [program.body, *(s.body for s in program.subprograms.values())]:
+        if type(body) is not list:
+            return {}                       # a streamed body: calls cannot be seen ahead
+        for c in _calls(body):
+            calls.setdefault(key(c.name), []).append(c)
+    out = {}
+    for name, sub in program.subprograms.items():
+        mine = calls.get(key(name))
+        if not mine or any(c.kind != "g65" or c.modal != "none" for c in mine):
+            continue
+        found = _locals_used(sub.body)
+        if found is None or any(c.kind != "g65" for c in _calls(sub.body)):
+            continue
+        used, written = found
+        passed = [{v.key for v in c.bindings.values() if isinstance(v.key, int)} for c in mine]
+        arguments = {k for k in used - written if k in by_local}
+        if any(arguments - p for p in passed):
+            continue                         # a call leaves out an argument the body reads
+        params = sorted(k for k in arguments.union(*passed) if k in by_local)
+        out[key(name)] = MacroProc([(k, by_local[k]) for k in params],
+                                   sorted(k for k in used if k not in params))
+    return out
+
+
+def _calls(body: list):
+    for b in walk.blocks(body):
+        for s in b.body:
+            if type(s) is ir.SubCall:
+                yield s
+
+
+def _locals_used(body: list) -> tuple[set[int], set[int]] | None:
+    """(the locals #1-#33 a body names, those it assigns); None when it reaches variables by a
+    computed number."""
+    used: set[int] = set()
+    written: set[int] = set()
+    indirect = False
+
+    def visit(e) -> None:
+        nonlocal indirect
+        if type(e) is ir.Var:
+            if e.space == "num":
+                if e.key is None:
+                    indirect = True
+                elif isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
+                    used.add(e.key)
+            for i in e.indices or ():
+                visit(i)
+        elif isinstance(e, (list, tuple)):
+            for x in e:
+                visit(x)
+        elif isinstance(e, dict):
+            for x in e.values():
+                visit(x)
+        elif hasattr(e, "__slots__") and not isinstance(e, (ir.Num, ir.Str, ir.Span)):
+            for f in e.__slots__:
+                if f not in walk.BODIES:          # walk() visits the nested bodies itself
+                    visit(getattr(e, f, None))
+
+    for node in walk.walk(body):
+        if type(node) is ir.Block:
+            visit(node.body)
+            written.update(s.target.key for s in node.body if type(s) is ir.Assign
+                           and s.target.space == "num" and isinstance(s.target.key, int))
+        else:
+            visit(node)
+    return None if indirect else (used, written)
