@@ -51,6 +51,9 @@ class RulesTable:
     codes: list[CodeRule] = field(default_factory=list)
     # system variable as spelled ("#5001", "$AA_IW") -> neutral meaning (vocabulary.SYSTEM_VARIABLES)
     system_variables: dict[str, str] = field(default_factory=dict)
+    # how the dialect spells expressions: operators, precedence, brackets, function names
+    # (nctrans.dialects.emit.ExpressionSyntax reads it)
+    expressions: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._by_code = {c.code.upper(): c for c in self.codes}

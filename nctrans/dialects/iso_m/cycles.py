@@ -91,7 +91,7 @@ def iso_cycle(call: n.CycleCall, emitter) -> IsoCycle:
     else:
         raise CycleRefused(f"{name} without a depth (DP or DPR)")
     words = [("Z", emitter.addr("Z", bottom)), ("R", emitter.addr("R", approach))]
-    out = IsoCycle("", "G99", words, name=name)
+    out = IsoCycle("", emitter.code_for("cycle_retract", "r_plane"), words, name=name)
     values: dict[str, n.Expr] = {}
     for arg, source in mapping.args.items():
         value = p.get(table.neutral(arg))
@@ -140,7 +140,7 @@ def iso_cycle(call: n.CycleCall, emitter) -> IsoCycle:
         raise CycleRefused(f"{name} with a computed RTP or approach level: G98/G99 cannot be chosen")
     up = 1.0 if (_num(bottom) is None or app >= _num(bottom)) else -1.0
     if (rtp - app) * up > _TOL:
-        out.retract, out.rtp = "G98", rtp
+        out.retract, out.rtp = emitter.code_for("cycle_retract", "initial"), rtp
     return out
 
 

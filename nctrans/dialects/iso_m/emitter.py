@@ -28,129 +28,92 @@ from __future__ import annotations
 
 import itertools
 import math
-from decimal import Decimal
 from typing import Any, Optional
 
-from nctrans.diagnostics import Diagnostic, at_span
+from nctrans.diagnostics import at_span
+from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, format_number, rewrites
 from nctrans.ir import nodes as n
 from nctrans.ir import walk
 from nctrans.ir.walk import constant
-from nctrans.rules import load_table
 
 from . import plan as pl
 from .cycles import CycleRefused, IsoCycle, iso_cycle, pattern_positions
 
+__all__ = ["IsoEmitter", "IsoSpelling", "NotExpressible", "format_number", "format_expr",
+           "format_value", "emit_program"]
+
 POINT_LETTERS = frozenset("XYZUVWABCIJKQRF")
 AXES = "XYZABCUVW"
 
-_OPS = {"+": ("+", 2), "-": ("-", 2), "or": ("OR", 2), "xor": ("XOR", 2), "bor": ("OR", 2),
-        "bxor": ("XOR", 2), "*": ("*", 3), "/": ("/", 3), "and": ("AND", 3), "band": ("AND", 3),
-        "mod": ("MOD", 3), "==": ("EQ", 1), "!=": ("NE", 1), ">": ("GT", 1), ">=": ("GE", 1),
-        "<": ("LT", 1), "<=": ("LE", 1)}
-_FUNCS = {"sin": "SIN", "cos": "COS", "tan": "TAN", "asin": "ASIN", "acos": "ACOS", "atan": "ATAN",
-          "sqrt": "SQRT", "abs": "ABS", "round": "ROUND", "fix": "FIX", "trunc": "FIX", "fup": "FUP",
-          "ln": "LN", "exp": "EXP", "bin": "BIN", "bcd": "BCD", "adp": "ADP", "pow": "POW"}
 
+class IsoSpelling(Spelling):
+    """Macro B expressions (operators and functions from rules/iso-m.toml [expressions]); without
+    an emitter only #n variables can be written."""
+    syntax_table = "iso-m"
 
-class NotExpressible(Exception):
-    """Raised inside expression formatting; the caller turns it into NC402."""
+    def var_text(self, v: n.Var) -> str:
+        if v.space == "num":
+            if v.key is None and v.indices:
+                return f"#[{self.expr(v.indices[0])}]"
+            return f"#{v.key}"
+        return self.named_var(v)
 
-
-def format_number(v: float, point: bool = False) -> str:
-    """Exact shortest decimal text of a float (no exponent); `point` forces a decimal point."""
-    if v != v or v in (float("inf"), float("-inf")):
-        raise NotExpressible(f"number {v!r}")
-    if v == int(v) and abs(v) < 1e16:
-        text = str(int(v))
-        if v == 0 and str(v).startswith("-"):
-            text = "-0"
-        return text + "." if point else text
-    text = format(Decimal(repr(v)), "f")
-    if "." in text:
-        text = text.rstrip("0")
-    return text
-
-
-def format_expr(e: Any, ctx: Optional["IsoEmitter"] = None) -> str:
-    """An IR expression in macro B syntax (brackets only where precedence needs them)."""
-    return _expr(e, ctx)[0]
-
-
-def _wrap(text: str, prec: int, need: int) -> str:
-    return f"[{text}]" if prec < need else text
-
-
-def _expr(e: Any, ctx) -> tuple[str, int]:
-    t = type(e)
-    if t is n.Num:
-        return format_number(e.value), 5 if e.value >= 0 else 4
-    if t is n.Var:
-        return _var(e, ctx), 5
-    if t is n.Binary:
-        op = e.op
-        if op == "pow":
-            return format_expr(n.Func("pow", [e.left, e.right]), ctx), 5
-        if op == "div":
-            return format_expr(n.Func("fix", [n.Binary("/", e.left, e.right)]), ctx), 5
-        if op not in _OPS:
-            raise NotExpressible(f"operator {op!r}")
-        sym, prec = _OPS[op]
-        lt, lp = _expr(e.left, ctx)
-        rt, rp = _expr(e.right, ctx)
-        if rt[:1] in "+-" and sym in "+-":
-            rp = 0                          # `1--5` is two signs in a row (NC002): 1-[-5]
-        if prec == 1:
-            return f"{_wrap(lt, lp, 2)}{sym}{_wrap(rt, rp, 2)}", 1
-        return f"{_wrap(lt, lp, prec)}{sym}{_wrap(rt, rp, prec + 1)}", prec
-    if t is n.Unary:
-        if e.op in ("-", "+"):
-            ot, op_ = _expr(e.operand, ctx)
-            if ot[:1] in "+-":
-                op_ = 0                     # -[-5], never --5
-            return f"{e.op}{_wrap(ot, op_, 4)}", 4
-        if e.op == "not":
-            ot, op_ = _expr(e.operand, ctx)
-            return f"[{ot}]EQ0", 1
-        raise NotExpressible(f"unary operator {e.op!r}")
-    if t is n.Func:
-        name = e.name.lower()
-        if name == "atan2" and len(e.args) == 2:
-            return f"ATAN[{format_expr(e.args[0], ctx)}]/[{format_expr(e.args[1], ctx)}]", 5
-        if name in ("minval", "maxval") and len(e.args) == 2:
-            a, b = e.args
-            sign = n.Binary("-" if name == "minval" else "+", n.Binary("+", a, b),
-                            n.Func("abs", [n.Binary("-", a, b)]))
-            if ctx is not None:
-                ctx.lowered(f"{name.upper()} written as an ABS expression")
-            return format_expr(n.Binary("/", sign, n.Num(2.0)), ctx), 3
-        if name not in _FUNCS:
-            raise NotExpressible(f"function {e.name.upper()}")
-        args = ",".join(format_expr(a, ctx) for a in e.args)
-        if name == "atan":              # bracketed, so a following "/[" is not read as ATAN[a]/[b]
-            return f"[ATAN[{args}]]", 5
-        return f"{_FUNCS[name]}[{args}]", 5
-    if t is n.Str:
-        raise NotExpressible("a string value")
-    raise NotExpressible(f"expression {t.__name__}")
-
-
-def _var(v: n.Var, ctx) -> str:
-    if v.space == "num":
-        if v.key is None and v.indices:
-            return f"#[{format_expr(v.indices[0], ctx)}]"
-        return f"#{v.key}"
-    if ctx is None:
+    def named_var(self, v: n.Var) -> str:
         raise NotExpressible(f"variable {v.space}:{v.key}")
-    return ctx.var_text(v)
+
+    def value(self, e: Any) -> str:
+        """An address value: numbers and variables as they are, anything else in brackets."""
+        if type(e) is n.Num:
+            return format_number(e.value)
+        if type(e) is n.Var:
+            return self.var_text(e)
+        return f"[{self.expr(e)}]"
+
+    @rewrites(n.Binary, "pow")
+    def _pow(self, e: n.Binary) -> tuple[str, int]:
+        return self.expr(n.Func("pow", [e.left, e.right])), self.syntax.atom
+
+    @rewrites(n.Binary, "div")
+    def _div(self, e: n.Binary) -> tuple[str, int]:
+        return self.expr(n.Func("fix", [n.Binary("/", e.left, e.right)])), self.syntax.atom
+
+    @rewrites(n.Unary, "not")
+    def _not(self, e: n.Unary) -> tuple[str, int]:
+        return f"[{self.expr(e.operand)}]{self.syntax.binary['=='].text}0", self.syntax.binary["=="].prec
+
+    @rewrites(n.Func, "atan2", "atan")
+    def _atan(self, e: n.Func) -> tuple[str, int]:
+        atan = self.syntax.functions["atan"]
+        if e.name.lower() == "atan2":
+            if len(e.args) != 2:
+                raise NotExpressible(f"function {e.name.upper()}")
+            return f"{atan}[{self.expr(e.args[0])}]/[{self.expr(e.args[1])}]", self.syntax.atom
+        # bracketed, so a following "/[" is not read as ATAN[a]/[b]
+        return f"[{self.call(e)}]", self.syntax.atom
+
+    @rewrites(n.Func, "minval", "maxval")
+    def _min_max(self, e: n.Func) -> tuple[str, int]:
+        name = e.name.lower()
+        if len(e.args) != 2:
+            raise NotExpressible(f"function {e.name.upper()}")
+        a, b = e.args
+        total = n.Binary("-" if name == "minval" else "+", n.Binary("+", a, b),
+                         n.Func("abs", [n.Binary("-", a, b)]))
+        self.lowered(f"{name.upper()} written as an ABS expression")
+        return self.term(n.Binary("/", total, n.Num(2.0)))
 
 
-def format_value(e: Any, ctx=None) -> str:
+_BARE = IsoSpelling()
+
+
+def format_expr(e: Any, ctx: Optional[IsoSpelling] = None) -> str:
+    """An IR expression in macro B syntax (brackets only where precedence needs them)."""
+    return (ctx or _BARE).expr(e)
+
+
+def format_value(e: Any, ctx: Optional[IsoSpelling] = None) -> str:
     """An address value: numbers and variables as they are, anything else in brackets."""
-    if type(e) is n.Num:
-        return format_number(e.value)
-    if type(e) is n.Var:
-        return _var(e, ctx)
-    return f"[{format_expr(e, ctx)}]"
+    return (ctx or _BARE).value(e)
 
 
 class _Line:
@@ -166,20 +129,18 @@ class _Lines(list):
     """Words a statement writes on lines of their own (one list of words per line)."""
 
 
-class IsoEmitter:
+class IsoEmitter(IsoSpelling, Emitter):
     """IR -> text for a dialect of the ISO family. dialect: the name of programs (and passthrough
     text) that are already this dialect's own; table: the rules table G/M codes are spelled from.
     ISO-family dialects subclass it with their names and override what they spell differently."""
     dialect = "iso-m"
     table_name = "iso-m"
     target_text = "ISO milling"          # NC402 wording: "<target_text> cannot express ..."
+    lowered_for = "ISO"
 
     def __init__(self, program: n.Program):
-        self.program = program
-        self.table = load_table(self.table_name)
-        self.diags: list[Diagnostic] = []
+        super().__init__(program)
         self.out: list[str] = []
-        self.span = None
         self.var_map: dict = {}
         self.next_common = 100
         self.next_label = 90000
@@ -187,7 +148,6 @@ class IsoEmitter:
         self.depth = 0
         # distance mode in source order, so a one-block G91 (incremental reference-point
         # approach from other dialects) can be followed by the G90 that restores it
-        self.distance = "absolute"
         self.restore_absolute = False
         self.arc_distance = "incremental"
         # the plan: labels, locals and O numbers per unit (None = the main program)
@@ -202,9 +162,7 @@ class IsoEmitter:
             for key, sub in program.subprograms.items() for prm in sub.params if prm.dims}
         top_r, dynamic_r = pl.max_r_used(program)
         self.next_array = 900 if dynamic_r else 500 + top_r + 1
-        # what is known at emit time: constant programmed position, plane, the constant
-        # programmable translation (None: unknown) and whether rotation/scale/mirror may be active
-        self.pos: dict[str, float] = {}
+        # plane and three-point mode, for arcs computed from the constant points (self.pos)
         self.plane = "XY"
         self.cip_mode = False
         # G33: ISO writes the thread lead as F, which is then the modal feed; the feed the source
@@ -212,8 +170,6 @@ class IsoEmitter:
         self.thread_mode = False
         self.last_feed: Optional[str] = None
         self.feed_clobbered = False
-        self.frame_trans: Optional[dict[str, float]] = {}
-        self.frame_other = False
         # named cycles written as ISO canned cycles (nctrans.dialects.iso_m.cycles): the modal one
         # (MCALL) and whether its G8x mode is on; motion mode, units and feed as programmed
         self.named_cycle: Optional[IsoCycle] = None
@@ -222,27 +178,7 @@ class IsoEmitter:
         self.units_mm = True
         self.feed_expr = None
 
-    # -------------------------------------------------------------- reporting
-    def _where(self):
-        """The current block's span, or the program's first line outside any block."""
-        return self.span if self.span is not None else n.Span(self.program.file, 1)
-
-    def lowered(self, what: str) -> None:
-        self.diags.append(at_span("NC401", "info", f"lowered for ISO: {what}", self._where()))
-
-    def refuse(self, what: str) -> None:
-        line = self.span.line if self.span is not None else 1
-        self.diags.append(at_span("NC402", "error",
-                                  f"{self.target_text} cannot express {what} (source line {line})", self._where()))
-
-    def forget(self) -> None:
-        """A place reached from elsewhere (jump target, structure, call): positions and the
-        programmable frame are no longer known constants."""
-        self.pos = {}
-        self.frame_trans = None
-        self.frame_other = True
-
-    def var_text(self, v: n.Var) -> str:
+    def named_var(self, v: n.Var) -> str:
         if v.space == "system":
             return self._system_var(v)
         if v.space == "name":
@@ -260,7 +196,7 @@ class IsoEmitter:
                 return self._slot_var(plan, key, v)
         if v.space == "R" and v.key is None and v.indices and len(v.indices) == 1:
             self.lowered("R[expr] written as #[500+expr]")
-            return f"#[500+{format_expr(v.indices[0], self)}]"
+            return f"#[500+{self.expr(v.indices[0])}]"
         return f"#{self.map_var(v)}"
 
     def _system_var(self, v: n.Var) -> str:
@@ -303,7 +239,7 @@ class IsoEmitter:
             if c != int(c) or not 0 <= c < size:
                 raise NotExpressible(f"index {format_number(c)} of the parameter {v.key} (size {size})")
             return plan.slot_text(offset + int(c))
-        return f"#[#{pl.SPILL_POINTER}+{base}+{format_expr(flat, self)}]"
+        return f"#[#{pl.SPILL_POINTER}+{base}+{self.expr(flat)}]"
 
     def _element(self, arr: pl.ArrayPlan, v: n.Var) -> str:
         idx = v.indices or []
@@ -319,7 +255,7 @@ class IsoEmitter:
         c = constant(offset)
         if c is not None:
             return f"#{arr.base + int(c)}"
-        return f"#[{format_expr(n.Binary('+', n.Num(float(arr.base)), offset), self)}]"
+        return f"#[{self.expr(n.Binary('+', n.Num(float(arr.base)), offset))}]"
 
     def map_var(self, v: n.Var) -> int:
         key = (v.space, v.key)
@@ -340,12 +276,12 @@ class IsoEmitter:
         return self.var_map[key]
 
     def val(self, e) -> str:
-        return format_value(e, self)
+        return self.value(e)
 
     def addr(self, letter: str, e) -> str:
         if type(e) is n.Num:
             return letter + format_number(e.value, letter in POINT_LETTERS)
-        return letter + format_value(e, self)
+        return letter + self.value(e)
 
     def fresh_label(self) -> str:
         while str(self.next_label) in self.used_numbers:
@@ -455,7 +391,7 @@ class IsoEmitter:
         self.nodes(sub.body)
         if (key in self.sub_numbers or unit.frame) and not walk.ends_with_return(sub.body):
             self.out.extend(self._pop_frame())
-            self.out.append("M99")
+            self.out.append(self.code_for("call", "m99"))
 
     def _pop_frame(self) -> list[str]:
         """What leaving the current unit must do first: release its spill frame."""
@@ -512,7 +448,10 @@ class IsoEmitter:
             structure = type(node) is not n.Block
             if structure:
                 self.forget()
-            getattr(self, "s_" + type(node).__name__)(node)
+            try:
+                self.dispatch("s_", node)
+            except NotExpressible as err:
+                self.refuse(str(err))
             if structure:
                 self.forget()
 
@@ -566,7 +505,7 @@ class IsoEmitter:
             self.out.append(text)
         if self.restore_absolute:
             self.restore_absolute = False
-            self.out.append("G90")
+            self.out.append(self.code_for("distance", "absolute"))
 
     def s_If(self, node: n.If) -> None:
         then = node.then
@@ -618,7 +557,7 @@ class IsoEmitter:
         step = node.step if node.step is not None else n.Num(1.0)
         down = type(step) is n.Num and step.value < 0
         label = self._loop_label(None)
-        self.out.append(f"{var}={format_expr(node.start, self)}")
+        self.out.append(f"{var}={self.expr(node.start)}")
         self.out.append(f"WHILE[{var}{'GE' if down else 'LE'}{self._operand(node.end)}]DO{label}")
         self.depth += 1
         self.nodes(node.body)
@@ -643,12 +582,11 @@ class IsoEmitter:
             self.out.append(f"GOTO{self._goto_target(node.default)}")
 
     def _operand(self, e) -> str:
-        text, prec = _expr(e, self)
-        return _wrap(text, prec, 4)
+        return self.expr(e, self.syntax.unary["-"].prec)
 
     def cond(self, e) -> str:
         try:
-            return format_expr(e, self)
+            return self.expr(e)
         except NotExpressible as err:
             self.refuse(str(err))
             return "0EQ1"
@@ -657,7 +595,7 @@ class IsoEmitter:
         try:
             if s.target.space == "system":
                 raise NotExpressible(f"writing the system variable {s.target.key}")
-            return f"{self.val(s.target)}={format_expr(s.value, self)}"
+            return f"{self.val(s.target)}={self.expr(s.value)}"
         except NotExpressible as err:
             self.refuse(str(err))
             return ""
@@ -677,10 +615,7 @@ class IsoEmitter:
         lines: list[_Line] = [_Line()]
         for s in body:
             try:
-                write = getattr(self, "w_" + type(s).__name__, None)
-                if write is None:           # a statement this emitter has no spelling for: say so
-                    raise NotExpressible(f"the statement {type(s).__name__}")
-                words = write(s)
+                words = self.dispatch("w_", s)
             except NotExpressible as err:
                 self.refuse(f"{type(s).__name__}: {err}")
                 continue
@@ -736,8 +671,10 @@ class IsoEmitter:
             raise NotExpressible(f"work offset {s.code or 'G53'} (no settable offset): ISO has no modal "
                                  "'no work offset', and G54 is the same only when its offset is zero")
         if s.group == "work_offset" and s.value.startswith("G54.1P"):
-            return [("G:14", "G54.1"), ("P", "P" + s.value[6:])]
-        if s.group == "work_offset" and s.value not in ("G54", "G55", "G56", "G57", "G58", "G59"):
+            if self.table.code_for("work_offset", "G54.1") is None:
+                raise NotExpressible(f"work offset {s.value}")
+            return [self.code_word("work_offset", "G54.1"), ("P", "P" + s.value[6:])]
+        if s.group == "work_offset" and self.table.code_for("work_offset", s.value) is None:
             raise NotExpressible(f"work offset {s.value}")
         code = s.code.upper() if s.code else ""
         if code and code[0] in "GM" and code[1:].replace(".", "").isdigit():
@@ -752,22 +689,6 @@ class IsoEmitter:
                 raise NotExpressible(f"per-word {av.mode} coordinate on {k}")
             words.append((k, self.addr(k, av.value)))
         return words
-
-    def _track(self, s: n.Motion) -> None:
-        """The constant programmed end point, where the words say it."""
-        if s.polar or s.machine_coords:
-            for k in s.target:
-                self.pos.pop(k, None)
-            if s.polar:
-                self.pos = {}
-            return
-        for k, av in s.target.items():
-            v = constant(av.value)
-            inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
-            if v is None or (inc and k not in self.pos):
-                self.pos.pop(k, None)
-            else:
-                self.pos[k] = self.pos[k] + v if inc else v
 
     def _cip(self, s: n.Motion):
         """A three-point arc as G2/G3 with the centre of the circle through start, via and end."""
@@ -832,7 +753,7 @@ class IsoEmitter:
         if self.cip_mode and s.target:
             raise NotExpressible("a three-point arc (CIP) without an intermediate point")
         start = dict(self.pos)
-        self._track(s)
+        self.track(s)
         if s.polar:
             raise NotExpressible("polar motion words")
         if s.indirect:
@@ -844,7 +765,7 @@ class IsoEmitter:
             words.append(("F", self.last_feed))
             self.feed_clobbered = False
         if s.machine_coords:
-            words.append(("", "G53"))
+            words.append(self.code_word("nonmodal", "machine_coords"))
         words += self._axes(s.target)
         if s.aperture is not None:
             words.append(("R", "R" + self._aperture_radius(s, start)))
@@ -900,7 +821,7 @@ class IsoEmitter:
 
     def w_ToolChange(self, s):
         self.pos = {}
-        return [("", "M6")]
+        return [self.code_word("tool_change", "change")]
 
     def w_OffsetSelect(self, s):
         self.pos = {}
@@ -911,26 +832,27 @@ class IsoEmitter:
         if s.revolutions is not None:
             raise NotExpressible("a dwell in spindle revolutions")
         sec = s.seconds if s.seconds is not None else n.Num(0.0)
+        dwell = self.code_word("nonmodal", "dwell")
         if type(sec) is n.Num:
             ms = _ms_text(sec.value)
             if ms is not None:
-                return [("G:18", "G4"), ("P", "P" + ms)]
-            return [("G:18", "G4"), ("X", "X" + format_number(sec.value, True))]
+                return [dwell, ("P", "P" + ms)]
+            return [dwell, ("X", "X" + format_number(sec.value, True))]
         if type(sec) is n.Binary and sec.op == "/" and type(sec.right) is n.Num and sec.right.value == 1000:
-            return [("G:18", "G4"), ("P", "P" + self.val(sec.left))]
-        return [("G:18", "G4"), ("X", "X" + self.val(sec))]
+            return [dwell, ("P", "P" + self.val(sec.left))]
+        return [dwell, ("X", "X" + self.val(sec))]
 
     def w_SetPosition(self, s):
         self.pos = {}
-        return [("G:18", "G92")] + self._axes(s.target)
+        return [self.code_word("nonmodal", "set_position")] + self._axes(s.target)
 
     def w_ResetSetPosition(self, s):
         self.pos = {}
-        return [("G:18", "G92.1")]
+        return [self.code_word("nonmodal", "reset_set_position")]
 
     def w_HomeReturn(self, s):
         self.pos = {}
-        words = [("G:18", "G28" if s.ref == 1 else "G30")]
+        words = [self.code_word("nonmodal", "home" if s.ref == 1 else "home2")]
         modes = {av.mode for av in s.via.values()}
         if modes == {"inc"}:
             # Sinumerik G74 (approach the reference point directly) arrives as a zero
@@ -939,7 +861,7 @@ class IsoEmitter:
             if self.distance == "absolute":
                 self.lowered("incremental reference-point approach written as G91 G28 ... then G90")
                 self.restore_absolute = True
-            return [("G:3", "G91")] + words + self._ref_index(s) + self._axes(via)
+            return [self.code_word("distance", "incremental")] + words + self._ref_index(s) + self._axes(via)
         return words + self._ref_index(s) + self._axes(s.via)
 
     def _ref_index(self, s) -> list:
@@ -949,25 +871,6 @@ class IsoEmitter:
         if s.ref_index is not None:
             words.append(("P", self.addr("P", s.ref_index)))
         return words
-
-    def _frame_state(self, s: n.FrameOp) -> None:
-        """Follow the programmable frame as far as it is constant (source semantics: an op that is
-        not additive, local or pivoted replaces the whole frame)."""
-        self.pos = {}
-        if s.op == "all" and s.clear:
-            self.frame_trans, self.frame_other = {}, False
-        elif s.op == "trans":
-            if s.clear:
-                self.frame_trans = {}
-                return
-            vals = {k: constant(v) for k, v in s.values.items()}
-            self.frame_trans = None if None in vals.values() else vals
-            if not s.local:
-                self.frame_other = False
-        elif not s.clear:
-            self.frame_other = True
-            if not s.local and s.center is None:
-                self.frame_trans = {}
 
     def _additive_trans(self, s: n.FrameOp):
         """ATRANS with no rotation, scale or mirror active: G52 with the accumulated shift."""
@@ -982,7 +885,8 @@ class IsoEmitter:
         self.frame_trans = total
         self.pos = {}
         self.lowered("additive translation (ATRANS) written as G52 with the accumulated shift")
-        return [("G:18", "G52")] + [(k, k + format_number(v + 0.0, True)) for k, v in total.items()]
+        return [self.code_word("nonmodal", "local_offset")] + [(k, k + format_number(v + 0.0, True))
+                                                               for k, v in total.items()]
 
     def w_FrameOp(self, s: n.FrameOp):
         if s.additive:
@@ -990,35 +894,38 @@ class IsoEmitter:
                 return self._additive_trans(s)
             raise NotExpressible(f"an additive frame ({s.op})")
         other = self.frame_other
-        self._frame_state(s)
+        self.track_frame(s)
         if s.op == "all" and s.clear:
             # the whole programmable frame off (Sinumerik TRANS/ROT without values): cancel the
             # local shift, and rotation, scaling and mirroring when they may be active
-            words = [("G:18", "G52")] + [(k, k + "0.") for k in "XYZ"]
+            words = [self.code_word("nonmodal", "local_offset")] + [(k, k + "0.") for k in "XYZ"]
             if other:
-                words += [("G:16", "G69"), ("G:11", "G50"), ("G:22", "G50.1")] + [(k, k + "0.") for k in "XYZ"]
+                mirror = self._cancel("mirror_off")
+                words += self._cancel("rot_off") + self._cancel("scale_off") + mirror
+                words += [(k, k + "0.") for k in "XYZ"] if mirror else []
             return words
         if s.op == "trans":
+            shift = self.code_word("nonmodal", "local_offset")
             if s.clear:
-                return [("G:18", "G52")] + [(k, k + "0.") for k in "XYZ"]
+                return [shift] + [(k, k + "0.") for k in "XYZ"]
             if not s.local:
                 self.lowered("programmable translation written as G52 local offset")
-            return [("G:18", "G52")] + [(k, self.addr(k, v)) for k, v in s.values.items()]
+            return [shift] + [(k, self.addr(k, v)) for k, v in s.values.items()]
         if s.op == "rot":
             if s.clear:
-                return [("G:16", "G69")]
-            words = [("G:16", "G68")] + (self._axes(s.center) if s.center else [])
+                return self._cancel("rot_off")
             extra = {k: v for k, v in s.values.items() if k in "IJK"}
             if set(s.values) - set(extra):
                 raise NotExpressible("rotation about a named axis")
+            words = [self.code_word("frame", "rot")] + (self._axes(s.center) if s.center else [])
             words += [(k, self.addr(k, v)) for k, v in extra.items()]
             if s.angle is not None:
                 words.append(("R", self.addr("R", s.angle)))
             return words
         if s.op == "scale":
             if s.clear:
-                return [("G:11", "G50")]
-            words = [("G:11", "G51")] + (self._axes(s.center) if s.center else [])
+                return self._cancel("scale_off")
+            words = [self.code_word("frame", "scale")] + (self._axes(s.center) if s.center else [])
             vals = s.values
             if set(vals) == {"X", "Y", "Z"} and _same(vals.values()):
                 words.append(("P", "P" + self._factor(vals["X"])))
@@ -1031,13 +938,24 @@ class IsoEmitter:
             return words
         if s.op == "mirror":
             if s.clear:
-                return [("G:22", "G50.1")] + [(k, k + "0.") for k in s.values]
-            words = [("G:22", "G51.1")]
+                mirror = self._cancel("mirror_off")
+                return mirror + [(k, k + "0.") for k in s.values] if mirror else []
+            words = [self.code_word("frame", "mirror")]
             center = dict(s.center or {})
             for k in s.values:
                 center.setdefault(k, n.AxisValue(n.Num(0.0)))
             return words + self._axes(center)
         raise NotExpressible(f"frame operation {s.op}")
+
+    def _cancel(self, meaning: str) -> list:
+        """The code that cancels a frame component (rotation, scaling, mirroring); nothing when the
+        dialect has no such component (an ISO lathe: G50/G68 mean other things there), as setting
+        one is refused, so none is active."""
+        if self.table.code_for("frame", meaning) is None:
+            what = {"rot_off": "rotation", "scale_off": "scaling", "mirror_off": "mirroring"}[meaning]
+            self.lowered(f"{what} cancel left out: {self.target_text} has no {what}, so none is active")
+            return []
+        return [self.code_word("frame", meaning)]
 
     def _factor(self, v) -> str:
         if type(v) is n.Num:
@@ -1081,11 +999,11 @@ class IsoEmitter:
             return lines
         # a one-shot call leaves a modal one (MCALL) in force: its G8x mode starts again at the next hole
         if self.named_active:
-            lines.append([("G:9", "G80")])
+            lines.append([self.code_word("cycle", "off")])
             self.named_active = False
         self.lowered(f"{cyc.name} written as {cyc.retract} {cyc.code} at the current position, then G80")
         lines.append(self._cycle_words(cyc, []))
-        lines += self._restore(cyc) if self.named_cycle is None else [[("G:9", "G80")]]
+        lines += self._restore(cyc) if self.named_cycle is None else [[self.code_word("cycle", "off")]]
         return lines
 
     def _drill_axis(self) -> str:
@@ -1098,7 +1016,7 @@ class IsoEmitter:
             raise NotExpressible(f"{cyc.name} with RTP {format_number(cyc.rtp)} above the approach "
                                  f"level: the ISO cycle returns to where the tool is when it starts "
                                  f"(G98), which is not RTP here")
-        words = [("G:10", cyc.retract), ("G:9", cyc.code), *plane_words, *cyc.words]
+        words = [self.word_of(cyc.retract), self.word_of(cyc.code), *plane_words, *cyc.words]
         if cyc.feed is not None:
             words.append(("F", self.addr("F", cyc.feed)))
         self.pos = {a: v for a, v in self.pos.items() if a != ax}
@@ -1108,7 +1026,7 @@ class IsoEmitter:
 
     def _restore(self, cyc: IsoCycle) -> list:
         """After G80: the motion mode (ISO G80 leaves none) and the feed the cycle replaced."""
-        lines = [[("G:9", "G80")]]
+        lines = [[self.code_word("cycle", "off")]]
         if self.motion_mode not in (None, "arc_3point"):
             lines.append([self._g("motion", self.motion_mode)])
         if cyc.feed is not None:
@@ -1135,7 +1053,7 @@ class IsoEmitter:
                                  "(an ISO cycle positions at rapid)")
         plane_words = self._axes(s.target)
         ax_pos = self.pos.get(self._drill_axis())
-        self._track(s)
+        self.track(s)
         if self.named_active:
             return plane_words
         self.pos[self._drill_axis()] = ax_pos
@@ -1165,7 +1083,7 @@ class IsoEmitter:
                 raise NotExpressible(f"the hole pattern {s.name} under incremental distances")
             lines.append(self.w_Motion(move) if self.named_cycle is not None else self._axes(move.target))
             if self.named_cycle is None:
-                self._track(move)
+                self.track(move)
         self.motion_mode = mode
         if self.named_cycle is None and saved not in (None, "rapid", "arc_3point"):
             lines.append([self._g("motion", saved)])
@@ -1184,14 +1102,10 @@ class IsoEmitter:
             return self._named_call(s, *callee)
         kind = s.kind if s.kind in ("m98", "g65", "g66") else ("g66" if s.modal != "none" else "m98")
         if kind != s.kind:
-            self.lowered(f"call of {s.name} written as {kind.upper()}")
+            self.lowered(f"call of {s.name} written as {self.code_for(*_CALL[kind])}")
         if s.args:
             raise NotExpressible(f"positional arguments of the call to {s.name}")
-        words = []
-        if kind == "m98":
-            words.append(("", "M98"))
-        else:
-            words.append(("G:12" if kind == "g66" else "", "G65" if kind == "g65" else "G66"))
+        words = [self.code_word(*_CALL[kind])]
         prog = self._program_word(s.name, None) if s.name else None
         if s.name and (prog is None or not prog[1:].isdigit()):
             raise NotExpressible(f"a call of {s.name!r} by name (ISO calls O numbers)")
@@ -1232,10 +1146,10 @@ class IsoEmitter:
         if s.named_args:
             raise NotExpressible(f"named arguments of the call to {s.name}")
         if s.modal != "none":
-            kind = "G66"
+            kind = "g66"
         else:
-            kind = "G65" if unit.uses_locals else "M98"
-        self.lowered(f"call of {s.name} written as {kind} P{number}")
+            kind = "g65" if unit.uses_locals else "m98"
+        self.lowered(f"call of {s.name} written as {self.code_for(*_CALL[kind])} P{number}")
         return self._call_lines(s, kind, number, unit, self._callee_params(s.name))
 
     def _external_call(self, s: n.SubCall):
@@ -1254,9 +1168,9 @@ class IsoEmitter:
         unit = pl.unit_plan(n.Subprogram(s.name, self._where(), [], params), [], self.fresh_label)
         if unit.refusal:
             raise NotExpressible(unit.refusal)
-        kind = "G66" if s.modal != "none" else "G65"
+        kind = "g66" if s.modal != "none" else "g65"
         self.diags.append(at_span(
-            "NC404", "warning", f"the call of {s.name} is kept as {kind} P{number}: {s.name} is not in "
+            "NC404", "warning", f"the call of {s.name} is kept as {self.code_for(*_CALL[kind])} P{number}: {s.name} is not in "
             f"this program nor found beside it, so the target control must provide O{number} "
             f"(convert {s.name}'s own file to get it)", self._where()))
         return self._call_lines(s, kind, number, unit, params)
@@ -1286,7 +1200,7 @@ class IsoEmitter:
         """The call and, around it, the spill-stack traffic of its arguments: parameters passed in
         the callee's spill frame are written to #[#149+150+slot] first, by-reference ones read
         back from there after the call."""
-        words = [("G:12" if kind == "G66" else "", kind), ("P", f"P{number}")]
+        words = [self.code_word(*_CALL[kind]), ("P", f"P{number}")]
         if s.repeat is not None:
             words.append(("L", "L" + self.val(s.repeat)))
         before: list = []
@@ -1301,7 +1215,7 @@ class IsoEmitter:
             offset, size = unit.slots[prm.name.upper()]
             for k, element in enumerate(self._elements(arg, size, s.name)):
                 slot = f"#[#{pl.SPILL_POINTER}+{pl.SPILL_BASE + offset + k}]"
-                before.append([("#", f"{slot}={format_expr(element, self)}")])
+                before.append([("#", f"{slot}={self.expr(element)}")])
                 if prm.by_ref and type(element) is n.Var:
                     after.append([("#", f"{self.val(element)}={slot}")])
         if not before and not after:
@@ -1326,10 +1240,10 @@ class IsoEmitter:
     def w_ModalCallOff(self, s):
         if self.named_cycle is not None:
             return _Lines(self._cycle_off())
-        return [("G:12", "G67")]
+        return [self.code_word("call", "g67")]
 
     def w_Return(self, s):
-        words = [("", "M99")]
+        words = [self.code_word("call", "m99")]
         if s.to_label is not None:
             words.append(("P", "P" + self._goto_target(s.to_label)))
         pop = self._pop_frame()
@@ -1338,10 +1252,11 @@ class IsoEmitter:
         return words
 
     def w_ProgramEnd(self, s):
-        return [("", {"end": "M2", "end_rewind": "M30", "restart": "M99"}.get(s.kind, "M30"))]
+        meaning = _PROGRAM_END.get(s.kind, _PROGRAM_END["end_rewind"])
+        return [self.code_word(*meaning)]
 
     def w_Stop(self, s):
-        return [("", "M1" if s.optional else "M0")]
+        return [self.code_word("stop", "optional" if s.optional else "program")]
 
     def w_Assign(self, s):
         text = self.assign(s)
@@ -1359,7 +1274,7 @@ class IsoEmitter:
 
     def w_Message(self, s):
         self.lowered("message written as an (MSG, ...) comment")
-        text = s.text.value if type(s.text) is n.Str else format_expr(s.text, self)
+        text = s.text.value if type(s.text) is n.Str else self.expr(s.text)
         return [("", self._comment(f"MSG, {text}"))]
 
     def w_Alarm(self, s):
@@ -1367,7 +1282,7 @@ class IsoEmitter:
         num = self.val(s.number)
         text = ""
         if s.text is not None:
-            text = " " + self._comment(s.text.value if type(s.text) is n.Str else format_expr(s.text, self))
+            text = " " + self._comment(s.text.value if type(s.text) is n.Str else self.expr(s.text))
         return [("#3000", f"#3000={num}{text}")]
 
     def w_VarDecl(self, s: n.VarDecl):
@@ -1380,14 +1295,14 @@ class IsoEmitter:
         local = plan.locals.get(s.name.upper()) if plan is not None else None
         if plan is not None and s.name.upper() in plan.slots:
             init = s.init[0] if s.init else n.Num(0.0)
-            return [("#", f"{self.var_text(var)}={format_expr(init, self)}")]
+            return [("#", f"{self.var_text(var)}={self.expr(init)}")]
         if local is not None:
             # a G65 local starts vacant; DEF starts at its initial value or 0
             init = s.init[0] if s.init else n.Num(0.0)
             self.lowered(f"local variable {s.name} written as #{local}")
-            return [("#", f"#{local}={format_expr(init, self)}")]
+            return [("#", f"#{local}={self.expr(init)}")]
         if s.init:
-            return [("#", f"{self.val(var)}={format_expr(s.init[0], self)}")]
+            return [("#", f"{self.val(var)}={self.expr(s.init[0])}")]
         self.map_var(var)
         return []
 
@@ -1410,7 +1325,7 @@ class IsoEmitter:
         self.arrays[(self.unit, s.name.upper())] = pl.ArrayPlan(base, dims)
         self.lowered(f"array {s.name}[{','.join(map(str, dims))}] stored row-major in "
                      f"#{base}..#{base + size - 1}")
-        return _Lines([[("#", f"#{base + i}={format_expr(init[i] if i < len(init) else n.Num(0.0), self)}")]
+        return _Lines([[("#", f"#{base + i}={self.expr(init[i] if i < len(init) else n.Num(0.0))}")]
                        for i in range(size)])
 
     def w_PolarPole(self, s: n.PolarPole):
@@ -1444,12 +1359,19 @@ class IsoEmitter:
         lclass = classes.get((s.kind, s.extended))
         if lclass is None:
             raise NotExpressible(f"data setting {s.kind}")
-        words = [("G:18", "G10"), ("L", "L" + lclass), ("P", self.addr("P", s.index))]
+        words = [self.code_word("nonmodal", "data_setting"), ("L", "L" + lclass), ("P", self.addr("P", s.index))]
         if s.kind == "work_offset":
             words += [(k, self.addr(k, v)) for k, v in s.values.items()]
         elif "value" in s.values:
             words.append(("R", self.addr("R", s.values["value"])))
         return words
+
+
+# SubCall kinds -> the meaning of the code that calls so
+_CALL = {"m98": ("call", "m98"), "g65": ("nonmodal", "macro_call"), "g66": ("call", "g66")}
+# ProgramEnd kinds -> the meaning of the code that ends a program so (M99: the program restarts)
+_PROGRAM_END = {"end": ("program_end", "end"), "end_rewind": ("program_end", "end_rewind"),
+                "restart": ("call", "m99")}
 
 
 def _same(values) -> bool:

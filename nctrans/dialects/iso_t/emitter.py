@@ -6,6 +6,7 @@ and the maximum spindle speed. Turning cycles are not written back as cycles: th
 expands them (nctrans.convert)."""
 from __future__ import annotations
 
+from nctrans.dialects.emit import NotExpressible
 from nctrans.dialects.iso_m import emitter as iso
 from nctrans.ir import nodes as n
 
@@ -16,6 +17,7 @@ class TurningEmitter(iso.IsoEmitter):
     dialect = "iso-t"
     table_name = "iso-t"
     target_text = "ISO turning"
+    lowered_for = "ISO"
 
     def __init__(self, program: n.Program):
         super().__init__(program)
@@ -45,7 +47,7 @@ class TurningEmitter(iso.IsoEmitter):
             inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
             letter = _INC.get(k, k) if inc else k
             if av.mode not in (None, "inc", "abs"):
-                raise iso.NotExpressible(f"per-word {av.mode} coordinate on {k}")
+                raise NotExpressible(f"per-word {av.mode} coordinate on {k}")
             words.append((letter, self.addr(letter, value)))
         return words
 
@@ -53,7 +55,7 @@ class TurningEmitter(iso.IsoEmitter):
         t = s.tool
         if type(t) is n.Num and t.value == int(t.value) and 0 <= t.value < 100:
             return [("T", f"T{int(t.value):02d}{int(t.value):02d}")]
-        raise iso.NotExpressible("a tool number that is not 0..99")
+        raise NotExpressible("a tool number that is not 0..99")
 
     def w_ToolChange(self, s):
         self.pos = {}
@@ -65,7 +67,7 @@ class TurningEmitter(iso.IsoEmitter):
 
     def w_SetPosition(self, s):
         self.pos = {}
-        return [("G:0", "G50")] + self._axes(s.target)
+        return [self.code_word("nonmodal", "coordinate_setting")] + self._axes(s.target)
 
     def w_HomeReturn(self, s):
         """G28 U0 W0: an incremental via point is written with U/W (system A has no G91); a
@@ -74,10 +76,10 @@ class TurningEmitter(iso.IsoEmitter):
         via = {k: av for k, av in s.via.items()
                if not (k == "Y" and av.mode == "inc" and type(av.value) is n.Num and av.value.value == 0)}
         if any(k not in _INC and av.mode == "inc" for k, av in via.items()):
-            raise iso.NotExpressible("an incremental reference-point via point on an axis without "
+            raise NotExpressible("an incremental reference-point via point on an axis without "
                                      "an incremental address")
-        return [("G:0", "G28" if s.ref == 1 else "G30")] + self._ref_index(s) + self._axes(via)
+        return [self.code_word("nonmodal", "home" if s.ref == 1 else "home2")] + self._ref_index(s) + self._axes(via)
 
     def w_SpindleLimit(self, s):
-        return [("G:0", "G50"), ("S", self.addr("S", s.value))]
+        return [self.code_word("nonmodal", "coordinate_setting"), ("S", self.addr("S", s.value))]
 
