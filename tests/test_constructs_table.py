@@ -79,8 +79,9 @@ CONSTRUCTS = [
       {"iso-m": "G55", "iso-t": "G55", "sinumerik": "G55", "fagor": "G55"}),
     C("ZX plane", [block(mode("plane", "ZX"))],
       {"iso-m": "G18", "iso-t": "G18", "sinumerik": "G18", "fagor": "G18"}),
+    # Sinumerik G70 is inch geometry only (feeds stay in the basic system); G700 is inch for both
     C("inch units", [block(mode("units", "inch"))],
-      {"iso-m": "G20", "iso-t": "G20", "sinumerik": "G70", "fagor": "G70"}),
+      {"iso-m": "G20", "iso-t": "G20", "sinumerik": "G700", "fagor": "G70"}),
     C("metric units", [block(mode("units", "mm"))],
       {"iso-m": "G21", "iso-t": "G21", "sinumerik": "G71", "fagor": "G71"}),
     C("incremental distances", [block(mode("distance", "incremental"))],
