@@ -36,7 +36,7 @@ def test_unmodelled_cycle_is_reported_at_its_line_and_moves_nothing(name):
 
 def test_fail_on_warning_and_flatten_refuse(tmp_path, capsys):
     src = tmp_path / "p.mpf"
-    src.write_text("G17 G90 G0 X0 Y0 Z20 F100 S1000 M3\nPOCKET3(10, 0, 2, -5, 40, 30, 5)\nM30\n")
+    src.write_text("G17 G90 G0 X0 Y0 Z20 F100 S1000 M3\nCYCLE72(\"KONTUR\", 10, 0, 2, -5)\nM30\n")
     assert cli.main(["lint", str(src), "--from", "sinumerik", "--fail-on", "warning"]) == 1
     conv = api.transpile(src.read_text(), "sinumerik", "iso-m", flatten=True)
     assert conv.text is None and any(d.rule == "NC402" and d.line == 2 for d in conv.diagnostics)

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import api, pipeline
-from nctrans.interp.milling_cycles import depth_levels, pocket_steps, rect_ring
+from nctrans.interp.milling_cycles import arc_slot_ring, depth_levels, milling_steps, rect_ring
 from nctrans.machine import Machine, Tool
 from nctrans.source import from_text
 
@@ -106,8 +106,8 @@ def test_finishing_only_goes_round_the_edge_once_per_finishing_cut():
 
 def test_rotated_pocket_and_arc_directions():
     segs = rect_ring(2.0, 1.0, 0.0, ccw=True)
-    assert [e for e, _ in segs] == [(2.0, 1.0), (-2.0, 1.0), (-2.0, -1.0), (2.0, -1.0), (2.0, 0.0)]
-    assert [e for e, _ in rect_ring(2.0, 1.0, 0.0, ccw=False)] == [
+    assert [e for e, _, _ in segs] == [(2.0, 1.0), (-2.0, 1.0), (-2.0, -1.0), (2.0, -1.0), (2.0, 0.0)]
+    assert [e for e, _, _ in rect_ring(2.0, 1.0, 0.0, ccw=False)] == [
         (2.0, -1.0), (-2.0, -1.0), (-2.0, 1.0), (2.0, 1.0), (2.0, 0.0)]
     # STA1 90: the length runs along Y; the finishing contour's far end is at Y 50 + 20 - 3
     recs, _ = _run("POCKET1(10, 0, 2, -2, , 40, 20, 0, 50, 50, 90, 100, 300, 0, 3, 0, 2)")
@@ -189,7 +189,7 @@ def test_pocket_moves_stay_inside_reach_the_depth_and_end_at_rtp(c):
     p.update(RTP=c["RFP"] + 15, SDIS=1.0, DP=c["RFP"] - c["depth"], FFD=50, FFP1=200, FFP2=100,
              CRAD=c["crad_frac"] * half)
     start = (0.0, 0.0, c["RFP"] + 40)
-    steps = pocket_steps("rect_pocket" if rect else "circ_pocket", p, r, start, 300.0)
+    steps = milling_steps("rect_pocket" if rect else "circ_pocket", p, r, start, 300.0)
     a, b = (c["LENG"] / 2, c["WID"] / 2) if rect else (c["PRAD"], c["PRAD"])
     rc = max(p["CRAD"] - r, 0.0) if rect else a - r
     ang = math.radians(c["STA1"]) if rect else 0.0
@@ -215,16 +215,26 @@ def test_pocket_moves_stay_inside_reach_the_depth_and_end_at_rtp(c):
 @pytest.mark.parametrize("call", [
     "POCKET1(10, 0, 2, -6, , 40, 20, 5, 50, 50, 30, 100, 300, 3, 2, 0.5, 0, 2, 200)",
     "POCKET2(10, 0, 2, -5, , 15, 50, 50, 100, 300, 5, 3, 1, 0, 0, 200)",
+    "POCKET3(10, 0, 2, -5, 30, 20, 4, 50, 50, 15, 2.5, 0.5, 0.2, 300, 100, 1, 1, 4)",
+    "POCKET4(10, 0, 2, -5, 15, 50, 50, 5, 1, 0.5, 300, 100, 0, 1, 5)",
+    "SLOT1(10, 0, 2, -4, , 3, 30, 10, 50, 50, 40, 10, 0, 100, 300, 2, 3, 0.5, 0, 4, 200)",
+    "SLOT2(10, 0, 2, -3, , 2, 60, 12, 50, 50, 30, 0, 180, 100, 300, 0, 2, 0.5, 0)",
+    "LONGHOLE(10, 0, 2, -5, , 4, 20, 50, 50, 30, 45, 0, 100, 300, 2)",
+    "CYCLE71(10, 0, 2, -2, 0, 0, 100, -40, 20, 1, 0, 5, 0.5, 400, 41)",
+    "CYCLE76(10, 0, 2, -4, , 40, 20, 2, 50, 50, 30, 2, 0.5, 0, 300, 100, 0, 1, 60, 40)",
+    "CYCLE77(10, 0, 2, -3, , 10, 50, 50, 0, 0.5, 0, 300, 100, 1, 1, 40)",
+    "CYCLE90(10, 0, 2, -6, , 24, 21, 3, 200, 2, 0, 50, 50)",
 ])
 def test_converted_to_iso_is_lowered_and_equivalent(call):
     text = f"G17 G90 G54 T1 D1 M6\nS2000 M3 F500\nG0 X50 Y50 Z20\n{call}\nG0 X0 Y0\nM30\n"
     machine = _machine(3.0)
+    name = call.split("(")[0]
     conv = api.transpile(text, "sinumerik", "iso-m", machine=machine)
-    assert conv.text is not None and "POCKET" not in conv.text and "G65" not in conv.text
+    assert conv.text is not None and name not in conv.text and "G65" not in conv.text
     assert any(d.rule == "NC401" and d.line == 4 for d in conv.diagnostics)
     assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m", machine=machine)
     again = api.transpile(text, "sinumerik", "sinumerik", machine=machine)
-    assert "POCKET" in again.text
+    assert f"{name}(" in again.text
     assert api.equiv(text, again.text, read_a="sinumerik", read_b="sinumerik", machine=machine)
 
 
@@ -232,6 +242,261 @@ def test_converted_without_a_tool_radius_is_refused():
     text = "G17 G90 G0 X50 Y50 Z20 F100 S1000 M3\nPOCKET2(10, 0, 2, -5, , 15, 50, 50, 100, 300)\nM30\n"
     conv = api.transpile(text, "sinumerik", "iso-m")
     assert conv.text is None and any(d.rule == "NC402" and d.line == 2 for d in conv.diagnostics)
+
+
+# ---------------------------------------------------------------------------------------------
+# Slots, elongated holes, spigots, face and thread milling: hand-computed paths
+
+def _start_at(recs, line=4):
+    return [r for r in recs if r.line == line]
+
+
+def _check(got, want):
+    assert [g[0] for g in got] == [w[0] for w in want], got
+    for g, w in zip(got, want):
+        assert g[1] == pytest.approx(tuple(map(float, w[1])), abs=1e-6), (g, w)   # _ends rounds to 1e-6
+        if w[0] == "arc":
+            assert g[2] == pytest.approx(tuple(map(float, w[2])), abs=1e-6) and g[3] == w[3], (g, w)
+        elif len(w) > 2:
+            assert g[2] == w[2], (g, w)
+
+
+def test_slot1_by_hand():
+    # two 30 x 10 slots on a radius-40 circle at 0 and 180 deg, tool radius 4, one 4 mm cut, roughing,
+    # CDIR 3. Slot = a 30 x 10 pocket with corner radius 5: tool limit 11 x 1, centre line +-10,
+    # one ring (1 / 6.4 -> 1): a stadium of half sizes 11 x 1 with end radius 1.
+    recs, diags = _run("SLOT1(10, 0, 2, -4, , 2, 30, 10, 0, 0, 40, 0, 180, 100, 300, 0, 3, 0, 1)", radius=4.0)
+    assert not [d for d in diags if d.severity != "info"]
+    got = _ends(recs)
+    first = [("rapid", (40, 0, 20)), ("rapid", (40, 0, 2)), ("linear", (40, 0, -4), 100),
+             ("linear", (30, 0, -4), 300), ("linear", (50, 0, -4), 300), ("linear", (51, 0, -4), 300),
+             ("arc", (50, 1, -4), (50, 0), "ccw"), ("linear", (30, 1, -4), 300),
+             ("arc", (29, 0, -4), (30, 0), "ccw"), ("arc", (30, -1, -4), (30, 0), "ccw"),
+             ("linear", (50, -1, -4), 300), ("arc", (51, 0, -4), (50, 0), "ccw"),
+             ("linear", (40, 0, -4), 300), ("rapid", (40, 0, 10))]
+    second = [("rapid", (-40, 0, 10)), ("rapid", (-40, 0, 2)), ("linear", (-40, 0, -4), 100),
+              ("linear", (-30, 0, -4), 300), ("linear", (-50, 0, -4), 300), ("linear", (-51, 0, -4), 300),
+              ("arc", (-50, -1, -4), (-50, 0), "ccw")]
+    _check(got[:len(first) + len(second)], first + second)
+    assert got[-1][0] == "rapid" and got[-1][1] == pytest.approx((-40, 0, 10))
+
+
+def test_slot2_arc_slot_contour():
+    # the contour round a 90 deg arc of radius 20 at distance 2, counterclockwise, from behind its start
+    start, segs = arc_slot_ring(20.0, 0.0, 90.0, 2.0, True)
+    assert start == pytest.approx((20.0, -2.0))
+    assert [e for e, _, _ in segs][0] == pytest.approx((22.0, 0.0))         # quarter round the start
+    assert [e for e, _, _ in segs][1] == pytest.approx((0.0, 22.0), abs=1e-12)   # outer arc
+    assert [e for e, _, _ in segs][2] == pytest.approx((0.0, 18.0), abs=1e-12)   # end cap
+    assert [e for e, _, _ in segs][3] == pytest.approx((18.0, 0.0), abs=1e-12)   # inner arc
+    assert [cw for _, _, cw in segs] == [False, False, False, True, False]
+    back, rev = arc_slot_ring(20.0, 0.0, 90.0, 2.0, False)
+    assert back == pytest.approx(start) and rev[-1][0] == pytest.approx(start)
+    assert [cw for _, _, cw in rev] == [True, False, True, True, True]
+    # SLOT2 at depth: plunge at the arc's start, centre arc there and back, then the ring, back
+    recs, _ = _run("SLOT2(10, 0, 2, -3, , 1, 90, 12, 0, 0, 20, 0, 0, 100, 300, 0, 3, 0, 1)", radius=4.0)
+    got = _ends(recs)
+    _check(got[:6], [("rapid", (20, 0, 20)), ("rapid", (20, 0, 2)), ("linear", (20, 0, -3), 100),
+                     ("arc", (0, 20, -3), (0, 0), "ccw"), ("arc", (20, 0, -3), (0, 0), "cw"),
+                     ("linear", (20, -2, -3), 300)])
+
+
+def test_longhole_by_hand():
+    # one 20 mm elongated hole at (0, 30) lying along Y (STA1 90), tool radius 3: ends 7 either side;
+    # depth 5 in MID 2 -> three cuts of 5/3, infeed alternating at the two ends
+    recs, _ = _run("LONGHOLE(10, 0, 2, -5, , 1, 20, 0, 0, 30, 90, 0, 100, 300, 2)")
+    z1, z2 = -5 / 3, -10 / 3
+    _check(_ends(recs), [("rapid", (0, 23, 20)), ("rapid", (0, 23, 2)),
+                         ("linear", (0, 23, z1), 100), ("linear", (0, 37, z1), 300),
+                         ("linear", (0, 37, z2), 100), ("linear", (0, 23, z2), 300),
+                         ("linear", (0, 23, -5), 100), ("linear", (0, 37, -5), 300),
+                         ("rapid", (0, 37, 10))])
+
+
+def test_circular_spigot_by_hand():
+    # CYCLE77 radius 10 from a 30 mm blank, tool 4, allowance 0.5, roughing clockwise (CDIR 2):
+    # 5 - 0.5 = 4.5 of material in one ring (4.5 < 6.4) at radius 10 + 4 + 0.5; entered at 10+5+4+2
+    recs, _ = _run("CYCLE77(10, 0, 2, -3, , 10, 0, 0, 0, 0.5, 0, 300, 100, 2, 1, 30)", radius=4.0)
+    c = (0, 0)
+    _check(_ends(recs), [("rapid", (21, 0, 20)), ("rapid", (21, 0, 2)), ("linear", (21, 0, -3), 100),
+                         ("linear", (14.5, 0, -3), 300), ("arc", (-14.5, 0, -3), c, "cw"),
+                         ("arc", (14.5, 0, -3), c, "cw"), ("linear", (21, 0, -3), 300),
+                         ("rapid", (21, 0, 10))])
+    # from a 50 mm blank: 14.5 mm in ceil(14.5 / 6.4) = 3 rings, outside in
+    recs, _ = _run("CYCLE77(10, 0, 2, -3, , 10, 0, 0, 0, 0.5, 0, 300, 100, 2, 1, 50)", radius=4.0)
+    radii = [round(r.end["X"], 6) for r in recs if r.kind == "linear" and r.end["Y"] == 0 and r.end["X"] < 25]
+    assert radii == pytest.approx([10 + 4.5 + 14.5 * 2 / 3, 10 + 4.5 + 14.5 / 3, 14.5])
+
+
+def test_rectangular_spigot_climb_by_hand():
+    # CYCLE76 40 x 20, corner 2, no blank, finishing (VARI 2), CDIR 0 = climb: with M3 round a spigot
+    # that is clockwise; tool 5 -> contour 25 x 15 half sizes, corner 7; entered at 20 + 5 + 2
+    recs, _ = _run("CYCLE76(10, 0, 2, -4, , 40, 20, 2, 0, 0, 0, 0, 0, 0, 300, 100, 0, 2)", radius=5.0)
+    _check(_ends(recs), [("rapid", (27, 0, 20)), ("rapid", (27, 0, 2)), ("linear", (27, 0, -4), 100),
+                         ("linear", (25, 0, -4), 300), ("linear", (25, -8, -4), 300),
+                         ("arc", (18, -15, -4), (18, -8), "cw"), ("linear", (-18, -15, -4), 300),
+                         ("arc", (-25, -8, -4), (-18, -8), "cw"), ("linear", (-25, 8, -4), 300),
+                         ("arc", (-18, 15, -4), (-18, 8), "cw"), ("linear", (18, 15, -4), 300),
+                         ("arc", (25, 8, -4), (18, 8), "cw"), ("linear", (25, 0, -4), 300),
+                         ("linear", (27, 0, -4), 300), ("rapid", (27, 0, 10))])
+
+
+def test_face_milling_meander_and_one_way_by_hand():
+    # 100 x 40 face from (0, 0), tool radius 10, MIDA 0 -> 16 mm apart at most: paths at Y 10, 20, 30
+    # (edges flush with the sides), each from X -15 to 115 (radius + FDP 5 beyond), 1 mm deep
+    recs, _ = _run("CYCLE71(10, 0, 2, -1, 0, 0, 100, 40, 0, 0, 0, 5, 0, 400, 31)", radius=10.0)
+    _check(_ends(recs), [("rapid", (-15, 10, 20)), ("rapid", (-15, 10, 2)),
+                         ("linear", (-15, 10, -1), 400), ("linear", (115, 10, -1), 400),
+                         ("linear", (115, 20, -1), 400), ("linear", (-15, 20, -1), 400),
+                         ("linear", (-15, 30, -1), 400), ("linear", (115, 30, -1), 400),
+                         ("rapid", (115, 30, 10))])
+    recs, _ = _run("CYCLE71(10, 0, 2, -1, 0, 0, 100, 40, 0, 0, 0, 5, 0, 400, 11)", radius=10.0)
+    _check(_ends(recs)[:8], [("rapid", (-15, 10, 20)), ("rapid", (-15, 10, 2)),
+                             ("linear", (-15, 10, -1), 400), ("linear", (115, 10, -1), 400),
+                             ("rapid", (115, 10, 2)), ("rapid", (-15, 20, 2)),
+                             ("linear", (-15, 20, -1), 400), ("linear", (115, 20, -1), 400)])
+
+
+def test_thread_milling_by_hand():
+    # internal M20 x 2 thread 3 mm deep, tool radius 4: helix radius 6, 1.5 turns from Z-3 up to Z0
+    recs, _ = _run("CYCLE90(10, 0, 2, -3, , 20, 17.5, 2, 200, 3, 0, 0, 0)", radius=4.0)
+    c = (0, 0)
+    _check(_ends(recs), [("rapid", (0, 0, 20)), ("rapid", (0, 0, 2)), ("linear", (0, 0, -3), 200),
+                         ("linear", (6, 0, -3), 200), ("arc", (-6, 0, -2), c, "ccw"),
+                         ("arc", (6, 0, -1), c, "ccw"), ("arc", (-6, 0, 0), c, "ccw"),
+                         ("linear", (0, 0, 0), 200), ("rapid", (0, 0, 10))])
+    # 2.5 deep: 1.25 turns, the last quarter turn ends at 90 deg
+    recs, _ = _run("CYCLE90(10, 0, 2, -2.5, , 20, 17.5, 2, 200, 3, 0, 0, 0)", radius=4.0)
+    arcs = [r for r in recs if r.kind == "arc"]
+    assert [round(r.end["Z"], 9) for r in arcs] == [-1.5, -0.5, 0]
+    assert (arcs[-1].end["X"], arcs[-1].end["Y"]) == pytest.approx((0, 6), abs=1e-9)
+    # external: helix radius 10 + 4, entered from outside at 14 + SDIS
+    recs, _ = _run("CYCLE90(10, 0, 2, -2, , 20, 17.5, 2, 200, 2, 1, 0, 0)", radius=4.0)
+    _check(_ends(recs)[:5], [("rapid", (16, 0, 20)), ("rapid", (16, 0, 2)),
+                             ("linear", (16, 0, -2), 200), ("linear", (14, 0, -2), 200),
+                             ("arc", (-14, 0, -1), c, "cw")])
+
+
+def test_pocket3_and_pocket4_by_hand():
+    # POCKET4 radius 15, tool 4, FAL 1, FALD 0.5, MID 5, roughing (VARI 1), CDIR 0 = climb (M3: G3),
+    # MIDA 5: rings 10 / ceil(10 / 5) = 2 -> radii 5 and 10, roughed down to -5 + 0.5
+    recs, _ = _run("POCKET4(10, 0, 2, -5, 15, 50, 50, 5, 1, 0.5, 300, 100, 0, 1, 5)", radius=4.0)
+    c = (50, 50)
+    _check(_ends(recs), [("rapid", (50, 50, 2)), ("linear", (50, 50, -4.5), 100),   # already over the centre
+                         ("linear", (55, 50, -4.5), 300), ("arc", (45, 50, -4.5), c, "ccw"),
+                         ("arc", (55, 50, -4.5), c, "ccw"), ("linear", (60, 50, -4.5), 300),
+                         ("arc", (40, 50, -4.5), c, "ccw"), ("arc", (60, 50, -4.5), c, "ccw"),
+                         ("linear", (50, 50, -4.5), 300), ("rapid", (50, 50, 10))])
+    # POCKET3 finishing (VARI 2) of a 30 x 20 sharp pocket at (0, 0), tool 5, CDIR 2: contour 10 x 5
+    recs, _ = _run("POCKET3(10, 0, 2, -2, 30, 20, 0, 0, 0, 0, 0, 0, 0, 300, 100, 2, 2)", radius=5.0)
+    corners = [r.end for r in recs if r.kind == "linear" and r.feed == 300 and r.end["Z"] == -2]
+    assert [(c["X"], c["Y"]) for c in corners] == [(10, 0), (10, -5), (-10, -5), (-10, 5), (10, 5),
+                                                   (10, 0), (0, 0)]
+
+
+@pytest.mark.parametrize("call, rule", [
+    ("POCKET3(10, 0, 2, -5, 30, 20, 0, 0, 0, 0, 0, 0, 0, 300, 100, 0, 21)", "NC224"),   # helical insertion
+    ("POCKET4(10, 0, 2, -5, 15, 0, 0, 0, 0, 0, 300, 100, 0, 1, 0, 20)", "NC224"),        # blank AP1
+    ("SLOT1(10, 0, 2, -4, , 2, 30, 10, 0, 0, 40, 0, 180, 100, 300, 0, 3, 0, 1, 0, 0, 0, 1)", "NC224"),
+    ("LONGHOLE(10, 0, 2, -5, , 1, 5, 0, 0, 30, 90)", "NC225"),                           # shorter than the tool
+    ("SLOT2(10, 0, 2, -3, , 1, 90, 12, 0, 0, 5, 0)", "NC225"),                           # reaches the centre
+    ("CYCLE71(10, 0, 2, -1, 0, 0, 100, 40, 0, 0, 0, 5, 0, 400, 5)", "NC225"),            # no path pattern
+    ("CYCLE90(10, 0, 2, -3, , 6, 5, 1, 200, 3, 0, 0, 0)", "NC225"),                      # tool too large
+    ("CYCLE90(10, 0, 2, -3, , 20, 17.5, 2, 200, 3, 4, 0, 0)", "NC225"),                  # TYPTH 4
+])
+def test_what_is_not_modelled_or_impossible_moves_nothing(call, rule):
+    recs, diags = _run(call, radius=4.0)
+    assert not [r for r in recs if r.line == 4]
+    assert [d.rule for d in diags if d.line == 4] == [rule]
+
+
+spigot_calls = st.fixed_dictionaries({
+    "rect": st.booleans(), "LENG": st.floats(5, 80), "WID": st.floats(5, 80), "crad_frac": st.floats(0, 1),
+    "PRAD": st.floats(2, 40), "blank": st.floats(0, 40), "PA": st.floats(-50, 50), "PO": st.floats(-50, 50),
+    "STA": st.floats(-180, 180), "radius": st.floats(0.5, 8), "FAL": st.floats(0, 1),
+    "depth": st.floats(0.5, 20), "MID": st.one_of(st.just(0.0), st.floats(0.5, 8)),
+    "VARI": st.sampled_from([1, 2]), "CDIR": st.sampled_from([0, 1, 2, 3]),
+})
+
+
+@settings(max_examples=80, deadline=None)
+@given(spigot_calls)
+def test_spigot_moves_stay_outside_reach_the_depth_and_end_at_rtp(c):
+    rect, r = c["rect"], c["radius"]
+    p = {k: c[k] for k in ("LENG", "WID", "PRAD", "PA", "PO", "STA", "FAL", "MID", "VARI", "CDIR")}
+    a, b = (c["LENG"] / 2, c["WID"] / 2) if rect else (c["PRAD"], c["PRAD"])
+    p.update(RTP=15, RFP=0, SDIS=1, DP=-c["depth"], FFD=50, FFP1=200, CRAD=c["crad_frac"] * min(a, b),
+             AP1=2 * a + c["blank"], AP2=2 * b + c["blank"])
+    start = (0.0, 0.0, 40.0)
+    steps = milling_steps("rect_spigot" if rect else "circ_spigot", p, r, start, 300.0)
+    rc = p["CRAD"] if rect else a
+    ang = math.radians(c["STA"]) if rect else 0.0
+    keep = r + (c["FAL"] if c["VARI"] == 1 else 0.0)
+    deepest = math.inf
+    for kind, (x, y, h) in _points(steps, start):
+        deepest = min(deepest, h)
+        if h >= 0:
+            continue
+        du, dv = x - c["PA"], y - c["PO"]
+        u = abs(du * math.cos(ang) + dv * math.sin(ang))
+        v = abs(-du * math.sin(ang) + dv * math.cos(ang))
+        # distance from the spigot (a rectangle with rounded corners) is at least the tool radius (+FAL)
+        qu, qv = max(u - (a - rc), 0.0), max(v - (b - rc), 0.0)
+        assert math.hypot(qu, qv) - rc >= keep - 1e-6
+        # and never further out than the blank's edge plus the tool radius and the clearance SDIS
+        assert math.hypot(qu, qv) - rc <= max(c["blank"] / 2, keep - r) + r + 1 + 1e-6
+    assert deepest == pytest.approx(-c["depth"])
+    assert steps[-1][0] == "rapid" and steps[-1][1][2] == pytest.approx(15)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(6, 60), st.floats(0.5, 5), st.floats(0.2, 4), st.floats(0.5, 20), st.sampled_from([2, 3]),
+       st.sampled_from([0, 1]))
+def test_thread_helix_keeps_its_radius_and_pitch(diath, radius, pit, depth, cdir, typth):
+    if typth == 0 and diath / 2 - radius < 0.1:
+        return
+    p = dict(RTP=10, RFP=0, SDIS=1, DP=-depth, DIATH=diath, PIT=pit, FFR=100, CDIR=cdir, TYPTH=typth,
+             CPA=3, CPO=-4)
+    steps = milling_steps("thread_mill", p, radius, (0.0, 0.0, 30.0), 100.0)
+    r_path = diath / 2 + (radius if typth else -radius)
+    at, climbed, arcs = None, 0.0, 0
+    for s in steps:
+        if s[0] == "arc":
+            x, y, h = s[1]
+            assert math.hypot(x - 3, y + 4) == pytest.approx(r_path)
+            assert s[3] == (cdir == 2)
+            assert 0 < h - at[2] <= pit / 2 + 1e-9          # never more than half a pitch per half turn
+            climbed += h - at[2]
+            arcs += 1
+        if s[0] in ("rapid", "linear", "arc"):
+            at = s[1]
+    assert climbed == pytest.approx(depth) and arcs == math.ceil(2 * depth / pit - 1e-9)
+    assert at[2] == pytest.approx(10)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(5, 200), st.floats(5, 100), st.floats(1, 12), st.sampled_from([11, 21, 31, 41, 12, 32]),
+       st.floats(0.2, 6), st.floats(-90, 90))
+def test_face_paths_cover_the_face_and_reach_the_depth(leng, wid, radius, vari, depth, sta):
+    p = dict(RTP=10, RFP=0, SDIS=1, DP=-depth, PA=0, PO=0, LENG=leng, WID=wid, STA=sta, MID=2, FDP=3,
+             FFP1=500, VARI=vari)
+    steps = milling_steps("face", p, radius, (0.0, 0.0, 30.0), 100.0)
+    ang = math.radians(sta)
+    along_u = vari // 10 in (1, 3)
+    cuts = [s[1] for s in steps if s[0] == "linear"]
+    across = []
+    for x, y, h in cuts:
+        u, v = x * math.cos(ang) + y * math.sin(ang), -x * math.sin(ang) + y * math.cos(ang)
+        s_, c_ = (u, v) if along_u else (v, u)
+        span, width = (leng, wid) if along_u else (wid, leng)
+        assert -radius - 3 - 1e-6 <= s_ <= span + radius + 3 + 1e-6
+        assert radius - 1e-6 <= c_ <= max(width - radius, width / 2) + 1e-6 or width <= 2 * radius
+        across.append(c_)
+    across = sorted(set(round(a, 6) for a in across))
+    gaps = [b - a for a, b in zip(across, across[1:])]
+    assert all(g <= 1.6 * radius + 1e-6 for g in gaps)        # no strip left between paths
+    assert min(h for _, _, h in cuts) == pytest.approx(-depth)
+    assert steps[-1][1][2] == pytest.approx(10)
 
 
 def test_inch_programs_scale_lengths_and_g70_keeps_feeds_in_mm():

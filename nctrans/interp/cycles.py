@@ -390,7 +390,7 @@ class MillingCycle:
     """A milling cycle nctrans models ([[milling]]): `shape` picks the motion (milling_cycles.py)."""
     __pydantic_config__ = {"extra": "forbid"}
     name: str
-    shape: Literal["rect_pocket", "circ_pocket", "rect_spigot", "circ_spigot", "slots_circle",
+    shape: Literal["rect_pocket", "circ_pocket", "rect_pocket3", "circ_pocket4", "rect_spigot", "circ_spigot", "slots_circle",
                    "arc_slots", "long_holes", "face", "thread_mill"]
     params: list[str]
     meaning: str = ""

@@ -1503,6 +1503,11 @@ class Interpreter(LatheMixin, RunChecks):
                 | {m.name: m for m in table.milling}).get(s.name.upper())
         params = list(spec.params) if spec is not None else []
         args = [s.params.get(table.neutral(p), n.Num(0.0, "")) for p in params]
+        unit = self._find_unit(s.name)          # a PROC declaring fewer parameters than the table
+        given = [i for i, p in enumerate(params) if table.neutral(p) in s.params]
+        keep = max(len(unit.params) if unit is not None and unit.params else len(args),
+                   given[-1] + 1 if given else 0)
+        args = args[:keep]
         if s.modal:
             call = n.SubCall(s.name, args, modal="after_move", kind="mcall")
             self.modal_cycle = None

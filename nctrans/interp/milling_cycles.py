@@ -7,43 +7,69 @@ them through the interpreter's ordinary `_move`, so frames, limits, backplot, cy
 per-construct lowering into other dialects see nothing but rapids, feeds and arcs.
 
 Facts [GK] (Siemens SINUMERIK 840D/810D cycles manual; the seeds are silent):
-- the cycle approaches the pocket centre at the retraction plane RTP with G0, then RFP+SDIS with G0;
-- the depth is cut in equal infeeds of at most MID (finishing: MIDF), each fed at FFD vertically at
-  the pocket centre (POCKET1/POCKET2 need a centre-cutting end mill); DPR wins over DP;
-- roughing clears the pocket from the inside outwards at FFP1 and leaves FAL on the edge; finishing
-  goes round the edge at FFP2; VARI 0 = roughing then finishing, 1 = roughing, 2 = finishing;
-- CDIR 2 mills clockwise (G2), 3 counterclockwise (G3);
+- a cycle approaches its start point at the retraction plane RTP with G0, then RFP+SDIS with G0,
+  and ends with G0 to RTP; DPR (depth below RFP) wins over DP;
+- the depth is cut in equal infeeds of at most MID (finishing: MIDF), fed at FFD; POCKET1/POCKET2
+  and SLOT1/SLOT2 plunge vertically (centre-cutting end mill);
+- roughing clears from the inside out at FFP1 leaving FAL on the edge; finishing goes round the edge
+  at FFP2; VARI 0 = roughing then finishing, 1 = roughing, 2 = finishing (POCKET3/4, CYCLE76/77:
+  ones digit 1 roughing, 2 finishing; FALD is left on the floor by roughing);
+- CDIR 2 mills clockwise (G2), 3 counterclockwise (G3); POCKET3/4 and CYCLE76/77 also take 0 climb
+  and 1 conventional milling, which depend on the spindle direction (M3, inside a pocket: climb is
+  G3; round a spigot: G2);
 - the tool radius comes from the active offset; without one the control stops (alarm 61000 "no
-  tool offset active"), and a cutter too large for the pocket stops it too (alarm 61105).
-Modelling choices [NC] where the manual leaves the path to the control:
-- roughing rings are concentric copies of the finishing contour, equally spaced from the centre out,
-  at most `ring_step` (rules: 0.8) x the tool diameter apart; the innermost "ring" of a rectangle
-  is the centre line along its longer side; every ring starts and ends on the length axis (+u);
-- each depth cut and the finishing contour are entered from the pocket centre by a straight feed
-  (the control's tangential quarter-circle approach is not modelled) and left back to the centre;
-- the cycle ends with G0 from the pocket centre to RTP.
-Finishing spindle speed SSF has no effect on the path and is not modelled.
+  tool offset active"); a cutter too large for the shape stops it too (alarm 61105).
+Modelling choices [NC] where the manual leaves the path to the control (or the seeds cannot say):
+- roughing rings are concentric copies of the finishing contour, equally spaced, at most
+  `ring_step` (rules: 0.8) x the tool diameter apart (MIDA where the cycle has it); the innermost
+  "ring" of a pocket is its centre line (a rectangle's along its longer side, a slot's along its
+  arc); rings start and end on the length axis (+u), arc slots at their start cap;
+- every depth cut and the finishing contour are entered by a straight feed from the plunge point
+  (the control's tangential quarter-circle approach is not modelled) and left back to it;
+- slots and elongated holes on a circle lie radially with RAD to their middle (as the open plotter
+  ncplot7py reads them), LENG their whole length; an elongated hole is as wide as the tool and is cut
+  by infeeds alternating at its two ends;
+- a spigot is roughed from the blank AP1 x AP2 (one ring when no blank is given), entered outside it
+  on +u at RFP+SDIS;
+- face milling (CYCLE71) runs paths whose tool edge is flush with the face's sides, equally spaced at
+  most MIDA (0.8 x diameter when 0) apart, starting and ending FDP beyond the face;
+- thread milling (CYCLE90) climbs one pitch per turn from DP to RFP, entered from the centre
+  (internal) or from outside (external) by a straight feed.
+Finishing spindle speed SSF has no effect on the path and is not modelled. Calls that ask for what
+is not modelled (helical or oscillating insertion, a pre-machined blank, a floor allowance in
+SLOT1/SLOT2) say so (NC224) and move nothing.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Optional
+from typing import Callable, Optional
 
 from nctrans.interp.cycles import DRILL_AXIS, PLANE_AXES, cycle_table, milling_cycle
 
 # A planned step, in plane coordinates (abscissa, ordinate, height along the tool axis):
 # ("rapid" | "linear", (p1, p2, h)) | ("arc", (p1, p2, h), (c1, c2), cw) | ("feed", f)
 Step = tuple
+# A contour segment in local coordinates: (end (u, v), arc centre (u, v) or None, clockwise)
+Seg = tuple
 _EPS = 1e-9
+MAX_PASSES = 10_000
 
 
 class MillingError(Exception):
-    """The call cannot run as the control would run it: rule, severity and message."""
+    """The call cannot run as nctrans models it: rule, severity and message."""
 
     def __init__(self, rule: str, severity: str, message: str):
         super().__init__(message)
         self.rule, self.severity, self.message = rule, severity, message
+
+
+def _impossible(message: str) -> MillingError:
+    return MillingError("NC225", "error", message)
+
+
+def _unmodelled(message: str) -> MillingError:
+    return MillingError("NC224", "warning", message)
 
 
 @dataclass
@@ -54,6 +80,10 @@ class Levels:
     approach: float
     bottom: float
     up: float                    # +1 when the tool axis points out of the material (RTP above RFP)
+
+    @property
+    def retract(self) -> float:
+        return self.rtp if (self.rtp - self.approach) * self.up > 0 else self.approach
 
 
 def levels_of(p: dict[str, float], current: float) -> Levels:
@@ -68,7 +98,7 @@ def levels_of(p: dict[str, float], current: float) -> Levels:
     else:
         raise MillingError("NC206", "error", "without a depth (DP or DPR)")
     if (rfp - bottom) * up <= _EPS:
-        raise MillingError("NC225", "error", "with its depth not below the reference plane RFP")
+        raise _impossible("with its depth not below the reference plane RFP")
     return Levels(rtp, rfp, rfp + up * abs(p.get("SDIS", 0.0)), bottom, up)
 
 
@@ -78,12 +108,24 @@ def depth_levels(top: float, bottom: float, mid: float, up: float) -> list[float
     if total <= _EPS:
         return [bottom]
     n = max(1, math.ceil(total / mid - 1e-9)) if mid and mid > 0 else 1
+    if n > MAX_PASSES:
+        raise _impossible(f"with more than {MAX_PASSES} depth cuts (MID too small)")
     return [top - up * total * k / n for k in range(1, n)] + [bottom]
 
 
-def rect_ring(hu: float, hv: float, rc: float, ccw: bool) -> list[tuple]:
+def _count(width: float, step: float) -> int:
+    n = max(1, math.ceil(width / step - 1e-9)) if width > _EPS else 1
+    if n > MAX_PASSES:
+        raise _impossible(f"with more than {MAX_PASSES} passes in the plane")
+    return n
+
+
+# ---------------------------------------------------------------------------------------------
+# Contours in local coordinates
+
+def rect_ring(hu: float, hv: float, rc: float, ccw: bool) -> list[Seg]:
     """A closed rectangle of half sizes (hu, hv), corner radius rc, centred on the origin, from
-    (hu, 0) back to it: [(end (u, v), arc centre or None)], counterclockwise when `ccw`."""
+    (hu, 0) back to it, counterclockwise when `ccw`."""
     rc = max(0.0, min(rc, hu, hv))
     pts: list[tuple] = [((hu, hv - rc), None)]
     for (cu, cv), (eu, ev), (nu, nv) in (
@@ -100,19 +142,48 @@ def rect_ring(hu: float, hv: float, rc: float, ccw: bool) -> list[tuple]:
             continue
         segs.append((prev, end, centre))
         prev = end
-    if not ccw:
-        segs = [(e, s, c) for s, e, c in reversed(segs)]
-    return [(e, c) for _, e, c in segs]
+    return _directed(segs, ccw)
 
 
-def circle_ring(r: float) -> list[tuple]:
+def _directed(ccw_segs: list[tuple], ccw: bool) -> list[Seg]:
+    """(start, end, centre) pieces of a closed counterclockwise contour as Segs in direction `ccw`."""
+    if ccw:
+        return [(e, c, False) for _, e, c in ccw_segs]
+    return [(s, c, True) for s, e, c in reversed(ccw_segs)]
+
+
+def circle_ring(r: float, ccw: bool) -> list[Seg]:
     """A full circle of radius r about the origin from (r, 0), as two half circles."""
-    return [((-r, 0.0), (0.0, 0.0)), ((r, 0.0), (0.0, 0.0))]
+    return [((-r, 0.0), (0.0, 0.0), not ccw), ((r, 0.0), (0.0, 0.0), not ccw)]
 
+
+def _polar(r: float, deg: float) -> tuple[float, float]:
+    a = math.radians(deg)
+    return r * math.cos(a), r * math.sin(a)
+
+
+def arc_slot_ring(rad: float, start: float, sweep: float, w: float, ccw: bool) -> tuple[tuple, list[Seg]]:
+    """The closed contour at distance w round the arc of radius `rad` about the origin from angle
+    `start` through `sweep` > 0 degrees: (its start point, behind the arc's start, and its Segs)."""
+    end = start + sweep
+    p0, p1 = _polar(rad, start), _polar(rad, end)
+    back = (p0[0] + w * math.sin(math.radians(start)), p0[1] - w * math.cos(math.radians(start)))
+    pieces = [(back, _polar(rad + w, start), p0), (_polar(rad + w, start), _polar(rad + w, end), (0.0, 0.0)),
+              (_polar(rad + w, end), _polar(rad - w, end), p1)]
+    inner = [(_polar(rad - w, end), _polar(rad - w, start), (0.0, 0.0)), (_polar(rad - w, start), back, p0)]
+    # counterclockwise round the slot: the inner arc runs clockwise about the circle's centre
+    segs = [(e, c, False) for _, e, c in pieces] + [(inner[0][1], inner[0][2], True), (back, p0, False)]
+    if ccw:
+        return back, segs
+    starts = [back] + [s[0] for s in segs[:-1]]
+    return back, [(s, c, not cw) for s, (e, c, cw) in reversed(list(zip(starts, segs)))]
+
+
+# ---------------------------------------------------------------------------------------------
+# Planning
 
 class _Plan:
-    """Collects steps in plane coordinates; local pocket coordinates (u, v) are turned by the
-    pocket angle and moved to its centre."""
+    """Collects steps in plane coordinates."""
 
     def __init__(self, start: tuple[float, float, float]):
         self.at = start
@@ -123,6 +194,8 @@ class _Plan:
         self._go("rapid", (p1, p2, h))
 
     def linear(self, p1: float, p2: float, h: float, feed: float) -> None:
+        if max(abs(a - b) for a, b in zip((p1, p2, h), self.at)) <= _EPS:
+            return
         self.set_feed(feed)
         self._go("linear", (p1, p2, h))
 
@@ -142,10 +215,19 @@ class _Plan:
         self.steps.append((kind, to))
         self.at = to
 
+    def approach(self, p1: float, p2: float, lv: Levels) -> None:
+        """G0 to (p1, p2) at RTP (rising to RTP first when below it), then G0 to RFP+SDIS."""
+        h = self.at[2]
+        if (h - lv.rtp) * lv.up < 0:
+            self.rapid(self.at[0], self.at[1], lv.rtp)
+            h = lv.rtp
+        self.rapid(p1, p2, h)
+        self.rapid(p1, p2, lv.approach)
+
 
 @dataclass
 class _Frame:
-    """Local pocket coordinates (u along the length, v across) -> plane coordinates."""
+    """Local coordinates (u along the shape's length, v across) -> plane coordinates."""
     cpa: float
     cpo: float
     angle_deg: float = 0.0
@@ -156,18 +238,10 @@ class _Frame:
         return self.cpa + u * c - v * s, self.cpo + u * s + v * c
 
 
-def _approach(plan: _Plan, centre: tuple[float, float], lv: Levels) -> None:
-    """G0 to the centre at RTP (rising to RTP first when below it), then G0 to RFP+SDIS."""
-    p1, p2, h = plan.at
-    if (h - lv.rtp) * lv.up < 0:
-        plan.rapid(p1, p2, lv.rtp)
-        h = lv.rtp
-    plan.rapid(centre[0], centre[1], h)
-    plan.rapid(centre[0], centre[1], lv.approach)
-
-
-def _ring_moves(plan: _Plan, frame: _Frame, segs: list[tuple], h: float, cw: bool, feed: float) -> None:
-    for (u, v), centre in segs:
+def _contour(plan: _Plan, frame: _Frame, start: tuple, segs: list[Seg], h: float, feed: float) -> None:
+    """A straight feed to `start`, then the contour, at height h."""
+    plan.linear(*frame(*start), h, feed)
+    for (u, v), centre, cw in segs:
         p1, p2 = frame(u, v)
         if centre is None:
             plan.linear(p1, p2, h, feed)
@@ -175,92 +249,392 @@ def _ring_moves(plan: _Plan, frame: _Frame, segs: list[tuple], h: float, cw: boo
             plan.arc(p1, p2, h, frame(*centre), cw, feed)
 
 
-def pocket_steps(shape: str, p: dict[str, float], radius: float,
-                 start: tuple[float, float, float], feed: float) -> list[Step]:
-    """The steps of POCKET1 (shape "rect_pocket") or POCKET2 ("circ_pocket") from `start`.
+@dataclass
+class Shape:
+    """A closed shape the tool clears (pocket) or goes round (spigot), in local coordinates.
+
+    `rings(offset, step)`: the roughing contours [(start, Segs)] in cutting order for a tool whose
+    centre keeps `offset` from the shape's edge; `entry`: where the tool plunges."""
+    rings: Callable[[float, float], list[tuple]]
+    entry: tuple[float, float]
+    room: float                  # pocket: how far the edge is from the centre line; spigot: inf
+
+
+def _rect_pocket(a: float, b: float, crad: float, ccw: bool) -> Shape:
+    def rings(offset: float, step: float) -> list[tuple]:
+        lu, lv = a - offset, b - offset
+        m = min(lu, lv)
+        out: list[tuple] = []
+        cu, cv = lu - m, lv - m                      # the centre line (one of them is 0)
+        if cu > _EPS:
+            out.append(((0.0, 0.0), [((-cu, 0.0), None, False), ((cu, 0.0), None, False)]))
+        elif cv > _EPS:
+            out.append(((0.0, 0.0), [((0.0, -cv), None, False), ((0.0, cv), None, False),
+                                     ((0.0, 0.0), None, False)]))
+        n = _count(m, step)
+        for j in range(1, n + 1):
+            inset = m * (n - j) / n
+            out.append(((lu - inset, 0.0), rect_ring(lu - inset, lv - inset, crad - offset - inset, ccw)))
+        return out
+    return Shape(rings, (0.0, 0.0), min(a, b))
+
+
+def _circ_pocket(prad: float, ccw: bool) -> Shape:
+    def rings(offset: float, step: float) -> list[tuple]:
+        m = prad - offset
+        n = _count(m, step)
+        return [((m * j / n, 0.0), circle_ring(m * j / n, ccw)) for j in range(1, n + 1)]
+    return Shape(rings, (0.0, 0.0), prad)
+
+
+def _arc_slot(rad: float, start: float, sweep: float, half_width: float, ccw: bool) -> Shape:
+    p0, p1 = _polar(rad, start), _polar(rad, start + sweep)
+
+    def rings(offset: float, step: float) -> list[tuple]:
+        m = half_width - offset
+        out: list[tuple] = [(p0, [(p1, (0.0, 0.0), False), (p0, (0.0, 0.0), True)])]
+        if m > _EPS:
+            n = _count(m, step)
+            out += [arc_slot_ring(rad, start, sweep, m * j / n, ccw) for j in range(1, n + 1)]
+        return out
+    return Shape(rings, p0, half_width)
+
+
+def _rect_spigot(a: float, b: float, crad: float, blank: tuple[float, float], ccw: bool,
+                 clearance: float, radius: float) -> Shape:
+    gap = max(blank[0] - a, blank[1] - b, 0.0)
+
+    def rings(offset: float, step: float) -> list[tuple]:
+        # offset < 0: the tool centre stays -offset outside the spigot's edge
+        d_final = -offset
+        width = max(gap + radius - d_final, 0.0)
+        n = _count(width, step) if width > _EPS else 1
+        ds = [d_final + width * (n - k) / n for k in range(1, n + 1)] if width > _EPS else [d_final]
+        return [((a + d, 0.0), rect_ring(a + d, b + d, crad + d, ccw)) for d in ds]
+    return Shape(rings, (max(a + gap, a) + radius + clearance, 0.0), math.inf)
+
+
+def _circ_spigot(prad: float, blank: float, ccw: bool, clearance: float, radius: float) -> Shape:
+    gap = max(blank - prad, 0.0)
+
+    def rings(offset: float, step: float) -> list[tuple]:
+        d_final = -offset
+        width = max(gap + radius - d_final, 0.0)
+        n = _count(width, step) if width > _EPS else 1
+        ds = [d_final + width * (n - k) / n for k in range(1, n + 1)] if width > _EPS else [d_final]
+        return [((prad + d, 0.0), circle_ring(prad + d, ccw)) for d in ds]
+    return Shape(rings, (prad + gap + radius + clearance, 0.0), math.inf)
+
+
+@dataclass
+class _Cut:
+    """What one shape's machining needs besides its geometry."""
+    radius: float
+    fal: float                   # edge allowance left by roughing
+    fald: float                  # floor allowance left by roughing
+    rough: bool
+    finish: bool
+    mid: float                   # roughing infeed
+    midf: float                  # finishing infeed
+    step: float                  # width between roughing rings
+    ffd: float
+    ffp1: float
+    ffp2: float
+    outside: bool = False        # a spigot: the tool stays outside the edge
+
+
+def _machine_shape(plan: _Plan, frame: _Frame, shape: Shape, lv: Levels, cut: _Cut) -> None:
+    """Approach, roughing and finishing of one shape, ending with G0 to RTP over its entry point."""
+    r, sign = cut.radius, (-1.0 if cut.outside else 1.0)
+    if not cut.outside and shape.room - r <= _EPS:
+        raise _impossible(f"with a tool (radius {r:g}) too large for the shape (the control stops "
+                          "with alarm 61105)")
+    if not cut.outside and cut.rough and shape.room - r - cut.fal <= _EPS:
+        raise _impossible(f"with a tool (radius {r:g}) too large for the shape and its finishing "
+                          "allowance FAL (the control stops with alarm 61105)")
+    entry = frame(*shape.entry)
+    plan.approach(*entry, lv)
+
+    def passes(levels: list[float], rings: list[tuple], feed: float) -> None:
+        for level in levels:
+            plan.linear(*entry, level, cut.ffd)
+            for start, segs in rings:
+                _contour(plan, frame, start, segs, level, feed)
+            plan.linear(*entry, level, feed)
+
+    if cut.rough:
+        bottom = lv.bottom + lv.up * cut.fald
+        if (lv.rfp - bottom) * lv.up <= _EPS:
+            raise _impossible("with its floor allowance FALD not above the depth")
+        passes(depth_levels(lv.rfp, bottom, cut.mid, lv.up), shape.rings(sign * (r + cut.fal), cut.step),
+               cut.ffp1)
+    if cut.finish:
+        passes(depth_levels(lv.rfp, lv.bottom, cut.midf, lv.up), shape.rings(sign * r, math.inf)[-1:],
+               cut.ffp2)
+    plan.rapid(*entry, lv.retract)
+
+
+def _mill_dir(code: int, outside: bool, spindle_cw: bool) -> bool:
+    """CDIR -> counterclockwise? 2 G2, 3 G3; 0 climb, 1 conventional (depends on the spindle)."""
+    if code == 2:
+        return False
+    if code == 3:
+        return True
+    if code in (0, 1):
+        climb_ccw = (not outside) == spindle_cw      # M3: climb is G3 in a pocket, G2 round a spigot
+        return climb_ccw if code == 0 else not climb_ccw
+    raise _impossible(f"with CDIR {code} (0 climb, 1 conventional, 2 G2, 3 G3)")
+
+
+def _cut(p: dict[str, float], radius: float, feed: float, vari_codes: tuple, *,
+         finish_infeed: Optional[str] = "MIDF", step_key: Optional[str] = None, outside: bool = False) -> _Cut:
+    """Roughing/finishing, allowances, infeeds and feeds of a call; `finish_infeed` names the
+    finishing infeed parameter (None: finishing takes MID's cuts)."""
+    vari = int(p.get("VARI", vari_codes[0]))
+    ones, tens = vari % 10, vari // 10 % 10
+    if ones not in vari_codes:
+        raise _impossible(f"with VARI {vari} (ones digit {'/'.join(map(str, vari_codes))})")
+    if tens not in (0, 1):
+        raise _unmodelled(f"with VARI {vari}: helical or oscillating insertion is not modelled")
+    rough = ones in (0, 1)
+    finish = ones in (0, 2)
+    step = p.get(step_key, 0.0) if step_key else 0.0
+    if step <= 0:
+        step = cycle_table().milling_model.get("ring_step", 0.8) * 2 * radius
+    mid = abs(p.get("MID", 0.0))
+    midf = abs(p.get(finish_infeed, 0.0)) if finish_infeed else mid
+    ffd = p.get("FFD") or feed
+    ffp1 = p.get("FFP1") or feed
+    return _Cut(radius, abs(p.get("FAL", 0.0)), abs(p.get("FALD", 0.0)), rough, finish, mid, midf,
+                step, ffd, ffp1, p.get("FFP2") or ffp1, outside)
+
+
+def _g2_g3(p: dict[str, float]) -> bool:
+    """CDIR of POCKET1/2, SLOT1/2 and CYCLE90 (2 = G2, 3 = G3) -> counterclockwise?"""
+    cdir = int(p.get("CDIR", 3))
+    if cdir not in (2, 3):
+        raise _impossible(f"with CDIR {cdir} (2 = G2, 3 = G3)")
+    return cdir == 3
+
+
+def _positive(p: dict[str, float], *names: str) -> None:
+    for name in names:
+        if p.get(name, 0.0) <= 0:
+            raise _impossible(f"with no positive {name}")
+
+
+def _pattern(p: dict[str, float]) -> list[float]:
+    """Angles of NUM positions on a circle from STA1, INDA apart (0: evenly round the circle)."""
+    num = int(p.get("NUM", 1) or 1)
+    if num < 1 or num > MAX_PASSES:
+        raise _impossible(f"with NUM {num}")
+    inda = p.get("INDA") or 360.0 / num
+    return [p.get("STA1", 0.0) + k * inda for k in range(num)]
+
+
+def milling_steps(shape: str, p: dict[str, float], radius: float, start: tuple[float, float, float],
+                 feed: float, spindle_cw: bool = True) -> list[Step]:
+    """The steps of one milling cycle call from `start` (plane coordinates).
 
     `p` holds the call's values by Siemens name (lengths and feeds already in mm); `radius` is the
     tool radius; `feed` the active feed, used for any feed the call leaves out. MillingError when
-    the control would refuse the call."""
+    the call cannot run (the control would stop, or nctrans does not model what it asks for)."""
     lv = levels_of(p, start[2])
-    rect = shape == "rect_pocket"
-    fal = abs(p.get("FAL", 0.0))
-    if rect:
-        a, b = p.get("LENG", 0.0) / 2, p.get("WID", 0.0) / 2
-        if a <= 0 or b <= 0:
-            raise MillingError("NC225", "error", "with no pocket length LENG or width WID")
-        crad = max(0.0, p.get("CRAD", 0.0))
-        if crad > min(a, b) + _EPS:
-            raise MillingError("NC225", "error", f"with a corner radius CRAD {crad:g} larger than half "
-                               f"the pocket width {2 * min(a, b):g}")
-        room = min(a, b) - radius
-    else:
-        a = b = p.get("PRAD", 0.0)
-        if a <= 0:
-            raise MillingError("NC225", "error", "with no pocket radius PRAD")
-        crad = a
-        room = a - radius
-    vari = int(p.get("VARI", 0.0)) % 10
-    if vari not in (0, 1, 2):
-        raise MillingError("NC225", "error", f"with VARI {vari} (0 complete, 1 roughing, 2 finishing)")
-    if room <= _EPS or (vari != 2 and room - fal <= _EPS):
-        raise MillingError("NC225", "error", f"with a tool (radius {radius:g}) too large for the pocket"
-                           f"{' and its finishing allowance' if fal and room > _EPS else ''} "
-                           "(the control stops with alarm 61105)")
-    cdir = int(p.get("CDIR", 3.0))
-    if cdir not in (2, 3):
-        raise MillingError("NC225", "error", f"with CDIR {cdir} (2 = G2, 3 = G3)")
-    cw = cdir == 2
-    ffd = p.get("FFD") or feed
-    ffp1 = p.get("FFP1") or feed
-    ffp2 = p.get("FFP2") or ffp1
-    frame = _Frame(p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("STA1", 0.0) if rect else 0.0)
-    centre = frame(0.0, 0.0)
-    step = cycle_table().milling_model.get("ring_step", 0.8) * 2 * radius
-
     plan = _Plan(start)
-    _approach(plan, centre, lv)
-
-    def down_at_centre(level: float) -> None:
-        plan.linear(centre[0], centre[1], level, ffd)
-
-    if vari in (0, 1):
-        limit_u, limit_v = a - radius - fal, b - radius - fal
-        m = min(limit_u, limit_v)
-        rings = max(1, math.ceil(m / step - 1e-9))
-        for level in depth_levels(lv.rfp, lv.bottom, abs(p.get("MID", 0.0)), lv.up):
-            down_at_centre(level)
-            if rect:
-                core_u, core_v = limit_u - m, limit_v - m        # the centre line (one is 0)
-                if core_u > _EPS:
-                    _ring_moves(plan, frame, [((-core_u, 0.0), None), ((core_u, 0.0), None)], level, cw, ffp1)
-                elif core_v > _EPS:
-                    _ring_moves(plan, frame, [((0.0, -core_v), None), ((0.0, core_v), None),
-                                              ((0.0, 0.0), None)], level, cw, ffp1)
-            for j in range(1, rings + 1):
-                inset = m * (rings - j) / rings
-                hu, hv = limit_u - inset, limit_v - inset
-                _ring_moves(plan, frame, [((hu, 0.0), None)], level, cw, ffp1)
-                if rect:
-                    segs = rect_ring(hu, hv, crad - radius - fal - inset, not cw)
-                else:
-                    segs = circle_ring(hu)
-                _ring_moves(plan, frame, segs, level, cw, ffp1)
-            plan.linear(centre[0], centre[1], level, ffp1)
-    if vari in (0, 2):
-        hu, hv = a - radius, b - radius
-        segs = rect_ring(hu, hv, crad - radius, not cw) if rect else circle_ring(hu)
-        for level in depth_levels(lv.rfp, lv.bottom, abs(p.get("MIDF", 0.0)), lv.up):
-            down_at_centre(level)
-            _ring_moves(plan, frame, [((hu, 0.0), None)], level, cw, ffp2)
-            _ring_moves(plan, frame, segs, level, cw, ffp2)
-            plan.linear(centre[0], centre[1], level, ffp2)
-    retract = lv.rtp if (lv.rtp - lv.approach) * lv.up > 0 else lv.approach
-    plan.rapid(centre[0], centre[1], retract)
+    if shape in ("rect_pocket", "circ_pocket"):
+        cut = _cut(p, radius, feed, (0, 1, 2))
+        ccw = _g2_g3(p)
+        if shape == "rect_pocket":
+            _positive(p, "LENG", "WID")
+            a, b = p["LENG"] / 2, p["WID"] / 2
+            crad = max(0.0, p.get("CRAD", 0.0))
+            if crad > min(a, b) + _EPS:
+                raise _impossible(f"with a corner radius CRAD {crad:g} larger than half the pocket "
+                                  f"width {2 * min(a, b):g}")
+            geo, frame = _rect_pocket(a, b, crad, ccw), _Frame(p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("STA1", 0.0))
+        else:
+            _positive(p, "PRAD")
+            geo, frame = _circ_pocket(p["PRAD"], ccw), _Frame(p.get("CPA", 0.0), p.get("CPO", 0.0))
+        _machine_shape(plan, frame, geo, lv, cut)
+    elif shape in ("rect_pocket3", "circ_pocket4"):
+        if any(p.get(k) for k in ("AP1", "AP2", "AD")):
+            raise _unmodelled("with a pre-machined blank (AP1/AP2/AD): not modelled")
+        cut = _cut(p, radius, feed, (1, 2), finish_infeed=None, step_key="MIDA")
+        ccw = _mill_dir(int(p.get("CDIR", 0)), False, spindle_cw)
+        if shape == "rect_pocket3":
+            _positive(p, "WID")
+            if not p.get("LENG"):
+                raise _impossible("with no pocket length LENG")
+            a, b = abs(p["LENG"]) / 2, p["WID"] / 2
+            crad = max(0.0, p.get("CRAD", 0.0))
+            if crad > min(a, b) + _EPS:
+                raise _impossible(f"with a corner radius CRAD {crad:g} larger than half the pocket "
+                                  f"width {2 * min(a, b):g}")
+            geo, frame = _rect_pocket(a, b, crad, ccw), _Frame(p.get("PA", 0.0), p.get("PO", 0.0), p.get("STA", 0.0))
+        else:
+            _positive(p, "PRAD")
+            geo, frame = _circ_pocket(p["PRAD"], ccw), _Frame(p.get("PA", 0.0), p.get("PO", 0.0))
+        _machine_shape(plan, frame, geo, lv, cut)
+    elif shape in ("rect_spigot", "circ_spigot"):
+        cut = _cut(p, radius, feed, (1, 2), finish_infeed=None, outside=True)
+        ccw = _mill_dir(int(p.get("CDIR", 0)), True, spindle_cw)
+        clearance = abs(p.get("SDIS", 0.0))
+        frame = _Frame(p.get("PA", 0.0), p.get("PO", 0.0), p.get("STA", 0.0) if shape == "rect_spigot" else 0.0)
+        if shape == "rect_spigot":
+            _positive(p, "LENG", "WID")
+            a, b = p["LENG"] / 2, p["WID"] / 2
+            crad = max(0.0, p.get("CRAD", 0.0))
+            if crad > min(a, b) + _EPS:
+                raise _impossible(f"with a corner radius CRAD {crad:g} larger than half the spigot "
+                                  f"width {2 * min(a, b):g}")
+            blank = (max(p.get("AP1", 0.0), 0.0) / 2 or a, max(p.get("AP2", 0.0), 0.0) / 2 or b)
+            geo = _rect_spigot(a, b, crad, blank, ccw, clearance, radius)
+        else:
+            _positive(p, "PRAD")
+            geo = _circ_spigot(p["PRAD"], max(p.get("AP1", 0.0), 0.0) / 2 or p["PRAD"], ccw, clearance, radius)
+        _machine_shape(plan, frame, geo, lv, cut)
+    elif shape in ("slots_circle", "arc_slots"):
+        if p.get("FALD"):
+            raise _unmodelled("with a floor allowance FALD: not modelled")
+        cut = _cut(p, radius, feed, (0, 1, 2))
+        ccw = _g2_g3(p)
+        _positive(p, "WID")
+        if shape == "slots_circle":
+            _positive(p, "LENG")
+            if p["LENG"] < p["WID"] - _EPS:
+                raise _impossible("with the slot length LENG shorter than its width WID")
+        else:
+            _positive(p, "AFSL", "RAD")
+            if p["WID"] / 2 >= p["RAD"] - _EPS:
+                raise _impossible("with the slot width WID reaching the circle's centre")
+        cpa, cpo, rad = p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("RAD", 0.0)
+        for angle in _pattern(p):
+            if shape == "slots_circle":
+                c = _polar(rad, angle)
+                frame = _Frame(cpa + c[0], cpo + c[1], angle)
+                geo = _rect_pocket(p["LENG"] / 2, p["WID"] / 2, p["WID"] / 2, ccw)
+            else:
+                frame = _Frame(cpa, cpo)
+                geo = _arc_slot(rad, angle, p["AFSL"], p["WID"] / 2, ccw)
+            _machine_shape(plan, frame, geo, lv, cut)
+    elif shape == "long_holes":
+        _positive(p, "LENG")
+        if p["LENG"] < 2 * radius - _EPS:
+            raise _impossible(f"with LENG {p['LENG']:g} shorter than the tool diameter {2 * radius:g}")
+        ffd, ffp1 = p.get("FFD") or feed, p.get("FFP1") or feed
+        cpa, cpo, rad = p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("RAD", 0.0)
+        half = p["LENG"] / 2 - radius
+        for angle in _pattern(p):
+            frame = _Frame(cpa + _polar(rad, angle)[0], cpo + _polar(rad, angle)[1], angle)
+            ends = [frame(-half, 0.0), frame(half, 0.0)]
+            plan.approach(*ends[0], lv)
+            for k, level in enumerate(depth_levels(lv.rfp, lv.bottom, abs(p.get("MID", 0.0)), lv.up)):
+                plan.linear(*ends[k % 2], level, ffd)
+                plan.linear(*ends[(k + 1) % 2], level, ffp1)
+            plan.rapid(*plan.at[:2], lv.retract)
+    elif shape == "face":
+        _face(plan, p, lv, radius, feed)
+    elif shape == "thread_mill":
+        _thread(plan, p, lv, radius, feed, spindle_cw)
+    else:
+        raise _unmodelled(f"shape {shape!r} is not modelled")
     return plan.steps
 
 
-PLANNERS = {"rect_pocket": pocket_steps, "circ_pocket": pocket_steps}
+def _face(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float) -> None:
+    """CYCLE71: paths over the rectangle from (PA, PO) over LENG x WID (signed) at angle STA."""
+    vari = int(p.get("VARI", 0))
+    ones, tens = vari % 10, vari // 10 % 10
+    if ones not in (1, 2) or tens not in (1, 2, 3, 4):
+        raise _impossible(f"with VARI {vari} (ones 1 roughing / 2 finishing, tens 1-4 the path pattern)")
+    if not p.get("LENG") or not p.get("WID"):
+        raise _impossible("with no face length LENG or width WID")
+    frame = _Frame(p.get("PA", 0.0), p.get("PO", 0.0), p.get("STA", 0.0))
+    lu, lw = sorted((0.0, p["LENG"])), sorted((0.0, p["WID"]))
+    along_u = tens in (1, 3)
+    alternate = tens in (3, 4)
+    span, across = (lu, lw) if along_u else (lw, lu)
+    width = across[1] - across[0]
+    step = p.get("MIDA") or cycle_table().milling_model.get("ring_step", 0.8) * 2 * radius
+    if width <= 2 * radius + _EPS:
+        centres = [(across[0] + across[1]) / 2]
+    else:
+        lo, hi = across[0] + radius, across[1] - radius + abs(p.get("FDP1", 0.0))
+        n = _count(hi - lo, step)
+        centres = [lo + (hi - lo) * k / n for k in range(n + 1)]
+    over = radius + abs(p.get("FDP", 0.0))
+    ends = (span[0] - over, span[1] + over)
+    ffp1 = p.get("FFP1") or feed
+
+    def at(s: float, c: float) -> tuple[float, float]:
+        return frame(s, c) if along_u else frame(c, s)
+
+    fald = abs(p.get("FALD", 0.0))
+    if ones == 1:
+        bottom = lv.bottom + lv.up * fald
+        if (lv.rfp - bottom) * lv.up <= _EPS:
+            raise _impossible("with its floor allowance FALD not above the depth")
+        levels = depth_levels(lv.rfp, bottom, abs(p.get("MID", 0.0)), lv.up)
+    else:
+        levels = [lv.bottom]
+    plan.approach(*at(ends[0], centres[0]), lv)
+    for i, level in enumerate(levels):
+        if i:                             # back over the first path's start for the next cut
+            plan.rapid(*plan.at[:2], lv.approach)
+            plan.rapid(*at(ends[0], centres[0]), lv.approach)
+        forward = True
+        for k, c in enumerate(centres):
+            s0, s1 = ends if forward else ends[::-1]
+            if k == 0 or not alternate:
+                if k:
+                    plan.rapid(*plan.at[:2], lv.approach)
+                    plan.rapid(*at(s0, c), lv.approach)
+                plan.linear(*at(s0, c), level, ffp1)
+            else:
+                plan.linear(*at(s0, c), level, ffp1)
+            plan.linear(*at(s1, c), level, ffp1)
+            if alternate:
+                forward = not forward
+    plan.rapid(*plan.at[:2], lv.retract)
+
+
+def _thread(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float,
+            spindle_cw: bool) -> None:
+    """CYCLE90: a helix of pitch PIT from DP up to RFP round (CPA, CPO), inside (TYPTH 0) or outside (1)."""
+    _positive(p, "DIATH", "PIT")
+    typth = int(p.get("TYPTH", 0))
+    if typth not in (0, 1):
+        raise _impossible(f"with TYPTH {typth} (0 internal, 1 external thread)")
+    cw = not _g2_g3(p)
+    outside = typth == 1
+    r_path = p["DIATH"] / 2 + (radius if outside else -radius)
+    if r_path <= _EPS:
+        raise _impossible(f"with a tool (radius {radius:g}) too large for the thread diameter "
+                          f"(the control stops with alarm 61105)")
+    pit = p["PIT"]
+    turns = (lv.rfp - lv.bottom) * lv.up / pit
+    if turns > MAX_PASSES:
+        raise _impossible(f"with more than {MAX_PASSES} thread turns")
+    cpa, cpo = p.get("CPA", 0.0), p.get("CPO", 0.0)
+    ffr = p.get("FFR") or feed
+    entry = (cpa + r_path + abs(p.get("SDIS", 0.0)), cpo) if outside else (cpa, cpo)
+    plan.approach(*entry, lv)
+    plan.linear(*entry, lv.bottom, ffr)
+    plan.linear(cpa + r_path, cpo, lv.bottom, ffr)
+    halves = math.ceil(2 * turns - 1e-9)
+    h = lv.bottom
+    for k in range(1, halves + 1):
+        frac = min(k / 2, turns) / turns if turns > 0 else 1.0
+        h = lv.bottom + lv.up * (lv.rfp - lv.bottom) * lv.up * frac
+        if k < halves or abs(2 * turns - halves) <= 1e-9:
+            end = (cpa - r_path, cpo) if k % 2 else (cpa + r_path, cpo)
+        else:                             # the last part turn ends where the pitch brings it
+            ang = math.pi * (2 * turns - (halves - 1)) * (-1 if cw else 1)
+            base = math.pi if (halves - 1) % 2 else 0.0
+            end = (cpa + r_path * math.cos(base + ang), cpo + r_path * math.sin(base + ang))
+        plan.arc(*end, h, (cpa, cpo), cw, ffr)
+    plan.linear(*entry, h, ffr)
+    plan.rapid(*entry, lv.retract)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -319,7 +693,8 @@ def run_milling_cycle(interp, s) -> None:
     pos = interp.pos
     start = (pos.get(a1, 0.0), pos.get(a2, 0.0), pos.get(ax, 0.0))
     try:
-        steps = PLANNERS[cyc.shape](cyc.shape, call_values(interp, cyc, s), radius, start, st.feed or 0.0)
+        steps = milling_steps(cyc.shape, call_values(interp, cyc, s), radius, start, st.feed or 0.0,
+                             spindle_cw=st.spindle_dir != "ccw")
     except MillingError as err:
         interp.diag(err.rule, err.severity, f"{cyc.name} {err.message}; the call is skipped and "
                     "moves nothing in the analysed toolpath")
