@@ -397,6 +397,7 @@ def test_pocket3_and_pocket4_by_hand():
 @pytest.mark.parametrize("call, rule", [
     ("POCKET3(10, 0, 2, -5, 30, 20, 0, 0, 0, 0, 0, 0, 0, 300, 100, 0, 21)", "NC224"),   # helical insertion
     ("POCKET4(10, 0, 2, -5, 15, 0, 0, 0, 0, 0, 300, 100, 0, 1, 0, 20)", "NC224"),        # blank AP1
+    ("POCKET3(10, 0, 2, -5, -30, 20, 0, 0, 0, 0, 0, 0, 0, 300, 100, 0, 1)", "NC224"),   # from a corner
     ("SLOT1(10, 0, 2, -4, , 2, 30, 10, 0, 0, 40, 0, 180, 100, 300, 0, 3, 0, 1, 0, 0, 0, 1)", "NC224"),
     ("LONGHOLE(10, 0, 2, -5, , 1, 5, 0, 0, 30, 90)", "NC225"),                           # shorter than the tool
     ("SLOT2(10, 0, 2, -3, , 1, 90, 12, 0, 0, 5, 0)", "NC225"),                           # reaches the centre

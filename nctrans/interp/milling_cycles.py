@@ -254,7 +254,8 @@ class Shape:
     """A closed shape the tool clears (pocket) or goes round (spigot), in local coordinates.
 
     `rings(offset, step)`: the roughing contours [(start, Segs)] in cutting order for a tool whose
-    centre keeps `offset` from the shape's edge; `entry`: where the tool plunges."""
+    centre keeps `offset` inside the shape's edge (negative: outside, for a spigot), at most `step`
+    apart; `entry`: where the tool plunges."""
     rings: Callable[[float, float], list[tuple]]
     entry: tuple[float, float]
     room: float                  # pocket: how far the edge is from the centre line; spigot: inf
@@ -300,29 +301,32 @@ def _arc_slot(rad: float, start: float, sweep: float, half_width: float, ccw: bo
     return Shape(rings, p0, half_width)
 
 
+def _outside_offsets(gap: float, radius: float, offset: float, step: float) -> list[float]:
+    """Distances of the tool centre from a spigot's edge, outside in: from the blank `gap` away
+    down to -offset (offset < 0 for a spigot), at most `step` of material per ring."""
+    final = -offset
+    width = max(gap + radius - final, 0.0)
+    if width <= _EPS:
+        return [final]
+    n = _count(width, step)
+    return [final + width * (n - k) / n for k in range(1, n + 1)]
+
+
 def _rect_spigot(a: float, b: float, crad: float, blank: tuple[float, float], ccw: bool,
                  clearance: float, radius: float) -> Shape:
     gap = max(blank[0] - a, blank[1] - b, 0.0)
 
     def rings(offset: float, step: float) -> list[tuple]:
-        # offset < 0: the tool centre stays -offset outside the spigot's edge
-        d_final = -offset
-        width = max(gap + radius - d_final, 0.0)
-        n = _count(width, step) if width > _EPS else 1
-        ds = [d_final + width * (n - k) / n for k in range(1, n + 1)] if width > _EPS else [d_final]
-        return [((a + d, 0.0), rect_ring(a + d, b + d, crad + d, ccw)) for d in ds]
-    return Shape(rings, (max(a + gap, a) + radius + clearance, 0.0), math.inf)
+        return [((a + d, 0.0), rect_ring(a + d, b + d, crad + d, ccw))
+                for d in _outside_offsets(gap, radius, offset, step)]
+    return Shape(rings, (a + gap + radius + clearance, 0.0), math.inf)
 
 
 def _circ_spigot(prad: float, blank: float, ccw: bool, clearance: float, radius: float) -> Shape:
     gap = max(blank - prad, 0.0)
 
     def rings(offset: float, step: float) -> list[tuple]:
-        d_final = -offset
-        width = max(gap + radius - d_final, 0.0)
-        n = _count(width, step) if width > _EPS else 1
-        ds = [d_final + width * (n - k) / n for k in range(1, n + 1)] if width > _EPS else [d_final]
-        return [((prad + d, 0.0), circle_ring(prad + d, ccw)) for d in ds]
+        return [((prad + d, 0.0), circle_ring(prad + d, ccw)) for d in _outside_offsets(gap, radius, offset, step)]
     return Shape(rings, (prad + gap + radius + clearance, 0.0), math.inf)
 
 
@@ -432,116 +436,133 @@ def _pattern(p: dict[str, float]) -> list[float]:
     return [p.get("STA1", 0.0) + k * inda for k in range(num)]
 
 
+def _rect_size(p: dict[str, float], what: str) -> tuple[float, float, float]:
+    """Half length, half width and corner radius of a rectangular shape (LENG, WID, CRAD)."""
+    _positive(p, "LENG", "WID")
+    a, b = p["LENG"] / 2, p["WID"] / 2
+    crad = max(0.0, p.get("CRAD", 0.0))
+    if crad > min(a, b) + _EPS:
+        raise _impossible(f"with a corner radius CRAD {crad:g} larger than half the {what} width "
+                          f"{2 * min(a, b):g}")
+    return a, b, crad
+
+
+def _pocket(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float, spindle_cw: bool,
+            shape: str) -> None:
+    """POCKET1 (rect_pocket) / POCKET2 (circ_pocket): centre CPA/CPO, CDIR 2/3, VARI 0/1/2, MIDF."""
+    cut = _cut(p, radius, feed, (0, 1, 2))
+    ccw = _g2_g3(p)
+    if shape == "rect_pocket":
+        a, b, crad = _rect_size(p, "pocket")
+        geo, frame = _rect_pocket(a, b, crad, ccw), _Frame(p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("STA1", 0.0))
+    else:
+        _positive(p, "PRAD")
+        geo, frame = _circ_pocket(p["PRAD"], ccw), _Frame(p.get("CPA", 0.0), p.get("CPO", 0.0))
+    _machine_shape(plan, frame, geo, lv, cut)
+
+
+def _pocket34(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float, spindle_cw: bool,
+              shape: str) -> None:
+    """POCKET3 (rect_pocket3) / POCKET4 (circ_pocket4): centre PA/PO, CDIR 0-3, MIDA, FALD."""
+    if any(p.get(k) for k in ("AP1", "AP2", "AD")):
+        raise _unmodelled("with a pre-machined blank (AP1/AP2/AD): not modelled")
+    cut = _cut(p, radius, feed, (1, 2), finish_infeed=None, step_key="MIDA")
+    ccw = _mill_dir(int(p.get("CDIR", 0)), False, spindle_cw)
+    if shape == "rect_pocket3":
+        if p.get("LENG", 0.0) < 0 or p.get("WID", 0.0) < 0:
+            raise _unmodelled("with a signed LENG/WID (dimensioned from a corner): not modelled")
+        a, b, crad = _rect_size(p, "pocket")
+        geo, frame = _rect_pocket(a, b, crad, ccw), _Frame(p.get("PA", 0.0), p.get("PO", 0.0), p.get("STA", 0.0))
+    else:
+        _positive(p, "PRAD")
+        geo, frame = _circ_pocket(p["PRAD"], ccw), _Frame(p.get("PA", 0.0), p.get("PO", 0.0))
+    _machine_shape(plan, frame, geo, lv, cut)
+
+
+def _spigot(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float, spindle_cw: bool,
+            shape: str) -> None:
+    """CYCLE76 (rect_spigot) / CYCLE77 (circ_spigot): roughed from the blank AP1 (x AP2) in."""
+    cut = _cut(p, radius, feed, (1, 2), finish_infeed=None, outside=True)
+    ccw = _mill_dir(int(p.get("CDIR", 0)), True, spindle_cw)
+    clearance = abs(p.get("SDIS", 0.0))
+    if shape == "rect_spigot":
+        a, b, crad = _rect_size(p, "spigot")
+        blank = (max(p.get("AP1", 0.0), 0.0) / 2 or a, max(p.get("AP2", 0.0), 0.0) / 2 or b)
+        geo = _rect_spigot(a, b, crad, blank, ccw, clearance, radius)
+        frame = _Frame(p.get("PA", 0.0), p.get("PO", 0.0), p.get("STA", 0.0))
+    else:
+        _positive(p, "PRAD")
+        geo = _circ_spigot(p["PRAD"], max(p.get("AP1", 0.0), 0.0) / 2 or p["PRAD"], ccw, clearance, radius)
+        frame = _Frame(p.get("PA", 0.0), p.get("PO", 0.0))
+    _machine_shape(plan, frame, geo, lv, cut)
+
+
+def _slots(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float, spindle_cw: bool,
+           shape: str) -> None:
+    """SLOT1 (slots_circle: straight, radial) / SLOT2 (arc_slots: along the circle), each like POCKET1."""
+    if p.get("FALD"):
+        raise _unmodelled("with a floor allowance FALD: not modelled")
+    cut = _cut(p, radius, feed, (0, 1, 2))
+    ccw = _g2_g3(p)
+    _positive(p, "WID")
+    if shape == "slots_circle":
+        _positive(p, "LENG")
+        if p["LENG"] < p["WID"] - _EPS:
+            raise _impossible("with the slot length LENG shorter than its width WID")
+    else:
+        _positive(p, "AFSL", "RAD")
+        if p["WID"] / 2 >= p["RAD"] - _EPS:
+            raise _impossible("with the slot width WID reaching the circle's centre")
+    cpa, cpo, rad = p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("RAD", 0.0)
+    for angle in _pattern(p):
+        if shape == "slots_circle":
+            c = _polar(rad, angle)
+            frame = _Frame(cpa + c[0], cpo + c[1], angle)
+            geo = _rect_pocket(p["LENG"] / 2, p["WID"] / 2, p["WID"] / 2, ccw)
+        else:
+            frame = _Frame(cpa, cpo)
+            geo = _arc_slot(rad, angle, p["AFSL"], p["WID"] / 2, ccw)
+        _machine_shape(plan, frame, geo, lv, cut)
+
+
+def _long_holes(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float,
+                spindle_cw: bool, shape: str) -> None:
+    """LONGHOLE: holes as wide as the tool, infeeds alternating at their two ends."""
+    _positive(p, "LENG")
+    if p["LENG"] < 2 * radius - _EPS:
+        raise _impossible(f"with LENG {p['LENG']:g} shorter than the tool diameter {2 * radius:g}")
+    ffd, ffp1 = p.get("FFD") or feed, p.get("FFP1") or feed
+    cpa, cpo, rad = p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("RAD", 0.0)
+    half = p["LENG"] / 2 - radius
+    for angle in _pattern(p):
+        c = _polar(rad, angle)
+        frame = _Frame(cpa + c[0], cpo + c[1], angle)
+        ends = [frame(-half, 0.0), frame(half, 0.0)]
+        plan.approach(*ends[0], lv)
+        for k, level in enumerate(depth_levels(lv.rfp, lv.bottom, abs(p.get("MID", 0.0)), lv.up)):
+            plan.linear(*ends[k % 2], level, ffd)
+            plan.linear(*ends[(k + 1) % 2], level, ffp1)
+        plan.rapid(*plan.at[:2], lv.retract)
+
+
 def milling_steps(shape: str, p: dict[str, float], radius: float, start: tuple[float, float, float],
-                 feed: float, spindle_cw: bool = True) -> list[Step]:
+                  feed: float, spindle_cw: bool = True) -> list[Step]:
     """The steps of one milling cycle call from `start` (plane coordinates).
 
     `p` holds the call's values by Siemens name (lengths and feeds already in mm); `radius` is the
-    tool radius; `feed` the active feed, used for any feed the call leaves out. MillingError when
-    the call cannot run (the control would stop, or nctrans does not model what it asks for)."""
-    lv = levels_of(p, start[2])
-    plan = _Plan(start)
-    if shape in ("rect_pocket", "circ_pocket"):
-        cut = _cut(p, radius, feed, (0, 1, 2))
-        ccw = _g2_g3(p)
-        if shape == "rect_pocket":
-            _positive(p, "LENG", "WID")
-            a, b = p["LENG"] / 2, p["WID"] / 2
-            crad = max(0.0, p.get("CRAD", 0.0))
-            if crad > min(a, b) + _EPS:
-                raise _impossible(f"with a corner radius CRAD {crad:g} larger than half the pocket "
-                                  f"width {2 * min(a, b):g}")
-            geo, frame = _rect_pocket(a, b, crad, ccw), _Frame(p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("STA1", 0.0))
-        else:
-            _positive(p, "PRAD")
-            geo, frame = _circ_pocket(p["PRAD"], ccw), _Frame(p.get("CPA", 0.0), p.get("CPO", 0.0))
-        _machine_shape(plan, frame, geo, lv, cut)
-    elif shape in ("rect_pocket3", "circ_pocket4"):
-        if any(p.get(k) for k in ("AP1", "AP2", "AD")):
-            raise _unmodelled("with a pre-machined blank (AP1/AP2/AD): not modelled")
-        cut = _cut(p, radius, feed, (1, 2), finish_infeed=None, step_key="MIDA")
-        ccw = _mill_dir(int(p.get("CDIR", 0)), False, spindle_cw)
-        if shape == "rect_pocket3":
-            _positive(p, "WID")
-            if not p.get("LENG"):
-                raise _impossible("with no pocket length LENG")
-            a, b = abs(p["LENG"]) / 2, p["WID"] / 2
-            crad = max(0.0, p.get("CRAD", 0.0))
-            if crad > min(a, b) + _EPS:
-                raise _impossible(f"with a corner radius CRAD {crad:g} larger than half the pocket "
-                                  f"width {2 * min(a, b):g}")
-            geo, frame = _rect_pocket(a, b, crad, ccw), _Frame(p.get("PA", 0.0), p.get("PO", 0.0), p.get("STA", 0.0))
-        else:
-            _positive(p, "PRAD")
-            geo, frame = _circ_pocket(p["PRAD"], ccw), _Frame(p.get("PA", 0.0), p.get("PO", 0.0))
-        _machine_shape(plan, frame, geo, lv, cut)
-    elif shape in ("rect_spigot", "circ_spigot"):
-        cut = _cut(p, radius, feed, (1, 2), finish_infeed=None, outside=True)
-        ccw = _mill_dir(int(p.get("CDIR", 0)), True, spindle_cw)
-        clearance = abs(p.get("SDIS", 0.0))
-        frame = _Frame(p.get("PA", 0.0), p.get("PO", 0.0), p.get("STA", 0.0) if shape == "rect_spigot" else 0.0)
-        if shape == "rect_spigot":
-            _positive(p, "LENG", "WID")
-            a, b = p["LENG"] / 2, p["WID"] / 2
-            crad = max(0.0, p.get("CRAD", 0.0))
-            if crad > min(a, b) + _EPS:
-                raise _impossible(f"with a corner radius CRAD {crad:g} larger than half the spigot "
-                                  f"width {2 * min(a, b):g}")
-            blank = (max(p.get("AP1", 0.0), 0.0) / 2 or a, max(p.get("AP2", 0.0), 0.0) / 2 or b)
-            geo = _rect_spigot(a, b, crad, blank, ccw, clearance, radius)
-        else:
-            _positive(p, "PRAD")
-            geo = _circ_spigot(p["PRAD"], max(p.get("AP1", 0.0), 0.0) / 2 or p["PRAD"], ccw, clearance, radius)
-        _machine_shape(plan, frame, geo, lv, cut)
-    elif shape in ("slots_circle", "arc_slots"):
-        if p.get("FALD"):
-            raise _unmodelled("with a floor allowance FALD: not modelled")
-        cut = _cut(p, radius, feed, (0, 1, 2))
-        ccw = _g2_g3(p)
-        _positive(p, "WID")
-        if shape == "slots_circle":
-            _positive(p, "LENG")
-            if p["LENG"] < p["WID"] - _EPS:
-                raise _impossible("with the slot length LENG shorter than its width WID")
-        else:
-            _positive(p, "AFSL", "RAD")
-            if p["WID"] / 2 >= p["RAD"] - _EPS:
-                raise _impossible("with the slot width WID reaching the circle's centre")
-        cpa, cpo, rad = p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("RAD", 0.0)
-        for angle in _pattern(p):
-            if shape == "slots_circle":
-                c = _polar(rad, angle)
-                frame = _Frame(cpa + c[0], cpo + c[1], angle)
-                geo = _rect_pocket(p["LENG"] / 2, p["WID"] / 2, p["WID"] / 2, ccw)
-            else:
-                frame = _Frame(cpa, cpo)
-                geo = _arc_slot(rad, angle, p["AFSL"], p["WID"] / 2, ccw)
-            _machine_shape(plan, frame, geo, lv, cut)
-    elif shape == "long_holes":
-        _positive(p, "LENG")
-        if p["LENG"] < 2 * radius - _EPS:
-            raise _impossible(f"with LENG {p['LENG']:g} shorter than the tool diameter {2 * radius:g}")
-        ffd, ffp1 = p.get("FFD") or feed, p.get("FFP1") or feed
-        cpa, cpo, rad = p.get("CPA", 0.0), p.get("CPO", 0.0), p.get("RAD", 0.0)
-        half = p["LENG"] / 2 - radius
-        for angle in _pattern(p):
-            frame = _Frame(cpa + _polar(rad, angle)[0], cpo + _polar(rad, angle)[1], angle)
-            ends = [frame(-half, 0.0), frame(half, 0.0)]
-            plan.approach(*ends[0], lv)
-            for k, level in enumerate(depth_levels(lv.rfp, lv.bottom, abs(p.get("MID", 0.0)), lv.up)):
-                plan.linear(*ends[k % 2], level, ffd)
-                plan.linear(*ends[(k + 1) % 2], level, ffp1)
-            plan.rapid(*plan.at[:2], lv.retract)
-    elif shape == "face":
-        _face(plan, p, lv, radius, feed)
-    elif shape == "thread_mill":
-        _thread(plan, p, lv, radius, feed, spindle_cw)
-    else:
+    tool radius; `feed` the active feed, used for any feed the call leaves out; `spindle_cw` the
+    spindle direction (climb and conventional milling depend on it). MillingError when the call
+    cannot run (the control would stop, or nctrans does not model what it asks for)."""
+    planner = PLANNERS.get(shape)
+    if planner is None:
         raise _unmodelled(f"shape {shape!r} is not modelled")
+    plan = _Plan(start)
+    planner(plan, p, levels_of(p, start[2]), radius, feed, spindle_cw, shape)
     return plan.steps
 
 
-def _face(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float) -> None:
+def _face(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float, spindle_cw: bool,
+          shape: str) -> None:
     """CYCLE71: paths over the rectangle from (PA, PO) over LENG x WID (signed) at angle STA."""
     vari = int(p.get("VARI", 0))
     ones, tens = vari % 10, vari // 10 % 10
@@ -599,7 +620,7 @@ def _face(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: flo
 
 
 def _thread(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: float,
-            spindle_cw: bool) -> None:
+            spindle_cw: bool, shape: str) -> None:
     """CYCLE90: a helix of pitch PIT from DP up to RFP round (CPA, CPO), inside (TYPTH 0) or outside (1)."""
     _positive(p, "DIATH", "PIT")
     typth = int(p.get("TYPTH", 0))
@@ -635,6 +656,14 @@ def _thread(plan: _Plan, p: dict[str, float], lv: Levels, radius: float, feed: f
         plan.arc(*end, h, (cpa, cpo), cw, ffr)
     plan.linear(*entry, h, ffr)
     plan.rapid(*entry, lv.retract)
+
+
+# shape (rules/cycles.toml [[milling]]) -> planner(plan, values, levels, radius, feed, spindle_cw, shape)
+PLANNERS: dict[str, Callable] = {
+    "rect_pocket": _pocket, "circ_pocket": _pocket, "rect_pocket3": _pocket34, "circ_pocket4": _pocket34,
+    "rect_spigot": _spigot, "circ_spigot": _spigot, "slots_circle": _slots, "arc_slots": _slots,
+    "long_holes": _long_holes, "face": _face, "thread_mill": _thread,
+}
 
 
 # ---------------------------------------------------------------------------------------------
