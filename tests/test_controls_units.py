@@ -89,3 +89,44 @@ def test_g70_conversion_runs_in_rs274(rs274, tmp_path):
     got = [(m.kind, round(m.end["X"], 3), round(m.end["Y"], 3),
             None if m.kind == "rapid" else round(m.feed, 3)) for m in run.moves]
     assert got == [(k, float(x), float(y), f if f is None else float(f)) for k, x, y, f in G70_MOVES]
+
+
+# One block switching to inch with an F in it: Sinumerik reads the F in the block's new units
+# (G700 F100 = 100 inch/min = 2540 mm/min); ISO (as LinuxCNC) and Fagor read F before the switch
+# (G20 F100 = 100 mm/min). X2 inch = 50.8 mm either way.
+IN_BLOCK = {
+    "sinumerik": ("G0 X0 Y0 Z0\nG1 X1 F200\nG700 G1 X2 F100\nG710 G1 X3 F100\nM30\n",
+                  [(1.0, 200.0), (50.8, 2540.0), (3.0, 100.0)]),
+    "iso-m": ("G0 X0 Y0 Z0\nG1 X1 F200\nG20 G1 X2 F100\nG21 G1 X3 F100\nM30\n",
+              [(1.0, 200.0), (50.8, 100.0), (3.0, 2540.0)]),
+    "fagor": ("G0 X0 Y0 Z0\nG1 X1 F200\nG70 G1 X2 F100\nG71 G1 X3 F100\nM30\n",
+              [(1.0, 200.0), (50.8, 100.0), (3.0, 2540.0)]),
+}
+
+
+def feeds(text: str, dialect: str) -> list[tuple]:
+    return [(round(r.end["X"], 6), round(r.feed, 6)) for r in nctrans.toolpath(text, dialect)
+            if r.kind == "linear"]
+
+
+@pytest.mark.parametrize("source", sorted(IN_BLOCK))
+def test_in_block_feed_and_units_order(source):
+    text, want = IN_BLOCK[source]
+    assert feeds(text, source) == want
+    for target in IN_BLOCK:
+        if target != source:
+            out = api.transpile(text, source, target).text
+            assert feeds(out, target) == want, (target, out)
+
+
+@pytest.mark.rs274
+def test_in_block_order_runs_in_rs274(rs274, tmp_path):
+    """LinuxCNC reads the ISO written from the Sinumerik block with the feed Sinumerik meant."""
+    text, want = IN_BLOCK["sinumerik"]
+    prog = tmp_path / "order.ngc"
+    prog.write_text(api.transpile(text, "sinumerik", "iso-m").text)
+    run = h.run_rs274(prog, h.write_tool_table(tmp_path / "t.tbl", [(1, 0.0, 0.0)]), tmp_path / "o.out")
+    assert run.completed, run.message
+    assert [(round(m.end["X"], 3), round(m.feed, 3)) for m in run.moves
+            # rs274 feeds to where it is on "G20 G1" alone (printed in inch: 0.0394)
+            if m.kind == "linear" and abs(m.end["X"] - m.start["X"]) > 2 * m.tol] == want

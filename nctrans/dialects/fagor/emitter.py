@@ -408,6 +408,8 @@ class _Emitter:
         i = 0
         while i < len(body):
             s = body[i]
+            if type(s) is n.Feed and any(type(x) is n.ModeChange and x.group == "units" for x in body[:i]):
+                new_line()      # Fagor reads F before G70/G71: an F read after the switch follows it
             try:
                 skip = self.statement(s, word, new_line, body[i + 1:])
             except NotExpressible as e:

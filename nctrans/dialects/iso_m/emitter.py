@@ -631,7 +631,11 @@ class IsoEmitter(IsoSpelling, Emitter):
                 continue
             line = lines[-1]
             keys = [k for k, _ in words if k]
-            if any(k in line.used for k in keys):
+            if type(s) is n.ModeChange and s.group == "units":
+                keys.append("units")
+            # ISO reads F before G20/G21 (in the units before the switch): an F the source reads
+            # after its units switch goes on the next line
+            if any(k in line.used for k in keys) or (type(s) is n.Feed and "units" in line.used):
                 line = _Line()
                 lines.append(line)
             line.words.extend(w for _, w in words)

@@ -292,6 +292,11 @@ class Emitter:
                 st.feed_mode = s.value
             elif g == "units":
                 st.units = s.value
+                if not out.join and any(w.startswith("F") for w in out.words):
+                    # an F the source reads before its units switch (ISO order): Sinumerik reads
+                    # the whole block in the new units, so the F goes in a block of its own first
+                    out.done.append(" ".join(out.words))
+                    out.words = []
             if g == "cycle":
                 if s.value == "off":
                     if st.cycle_active:
