@@ -59,13 +59,26 @@ class AxisName(str):
 AXIS_NAME = re.compile(r"^(?:[XYZABCUVW][0-9]{0,2})$")
 
 
+def check_limits(limits: Optional[tuple], value: Any) -> None:
+    """`limits` (name, LLI, ULI) of a Sinumerik DEF: a value outside them is refused as the
+    control refuses it (an alarm): NC223, and the variable keeps its value."""
+    if limits is None:
+        return
+    name, lo, hi = limits
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and (
+            (lo is not None and value < lo) or (hi is not None and value > hi)):
+        raise EvalError("NC223", f"{value:g} assigned to {name} is outside its declared limits "
+                        f"(LLI {'-' if lo is None else f'{lo:g}'}, ULI "
+                        f"{'-' if hi is None else f'{hi:g}'}); the value is not taken")
+
+
 class Ref:
     """A by-reference binding (Sinumerik PROC VAR parameter): reads and writes go to the caller's
-    variable (a name, an R parameter, an ISO number or one array element)."""
-    __slots__ = ("store", "key", "array")
+    variable (a name, an R parameter, an ISO number or one array element), within its DEF limits."""
+    __slots__ = ("store", "key", "array", "limits")
 
-    def __init__(self, store: Any, key: Any, array: bool = False):
-        self.store, self.key, self.array = store, key, array
+    def __init__(self, store: Any, key: Any, array: bool = False, limits: Optional[tuple] = None):
+        self.store, self.key, self.array, self.limits = store, key, array, limits
 
     def get(self) -> Any:
         return self.store.get(self.key) if self.array else self.store.get(self.key, 0.0)
@@ -74,6 +87,7 @@ class Ref:
         if self.array:
             self.store.set(self.key, value)
         else:
+            check_limits(self.limits, value)
             self.store[self.key] = value
 
 
@@ -121,13 +135,15 @@ class Scope:
 
 
 class Array:
-    """A declared array (Sinumerik DEF REAL A[3,4]): bounds-checked element store."""
-    __slots__ = ("dims", "data", "default")
+    """A declared array (Sinumerik DEF REAL A[3,4]): bounds-checked element store; `limits`
+    (name, LLI, ULI) of its DEF hold for every element."""
+    __slots__ = ("dims", "data", "default", "limits")
 
-    def __init__(self, dims: list[int], default: Any):
+    def __init__(self, dims: list[int], default: Any, limits: Optional[tuple] = None):
         self.dims = tuple(dims)
         self.data: dict[tuple, Any] = {}
         self.default = default
+        self.limits = limits
 
     def key(self, idx: tuple) -> tuple:
         if len(idx) != len(self.dims) or any(not 0 <= i < d for i, d in zip(idx, self.dims)):
@@ -138,7 +154,9 @@ class Array:
         return self.data.get(self.key(idx), self.default)
 
     def set(self, idx: tuple, value: Any) -> None:
-        self.data[self.key(idx)] = value
+        key = self.key(idx)
+        check_limits(self.limits, value)
+        self.data[key] = value
 
     def keys_from(self, idx: tuple) -> list[tuple]:
         """Element keys in storage order (right index fastest) from `idx` to the end."""
@@ -733,41 +751,43 @@ class Evaluator:
         if rep:
             init = init[0].args[:1]
         inits = [self._typed(typ, self.compile(e)()) for e in init]
+        refused: Optional[EvalError] = None     # an initial value outside LLI/ULI: not taken
         if decl.dims:
-            arr = Array(decl.dims, default)
+            arr = Array(decl.dims, default, (name, *decl.limits) if decl.limits else None)
             # initialisers fill the array in storage order (right index fastest); REP fills all
             if inits:
                 keys = arr.keys_from((0,) * len(decl.dims))
                 if rep:
-                    for key in keys:
-                        arr.data[key] = inits[0]
-                else:
-                    if len(inits) > len(keys):
-                        raise EvalError("NC105", f"{len(inits)} initial values for the "
-                                        f"{len(keys)} elements of {name}")
-                    for key, v in zip(keys, inits):
-                        arr.data[key] = v
+                    keys, inits = keys, [inits[0]] * len(keys)
+                elif len(inits) > len(keys):
+                    raise EvalError("NC105", f"{len(inits)} initial values for the "
+                                    f"{len(keys)} elements of {name}")
+                for key, v in zip(keys, inits):
+                    try:
+                        arr.set(key, v)
+                    except EvalError as err:
+                        refused = refused or err
             store[name] = arr
         else:
+            value = inits[0] if inits else default
             if decl.limits:
                 self.limits[name] = tuple(decl.limits)
-                if inits:
-                    self._check_limits(name, inits[0])
+                try:
+                    if inits:
+                        self._check_limits(name, value)
+                except EvalError as err:
+                    refused, value = err, default
             else:
                 self.limits.pop(name, None)
-            store[name] = inits[0] if inits else default
+            store[name] = value
             if inits and typ == "STRING":
                 self._cap_string(store, lengths, name, store[name])
+        if refused is not None:
+            raise refused
 
     def _check_limits(self, name: str, value: Any) -> None:
-        """A value outside a name's declared LLI/ULI is refused as the control refuses it (an
-        alarm): NC223, and the variable keeps its value."""
-        lo, hi = self.limits[name]
-        if isinstance(value, (int, float)) and not isinstance(value, bool) and (
-                (lo is not None and value < lo) or (hi is not None and value > hi)):
-            raise EvalError("NC223", f"{value:g} assigned to {name} is outside its declared limits "
-                            f"(LLI {'-' if lo is None else f'{lo:g}'}, ULI "
-                            f"{'-' if hi is None else f'{hi:g}'}); the value is not taken")
+        """A value outside a name's declared LLI/ULI: NC223 (check_limits)."""
+        check_limits((name, *self.limits[name]), value)
 
     @staticmethod
     def _cap_string(store: dict, lengths: dict, name: str, value: Any) -> None:
@@ -799,7 +819,8 @@ class Evaluator:
                     if isinstance(cur, Array):
                         return Ref(cur, self._indices(fns), True) if fns else cur
                     if not fns:
-                        return Ref(store, name)
+                        lim = self.limits.get(name)
+                        return Ref(store, name, limits=(name, *lim) if lim else None)
             elif expr.space == "R":
                 k = self._indices(fns)[0] if fns else int(expr.key or 0)
                 return Ref(self.R, k)
