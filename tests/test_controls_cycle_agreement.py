@@ -167,7 +167,39 @@ ENDFOR
 RET
 """
 
-SOURCES = {"CYCLE81": CYCLE81, "CYCLE82": CYCLE82, "CYCLE83": CYCLE83, "HOLES1": HOLES1,
+CYCLE84 = """PROC CYCLE84(REAL RTP, REAL RFP, REAL SDIS, REAL DP, REAL DPR, REAL DTB, INT SDAC, REAL MPIT, REAL PIT, REAL POSS, REAL SST, REAL SST1, INT _AXN, INT _PTAB, INT _TECHNO, INT _VARI, REAL _DAM, REAL _VRT) SAVE
+; rigid tapping with G331/G332: lead PIT (its sign the hand) down to DP (or RFP-DPR), dwell DTB,
+; back to RFP+SDIS with the spindle reversed, the spindle as SDAC says (3 M3, 4 M4, 5 M5), G0 to RTP
+DEF REAL _ZSD
+DEF AXIS _AX
+_AX=$P_AXN3
+_ZSD=DP
+IF DPR<>0
+  _ZSD=RFP-DPR
+ENDIF
+G0 AX[_AX]=RFP+SDIS
+G331 AX[_AX]=_ZSD K=PIT
+IF DTB>0
+  G4 F=DTB
+ENDIF
+G332 AX[_AX]=RFP+SDIS K=PIT
+CASE SDAC OF 3 GOTOF _M3 4 GOTOF _M4 5 GOTOF _M5 DEFAULT GOTOF _HAND
+_M3: M3
+GOTOF _OUT
+_M4: M4
+GOTOF _OUT
+_M5: M5
+GOTOF _OUT
+_HAND: IF PIT>0
+  M3
+ELSE
+  M4
+ENDIF
+_OUT: G0 AX[_AX]=RTP
+RET
+"""
+
+SOURCES = {"CYCLE84": CYCLE84, "CYCLE81": CYCLE81, "CYCLE82": CYCLE82, "CYCLE83": CYCLE83, "HOLES1": HOLES1,
            "HOLES2": HOLES2, "CYCLE801": CYCLE801}
 START = "G17 G90 G0 X0 Y0 Z50 F100 S1000 M3\n"
 
@@ -194,6 +226,15 @@ PROGRAMS = {
                  "M30\n", "CYCLE81", "CYCLE801"),
     "cycle801-rotated": (START + "MCALL CYCLE82(10, 0, 2, , 3, 0.5)\nCYCLE801(0, 0, 30, 10, 10, 2, 4)"
                          "\nMCALL\nM30\n", "CYCLE82", "CYCLE801"),
+    # rigid tapping: PIT 1.25 at S1000 (1250 mm/min), dwell, SDAC 3; left hand under M4 with DPR,
+    # spindle off after (SDAC 5); MCALL at three positions
+    "84-pit": (START + "CYCLE84(10, 0, 2, -15, , 0.5, 3, , 1.25)\nM30\n", "CYCLE84", None),
+    "84-left-dpr": (START.replace("M3", "M4") + "CYCLE84(10, 1, 2, , 9, , 5, , -1)\nM30\n",
+                    "CYCLE84", None),
+    "84-positions": (START + "MCALL CYCLE84(5, 0, 1, -6, , , 3, , 0.8)\nX10\nY10\nX20 Y5\n"
+                     "MCALL\nM30\n", "CYCLE84", None),
+    "84-holes1": (START + "MCALL CYCLE84(5, 0, 1, -6, , , 3, , 1)\nHOLES1(5, 5, 0, 10, 8, 3)\n"
+                  "MCALL\nM30\n", "CYCLE84", "HOLES1"),
     "pattern-no-mcall": (START + "CYCLE801(0, 0, 0, 5, 5, 2, 2)\nHOLES1(0, 0, 90, 0, 4, 3)\nM30\n",
                          None, "CYCLE801"),
 }
@@ -208,9 +249,11 @@ def records(where: Path, text: str):
     out = []
     for r in recs:
         if r.kind in ("rapid", "linear", "arc"):
-            out.append((r.kind, {a: round(v, 6) for a, v in r.end.items()}, r.feed))
+            out.append((r.kind, {a: round(v, 6) for a, v in r.end.items()}, r.feed, r.pitch))
         elif r.kind == "dwell":
             out.append(("dwell", r.dwell_s))
+        elif r.kind == "spindle":
+            out.append(("spindle", r.spindle_dir))
     return out, bad
 
 
@@ -238,8 +281,18 @@ def test_cycle83_vari0_strokes_by_hand(tmp_path):
     # chip breaking goes back 1 mm with G1 between strokes
     got, bad = records(tmp_path, PROGRAMS["83-vari0"][0])
     assert bad == []
-    z = [m[1]["Z"] for m in got if m[0] != "dwell"][1:]
+    z = [m[1]["Z"] for m in got if m[0] not in ("dwell", "spindle")][1:]
     assert z == [2, -10, -9, -16, -15, -20, -19, -24, -23, -28, -27, -30, 10]
+
+
+def test_cycle84_by_hand(tmp_path):
+    # RFP 0 + SDIS 2 = Z2 by G0; tap to -15 at 1.25 x 1000 = 1250 mm/min carrying the pitch; dwell
+    # 0.5 s; spindle reversed, back to Z2; SDAC 3: M3; G0 to RTP 10
+    got, bad = records(tmp_path, PROGRAMS["84-pit"][0])
+    assert bad == []
+    assert [(m[0], m[1]["Z"], m[2], m[3]) if m[0] in ("rapid", "linear") else m for m in got][2:] == [
+        ("rapid", 2.0, None, None), ("linear", -15.0, 1250.0, 1.25), ("dwell", 0.5),
+        ("spindle", "ccw"), ("linear", 2.0, 1250.0, 1.25), ("spindle", "cw"), ("rapid", 10.0, None, None)]
 
 
 def test_cycle801_meander_by_hand(tmp_path):

@@ -45,9 +45,14 @@ def test_p_gg_follows_changes_as_the_program_runs():
 
 
 def test_p_gg_of_an_unmodelled_motion_code_in_force_is_its_index():
-    # G331 moves nothing in the analysis (NC220), but $P_GG[1] still names it: index 11
-    got, diags = values("G331 Z-1 K1\nR1=$P_GG[1]\n", 1)
-    assert got[-1] == 11.0 and any(d.rule == "NC220" for d in diags)
+    # G34 moves nothing in the analysis (NC220), but $P_GG[1] still names it: index 16
+    got, diags = values("G34 Z-1 K1 F=0.1\nR1=$P_GG[1]\n", 1)
+    assert got[-1] == 16.0 and any(d.rule == "NC220" for d in diags)
+
+
+def test_p_gg_of_rigid_tapping_is_its_index():
+    got, diags = values("S100 M3\nG331 Z-1 K1\nR1=$P_GG[1]\nG332 Z0 K1\nR2=$P_GG[1]\n", 2)
+    assert got[-2:] == [11.0, 12.0] and not any(d.rule == "NC220" for d in diags)
 
 
 @pytest.mark.parametrize("setup,group", [("", 99),            # no such group

@@ -86,13 +86,13 @@ def test_pole_round_trips_through_sinumerik_and_flattens_for_iso(tmp_path):
 # --------------------------------------------------------------------------- the general rule
 
 def test_unmodelled_motion_code_moves_nothing_until_the_next_motion_code():
-    text = "G0 X1 Y2 Z3\nG331 Z-10 K1.5\nZ-20\nG1 Z5 F100\nM30\n"
+    text = "G0 X1 Y2 Z3\nG35 Z-10 K1.5 F=0.1\nZ-20\nG1 Z5 F100\nM30\n"
     recs, diags = run(text)
-    # G331 and the Z-20 after it move nothing; G1 Z5 starts from (1,2,3)
+    # G35 (thread with decreasing lead) and the Z-20 after it move nothing; G1 Z5 starts from (1,2,3)
     assert [(r.line, r.end["Z"]) for r in moves(recs)] == [(1, 3.0), (4, 5.0)]
     lines = [(d.line, d.severity) for d in nc220(diags)]
     assert lines == [(2, "warning"), (3, "warning")]
-    assert "G331" in nc220(diags)[0].message and "G331" in nc220(diags)[1].message
+    assert "G35" in nc220(diags)[0].message and "G35" in nc220(diags)[1].message
 
 
 def test_unmodelled_word_in_a_modelled_block_is_named_at_its_line():

@@ -43,7 +43,7 @@ from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
 from nctrans.interp.run_checks import RunChecks
 from nctrans.interp.state import LINEAR_AXES, ModalState
 from nctrans.interp.travel_limits import ProgrammedLimits
-from nctrans.interp import ggroups, sections, sysvars, unmodelled
+from nctrans.interp import ggroups, rigid_tap, sections, sysvars, unmodelled
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_LIMITS, UNMODELLED_MODES
 from nctrans import plainrun
@@ -1078,6 +1078,10 @@ class Interpreter(LatheMixin, RunChecks):
             if vals:
                 self._g33_move(vals, center)
             return
+        if motion in rigid_tap.MODES:
+            if vals:
+                rigid_tap.rigid_tap_move(self, vals, center, motion)
+            return
         if motion in ("arc_cw", "arc_ccw"):
             self._arc(vals, center, radius, turns, motion == "arc_cw", aperture)
             return
@@ -1463,7 +1467,9 @@ class Interpreter(LatheMixin, RunChecks):
                     st.feed = s[1]
                 elif k == "dwell":
                     self._record("dwell", dwell_s=float(s[1] or 0.0))
-                elif k == "spindle":
+                elif k == "spindle":         # the cycle turns it (tapping reversal, CYCLE84 SDAC)
+                    st.set("spindle", s[1])
+                    self.spindle_stopped = s[1] in ("off", "orient")
                     self._record("spindle", spindle_dir=s[1], spindle=st.spindle_speed)
                 elif k == "stop":
                     self._record("stop", stop_kind="stop")

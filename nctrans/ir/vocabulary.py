@@ -8,7 +8,8 @@ MODAL_GROUPS: dict[str, tuple[str, ...]] = {
     # motion: what a Motion statement does. "cycle" while a canned cycle mode is active is tracked
     # by the "cycle" group instead; "none" after ISO G80 on controllers that cancel motion (LinuxCNC).
     "motion": ("rapid", "linear", "arc_cw", "arc_ccw", "thread", "none",
-               "arc_3point", "arc_tangent"),                 # Sinumerik CIP (Motion.via) / CT
+               "arc_3point", "arc_tangent",                  # Sinumerik CIP (Motion.via) / CT
+               "tap_rigid", "tap_rigid_retract"),            # Sinumerik G331 / G332
     "plane": ("XY", "ZX", "YZ"),
     "distance": ("absolute", "incremental"),
     "arc_distance": ("incremental", "absolute"),          # ISO G91.1 / G90.1

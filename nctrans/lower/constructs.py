@@ -97,29 +97,43 @@ def _modal_runs(body: list) -> list[tuple[int, int]]:
     return runs
 
 
-def _inch_geometry_runs(body: list) -> list[tuple[int, int]]:
-    """(first, last) top-level indices from a node that selects inch geometry with metric feeds
-    (Sinumerik G70, neutral units=inch_geometry) to the node before the block that selects other
-    units (the end of the body when nothing does). A target without that mode (ISO, Fagor: their inch reads F in
-    inch too) lowers the whole run, so no F of the source is read in the wrong unit after it."""
+# Modes some targets lack whose stretch must be lowered whole: what follows the mode's block reads
+# it (the next axis words tap, the next F is mm/min), so lowering the block alone would leave the
+# rest of the stretch in the wrong mode. group -> values of that kind.
+STRETCH_MODES = {
+    # Sinumerik G70: lengths in inch, feeds in the basic system (ISO and Fagor inch reads F in inch)
+    "units": frozenset(("inch_geometry",)),
+    # Sinumerik G331/G332: every later block with axis words taps or retracts
+    "motion": frozenset(("tap_rigid", "tap_rigid_retract")),
+}
+
+
+def _sets(node, group: str, values=None) -> bool:
+    """A block that selects a mode of `group` itself (one of `values` when given)."""
+    return type(node) is n.Block and any(
+        type(s) is n.ModeChange and s.group == group and (values is None or s.value in values)
+        for s in node.body)
+
+
+def _stretch_runs(body: list) -> list[tuple[int, int]]:
+    """(first, last) top-level indices from a node that selects a STRETCH_MODES value to the node
+    before the block that selects another value of the same group (the end of the body when
+    nothing does). A segment holding the first node takes the whole run: the target refused the
+    mode, so none of the stretch may keep its structure."""
     runs = []
-    start: Optional[int] = None
-    for i, node in enumerate(body):
-        if start is None:
-            if any(type(s) is n.ModeChange and s.group == "units" and s.value == "inch_geometry"
-                   for x in walk([node]) if type(x) is n.Block for s in x.body):
-                start = i
-        elif type(node) is n.Block and any(type(s) is n.ModeChange and s.group == "units"
-                                           and s.value != "inch_geometry" for s in node.body):
-            runs.append((start, i - 1))
-            start = None
-    if start is not None:
-        runs.append((start, len(body) - 1))
+    for group, values in STRETCH_MODES.items():
+        start: Optional[int] = None
+        for i, node in enumerate(body):
+            if start is None:
+                if any(type(s) is n.ModeChange and s.group == group and s.value in values
+                       for x in walk([node]) if type(x) is n.Block for s in x.body):
+                    start = i
+            elif _sets(node, group) and not _sets(node, group, values):
+                runs.append((start, i - 1))
+                start = None
+        if start is not None:
+            runs.append((start, len(body) - 1))
     return runs
-
-
-def _sets_units(node) -> bool:
-    return type(node) is n.Block and any(type(s) is n.ModeChange and s.group == "units" for s in node.body)
 
 
 def _vars(obj, out: set) -> None:
@@ -205,7 +219,7 @@ def _segments(program: n.Program, refusals: list[Diagnostic]) -> tuple[list[Segm
         for seg in found:
             if seg.first <= b and seg.last >= a:
                 seg.first, seg.last = min(seg.first, a), max(seg.last, b)
-    for a, b in _inch_geometry_runs(body):
+    for a, b in _stretch_runs(body):
         for seg in found:
             if seg.first <= a <= seg.last:     # the target refused the mode itself
                 seg.last = max(seg.last, b)
@@ -374,7 +388,7 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
         new_body.extend(program.body[done:seg.first])
         new_body.extend(seg.flattener.blocks)
         last_span = n.Span(program.file, last_line)
-        units_follow = seg.last == len(program.body) - 1 or _sets_units(program.body[seg.last + 1])
+        units_follow = seg.last == len(program.body) - 1 or _sets(program.body[seg.last + 1], "units")
         restore = _restore(seg, last_span, units_follow) if not ended else None
         if restore is not None and restore.body:
             new_body.append(restore)

@@ -1,0 +1,57 @@
+"""Sinumerik G331 / G332: rigid tapping without a compensating chuck, programmed move by move.
+
+Seed (group 1, table L24423-24424) and spec 9.2: `G331 Z.. K..` taps to the end point, `G332 Z..
+K..` retracts; both are modal motion codes of group 1. The lead is the I/J/K word of the axis
+that travels furthest (as with G33), in program length units per revolution; its sign gives the
+hand: positive a right-hand thread (spindle clockwise, as M3), negative a left-hand one (as M4)
+[GK, Siemens Fundamentals, "Tapping without compensating chuck"]. G332 runs the spindle the other
+way (the control reverses it); the feed of both is lead x S, F is not read.
+
+The toolpath holds them as CYCLE84's tapping does (cycles.tap_steps): linear records carrying the
+pitch, and the spindle direction they need set (and recorded) where it changes: G331 turns it the
+thread's way, G332 the other way, and it stays so until the program says otherwise (M3/M4/M5), as
+a CYCLE84 written with G331/G332 and its SDAC leaves it.
+"""
+from __future__ import annotations
+
+TAP = "tap_rigid"                   # G331
+RETRACT = "tap_rigid_retract"       # G332
+MODES = frozenset((TAP, RETRACT))
+
+_AXIS_OF_LEAD = (("I", "X"), ("J", "Y"), ("K", "Z"))
+
+
+def rigid_tap_move(it, vals, center, motion: str) -> None:
+    """One G331/G332 block with axis words, on interpreter `it`."""
+    st = it.st
+    code = "G331" if motion == TAP else "G332"
+    target = it._target(vals)
+    leads = {w: v for w, v, _ in it._eval_words(center)} if center else {}
+    if not leads:
+        it.diag("NC206", "error", f"{code} without a thread lead (K, or I/J for X/Y): the move is not made")
+        return
+    travel = {w: abs(target.get(a, 0.0) - it.pos.get(a, 0.0)) for w, a in _AXIS_OF_LEAD}
+    lead = leads[max(leads, key=lambda w: travel.get(w, 0.0))]
+    if not lead:
+        it.diag("NC206", "error", f"{code} with a zero lead: the move is not made")
+        return
+    if not st.spindle_speed:
+        it.diag("NC206", "error", f"{code} with no spindle speed: the tapping feed (lead x S) is "
+                "unknown, the move is not made")
+        return
+    hand = "cw" if lead > 0 else "ccw"
+    turning = hand if motion == TAP else ("ccw" if hand == "cw" else "cw")
+    if st.spindle_dir != turning or it.spindle_stopped:
+        st.set("spindle", turning)
+        it.spindle_stopped = False
+        it._record("spindle", spindle_dir=turning, spindle=st.spindle_speed)
+    pitch = abs(lead)
+    saved, saved_mode = st.feed, st.feed_mode
+    st.feed, st.feed_mode = pitch * st.spindle_speed, "per_min"
+    mark = len(it.out)
+    try:
+        it._move("linear", target)
+    finally:
+        st.feed, st.feed_mode = saved, saved_mode
+    for rec in it.out[mark:]:
+        rec.pitch = pitch

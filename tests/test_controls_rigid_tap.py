@@ -1,0 +1,118 @@
+"""Sinumerik G331/G332 rigid tapping (issue 8): spindle-synchronised feed lead x S, records that
+carry the pitch, the spindle reversed for the retraction. Expected values by hand."""
+from __future__ import annotations
+
+import pytest
+
+import nctrans
+from nctrans import api
+
+
+def events(text: str, dialect: str = "sinumerik") -> list[tuple]:
+    out = []
+    for r in nctrans.toolpath(text, dialect):
+        if r.kind in ("rapid", "linear"):
+            out.append((r.kind, round(r.end["Z"], 6), None if r.kind == "rapid" else round(r.feed, 6),
+                        r.pitch))
+        elif r.kind == "spindle":
+            out.append(("spindle", r.spindle_dir))
+    return out
+
+
+def diags(text: str) -> list[tuple]:
+    return [(d.rule, d.line, d.severity) for d in api.lint(text, "sinumerik")]
+
+
+def test_right_hand_tap_and_retract():
+    # K1.5 at S500: 750 mm/min both ways; G332 reverses the spindle, M3 turns it back
+    text = "G17 G90 G0 X10 Y20 Z5\nS500 M3\nG331 Z-20 K1.5\nG332 Z5 K1.5\nM3\nG0 Z50\nM30\n"
+    assert events(text) == [("rapid", 5.0, None, None), ("spindle", "cw"),
+                            ("linear", -20.0, 750.0, 1.5), ("spindle", "ccw"),
+                            ("linear", 5.0, 750.0, 1.5), ("spindle", "cw"), ("rapid", 50.0, None, None)]
+    assert diags(text) == []
+
+
+def test_left_hand_tap_from_the_sign_of_the_lead():
+    # K-1 at S200 under M3: G331 turns the spindle counterclockwise, 200 mm/min, G332 clockwise
+    text = "G0 X0 Y0 Z2\nS200 M3\nG331 Z-10 K-1\nG332 Z2 K-1\nM30\n"
+    assert events(text) == [("rapid", 2.0, None, None), ("spindle", "cw"), ("spindle", "ccw"),
+                            ("linear", -10.0, 200.0, 1.0), ("spindle", "cw"),
+                            ("linear", 2.0, 200.0, 1.0)]
+
+
+def test_lead_in_inch_under_g700():
+    # K0.05 inch = 1.27 mm per revolution at S400: 508 mm/min; Z-1 inch = -25.4
+    text = "G700 G0 X0 Y0 Z0.1\nS400 M3\nG331 Z-1 K0.05\nM30\n"
+    assert events(text)[2:] == [("linear", -25.4, 508.0, 1.27)]
+
+
+def test_tapping_ignores_f_and_restores_it_after():
+    # F100 stays the feed of the G1 after the tapping (not 750)
+    text = "G0 X0 Y0 Z5\nS500 M3\nG1 Z4 F100\nG331 Z-20 K1.5\nG332 Z5 K1.5\nG1 Z6\nM30\n"
+    ev = events(text)
+    assert ev[2] == ("linear", 4.0, 100.0, None) and ev[-1] == ("linear", 6.0, 100.0, None)
+
+
+def test_modal_g331_taps_again_with_its_lead_and_without_it_refuses():
+    text = "G0 X0 Y0 Z5\nS100 M3\nG331 Z-5 K2\nZ-8 K2\nZ-9\nM30\n"
+    ev = events(text)
+    assert ev[2:] == [("linear", -5.0, 200.0, 2.0), ("linear", -8.0, 200.0, 2.0)]
+    assert ("NC206", 5, "error") in diags(text)
+
+
+def test_no_spindle_speed_is_an_error_and_no_move():
+    text = "G0 X0 Y0 Z5\nG331 Z-5 K1\nM30\n"
+    assert events(text) == [("rapid", 5.0, None, None)]
+    assert ("NC206", 2, "error") in diags(text)
+
+
+def test_g331_is_in_g_group_1_index_11():
+    from nctrans.interp.interpreter import interpret
+    from nctrans.dialects import base
+    res = base.get("sinumerik").parse("S100 M3\nG331 Z-1 K1\nR1=$P_GG[1]\nG0 X=R1\nM30\n", "t.mpf")
+    recs = [r for r in interpret(res.program, diagnostics=[]) if r.kind == "rapid"]
+    assert recs[-1].end["X"] == 11.0
+
+
+TAP_PROGRAM = "G17 G90 G0 X10 Y20 Z5\nS500 M3\nG331 Z-20 K1.5\nG332 Z5 K1.5\nG0 Z50\nM30\n"
+
+
+def test_conversion_to_iso_writes_synchronised_moves():
+    """ISO has no G331: the stretch is lowered to G33 moves with their lead and the spindle
+    reversal (M4/M3) between them; the toolpath stays the same, spindle events included."""
+    out = api.transpile(TAP_PROGRAM, "sinumerik", "iso-m")
+    assert out.text is not None, [d.message for d in out.diagnostics]
+    assert api.equiv(TAP_PROGRAM, out.text, read_a="sinumerik", read_b="iso-m").equivalent
+    assert events(out.text, "iso-m") == events(TAP_PROGRAM)
+    words = out.text.split()
+    assert "G33" in words and "M4" in words
+
+
+def test_conversion_to_fagor_is_refused_at_its_line():
+    """The Fagor writer has no spindle-synchronised move: refused at the G331 line, never plain feeds."""
+    out = api.transpile(TAP_PROGRAM, "sinumerik", "fagor")
+    assert out.text is None
+    assert any(d.rule == "NC402" and d.severity == "error" and d.line == 3 for d in out.diagnostics)
+
+
+def test_sinumerik_output_keeps_g331_g332():
+    text = "G0 X0 Y0 Z5\nS500 M3\nG331 Z-20 K1.5\nZ-22 K1.5\nG332 Z5 K1.5\nM30\n"
+    out = api.transpile(text, "sinumerik", "sinumerik").text
+    assert "G331" in out and "G332" in out
+    assert events(out) == events(text)
+
+
+def test_modal_stretch_is_lowered_whole_for_iso():
+    """Axis words after G331/G332 still tap: the whole stretch up to G1/G0 is lowered, so no
+    later block runs as a plain G33 in the wrong mode (hand-counted: 4 taps down, 2 up; the
+    spindle reversed once, before the first G332 move)."""
+    text = ("G0 X0 Y0 Z5\nS500 M3\nG331 Z-20 K1.5\nZ-22 K1.5\nG1 X1 F100\nG331 Z-24 K1.5\n"
+            "Z-25 K1.5\nG332 Z5 K1.5\nZ6 K1.5\nG0 Z10\nM30\n")
+    want = [("rapid", 5.0, None, None), ("spindle", "cw"), ("linear", -20.0, 750.0, 1.5), ("linear", -22.0, 750.0, 1.5),
+            ("linear", -22.0, 100.0, None), ("linear", -24.0, 750.0, 1.5),
+            ("linear", -25.0, 750.0, 1.5), ("spindle", "ccw"), ("linear", 5.0, 750.0, 1.5),
+            ("linear", 6.0, 750.0, 1.5), ("rapid", 10.0, None, None)]
+    assert events(text) == want
+    out = api.transpile(text, "sinumerik", "iso-m")
+    assert events(out.text, "iso-m") == want
+    assert api.equiv(text, out.text, read_a="sinumerik", read_b="iso-m").equivalent
