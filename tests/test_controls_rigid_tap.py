@@ -116,3 +116,36 @@ def test_modal_stretch_is_lowered_whole_for_iso():
     out = api.transpile(text, "sinumerik", "iso-m")
     assert events(out.text, "iso-m") == want
     assert api.equiv(text, out.text, read_a="sinumerik", read_b="iso-m").equivalent
+
+
+# ---------------------------------------------------------------- G33 between F-lead and K-lead
+
+def test_iso_g33_lead_becomes_k_in_sinumerik():
+    """ISO G33 Z.. F1.5 reads its lead from F; Sinumerik from K only (an F alone: no lead, NC206).
+    Hand values at S500: 1.5 x 500 = 750 mm/min; the second G33 takes the F in force ($P_F);
+    under G20 F0.05 inch = 1.27 mm lead, 635 mm/min."""
+    iso = ("G21 G17 G90 G0 X0 Y0 Z5\nS500 M3\nG33 Z-20 F1.5\nG0 Z5\nG33 Z-10\nG0 Z5\n"
+           "G20\nG33 Z-0.5 F0.05\nM30\n")
+    want = [("linear", -20.0, 750.0, 1.5), ("linear", -10.0, 750.0, 1.5),
+            ("linear", -12.7, 635.0, 1.27)]
+    assert [e for e in events(iso, "iso-m") if e[0] == "linear"] == want
+    out = api.transpile(iso, "iso-m", "sinumerik")
+    assert "K=1.5" in out.text and "K=$P_F" in out.text
+    assert [e for e in events(out.text) if e[0] == "linear"] == want
+    assert not [d for d in api.lint(out.text, "sinumerik") if d.severity == "error"]
+
+
+def test_iso_taper_thread_with_f_lead_is_never_written_without_its_lead():
+    """Along two axes the lead's axis is not known statically: the block is lowered (its lead
+    written from the analysed pitch) or refused at its line, never written without a lead."""
+    text = "G0 X0 Z5\nS100 M3\nG33 X2 Z-10 F1\nM30\n"
+    out = api.transpile(text, "iso-m", "sinumerik")
+    assert any(d.rule in ("NC402", "NC401") and d.line == 3 for d in out.diagnostics)
+    assert out.text is None or api.equiv(text, out.text, read_a="iso-m", read_b="sinumerik").equivalent
+
+
+def test_p_f_reads_the_feed_in_its_own_unit():
+    """$P_F gives F as programmed: under G70 F stays mm/min (100), under G700 inch/min (4)."""
+    text = "G70 G1 X0 F100\nR1=$P_F\nG700 F4\nR2=$P_F\nG71 G0 X=R1 Y=R2\nM30\n"
+    rapid = [r for r in nctrans.toolpath(text, "sinumerik") if r.kind == "rapid"][-1]
+    assert (rapid.end["X"], rapid.end["Y"]) == (100.0, 4.0)

@@ -43,7 +43,7 @@ from nctrans.interp.lathe import TURNING_KINDS, LatheMixin
 from nctrans.interp.run_checks import RunChecks
 from nctrans.interp.state import LINEAR_AXES, ModalState
 from nctrans.interp.travel_limits import ProgrammedLimits
-from nctrans.interp import ggroups, rigid_tap, sections, sysvars, unmodelled
+from nctrans.interp import ggroups, indirect_g, rigid_tap, sections, sysvars, unmodelled
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_LIMITS, UNMODELLED_MODES
 from nctrans import plainrun
@@ -397,6 +397,7 @@ class Interpreter(LatheMixin, RunChecks):
             n.Goto: self._c_goto, n.Alarm: lambda s: (self._h_alarm, s),
             n.DataSetting: lambda s: (self._h_data, s),
             n.PolarPole: lambda s: (self._h_pole, s),
+            n.ModeSelect: lambda s: (lambda d: indirect_g.select_mode(self, d), (s, self.ev.compile(s.index))),
             n.SectionRepeat: lambda s: (self._h_section, (s, None if s.count is None
                                                            else self.ev.compile(s.count))),
             n.Passthrough: self._c_passthrough,
@@ -1969,7 +1970,8 @@ class Interpreter(LatheMixin, RunChecks):
         values["active_tool"] = lambda: float(st.tool or 0)
         values["programmed_tool"] = lambda: float(st.tool_selected or 0)
         values["active_tool_edge"] = lambda: float(st.radius_index or 0)
-        values["feed"] = lambda: st.feed or 0.0
+        # F as programmed, in the feed unit in force (G700 inch/min; G70 keeps mm/min)
+        values["feed"] = lambda: (st.feed or 0.0) / (st.feed_scale if st.feed_mode != "inverse_time" else 1.0)
         values["spindle_speed"] = lambda: st.spindle_speed or 0.0
         for i in range(3):      # geometry axes of the plane: abscissa, ordinate, applicate
             values[f"plane_axis_{i + 1}"] = (lambda i=i: AxisName(PLANE_AXES[st.plane][i]))

@@ -62,7 +62,9 @@ def _reader(interp, e: dict, offset: int) -> Callable[[], Any] | None:
             v = getattr(st, attr)
             if v is None:
                 return None              # vacant: nothing programmed yet
-            return float(v) / (st.scale if word == "feed" and st.feed_mode == "per_min" else 1.0)
+            # the feed as programmed: in the feed unit (G70 keeps it mm, G700 inch), per minute
+            # or per revolution alike; an inverse-time F has no unit
+            return float(v) / (st.feed_scale if word == "feed" and st.feed_mode != "inverse_time" else 1.0)
         return modal_word
     if src == "work_offset":
         step = int(e.get("step", 20))

@@ -140,6 +140,17 @@ class ModeChange:
 
 
 @node
+class ModeSelect:
+    """Select the function numbered `index` (evaluated as the program runs) in one modal group of
+    the dialect (Sinumerik indirect G code `G[8]=INT_VAR`). `choices[i - 1]` is the neutral
+    [group, value, code] that number i selects, or None where that number means nothing the IR
+    models; `family` is the dialect's name of the group (its G group number), for writing back."""
+    family: int
+    index: Expr
+    choices: list
+
+
+@node
 class Motion:
     """Move to `target` with the modal motion mode in force.
 
@@ -427,7 +438,7 @@ Statement = Union[
     ModeChange, Motion, Feed, SpindleSpeed, SpindleLimit, ToolSelect, ToolChange, OffsetSelect, Dwell,
     SetPosition, ResetSetPosition, FrameOp, HomeReturn, CycleParams, CycleCall, SubCall,
     ModalCallOff, Return, ProgramEnd, Stop, Assign, VarDecl, Goto, Message, Alarm, Passthrough,
-    DataSetting, PolarPole, SectionRepeat, TravelLimit,
+    DataSetting, PolarPole, SectionRepeat, TravelLimit, ModeSelect,
 ]
 
 

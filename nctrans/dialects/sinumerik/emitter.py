@@ -427,6 +427,9 @@ class Emitter:
                 ws += [f"{k}={self.expr(s.polar[key])}" for k, key in (("AP", "angle"), ("RP", "radius"))
                        if key in s.polar]
             out.alone(" ".join([code.code if code else "G111", *ws]))
+        elif isinstance(s, ir.ModeSelect):
+            st.known = {}                   # the mode is chosen as the program runs
+            out.words.append(f"G[{s.family}]={self.expr(s.index)}")
         elif isinstance(s, ir.TravelLimit):
             if s.dialect == DIALECT:
                 out.alone(s.text)
@@ -481,7 +484,29 @@ class Emitter:
             ws.append(f"TURN={self.expr(m.turns)}")
         for axis, v in m.indirect or ():
             ws.append(f"AX[{self.expr(axis)}]={self.expr(v.value)}")
+        if st.motion == "thread" and not m.center and self._lead_is_feed():
+            ws.append(self._lead_from_feed(m, out))
         out.words.extend(ws)
+
+    def _lead_is_feed(self) -> bool:
+        """The source reads a thread's lead from F (its table's `thread_lead = "feed"`: ISO G33
+        Z.. F<lead>); Sinumerik reads it from I/J/K only."""
+        try:
+            return load_table(self.p.dialect).options.get("thread_lead") == "feed"
+        except Exception:           # a dialect without a table of its own
+            return False
+
+    def _lead_from_feed(self, m: ir.Motion, out: "_Line") -> str:
+        """The lead word (I/J/K of the one axis that moves) holding the F of the block, or the F
+        in force ($P_F) when the block has none."""
+        axes = [a for a in m.target if a in ("X", "Y", "Z")]
+        if len(axes) != 1:
+            self.refuse("a thread (G33) whose lead is its F, along more than one axis: Sinumerik "
+                        "needs the lead on one axis (I/J/K)")
+            return ""
+        feed = next((w for w in out.words if w.startswith("F")), None)
+        value = feed[1:].lstrip("=") if feed else "$P_F"
+        return f"{'IJK'['XYZ'.index(axes[0])]}={value}"
 
     def track(self, m: ir.Motion) -> None:
         """Last programmed constant position per axis (for the ISO cycle initial level)."""

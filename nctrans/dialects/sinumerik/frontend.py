@@ -273,7 +273,7 @@ def func(name: str, args: list) -> ir.Expr:
 # --------------------------------------------------------------------------- block lowering
 
 _ORDER = {"Assign": 0, "VarDecl": 0, "ModeChange": 1, "Feed": 2, "SpindleSpeed": 2,
-          "ToolSelect": 2, "OffsetSelect": 2, "ToolChange": 3, "Message": 5, "Alarm": 5,
+          "ModeSelect": 1, "ToolSelect": 2, "OffsetSelect": 2, "ToolChange": 3, "Message": 5, "Alarm": 5,
           "Passthrough": 5, "FrameOp": 5, "HomeReturn": 5, "Dwell": 6, "Motion": 6, "CycleCall": 6,
           "CycleParams": 6, "PolarPole": 5, "SubCall": 7, "ModalCallOff": 7, "Stop": 8, "ProgramEnd": 8,
           "Return": 8, "Goto": 8}
@@ -285,6 +285,19 @@ _LEADING = re.compile(r"\s*([A-Za-z_][A-Za-z_0-9]*)")
 def _t(text) -> str:
     """Statement text for a Passthrough: computed lazily (only kept constructs need it)."""
     return text() if callable(text) else text
+
+
+@lru_cache(maxsize=None)
+def _g_group_choices(family: int) -> list:
+    """[group, value, code] (or None) per G code number of G group `family`, shared by every
+    G[family]= of every program (read only)."""
+    t = table()
+    choices: list = []
+    for code in (t.options.get("g_group_index") or {}).get(str(family)) or ():
+        rule = t.lookup(code) if code else None
+        choices.append([rule.group, rule.value, rule.code] if rule is not None and rule.group
+                       and rule.modal else None)
+    return choices
 
 
 def _priority(st) -> int:
@@ -357,6 +370,17 @@ class Lowerer:
         known = t.options.get("no_motion_effect", {})
         self.no_effect = {w: NO_EFFECT_PREFIX for w in known.get("words", ())}
         self.no_effect.update({w: MILL_ONLY for w in known.get("mill_only", ())})
+
+    @staticmethod
+    def indirect_g(index: list, value: ir.Expr) -> Optional[ir.ModeSelect]:
+        """`G[n]=expr` (spec 3.6): the codes of G group n in their "index as PLC interface" order
+        (`[options.g_group_index]`, as $P_GG[n] reads them); None when n is not a constant the
+        table lists (a group whose codes the state cannot tell apart stays unmodelled, NC220)."""
+        if len(index) != 1 or type(index[0]) is not ir.Num or index[0].value != int(index[0].value):
+            return None
+        family = int(index[0].value)
+        choices = _g_group_choices(family)
+        return ir.ModeSelect(family, value, choices) if choices else None
 
     # ---- diagnostics
     def error(self, rule: str, msg: str, line: int, col: int, end_col: int = 0) -> None:
@@ -581,6 +605,8 @@ class Lowerer:
                     if name == "AX" and len(_index(idx)) == 1:
                         # indirect axis: the axis is a value (AX[_AXN]=RTP, spec 3.6)
                         w.indirect.append((_index(idx)[0], _axis_value(value)))
+                    elif name == "G" and (select := self.indirect_g(_index(idx), value)) is not None:
+                        w.out.append(select)
                     elif name in self.pass_words:
                         w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
                     elif name == "R":
