@@ -255,7 +255,7 @@ class LatheMixin:
 
     # ------------------------------------------------------------------ contours
     def _contour_blocks(self, vals: dict, unit, pc):
-        from nctrans.interp.interpreter import BLOCK, label_key
+        from nctrans.interp.compiled import BLOCK, label_key
         code_name = "G70-G73"
         if "start" not in vals or "end" not in vals:
             self.diag("NC130", "error", f"{code_name} without P and Q (first and last contour block)")

@@ -1,0 +1,232 @@
+"""Subprogram calls and the call stack: finding a callee (in the program, or through the resolver),
+argument binding and parameter scopes, modal calls (MCALL, G66), repeated program sections
+(REPEAT), SAVE subprograms (modal state restored on return), and calls nothing defines.
+
+Calls keep an explicit stack of frames (compiled.Frame; no Python recursion), so the loop in
+flow.py stays one generator. A mixin of Interpreter.
+"""
+from __future__ import annotations
+
+from typing import Callable, Optional
+
+from nctrans.interp import sections
+from nctrans.interp.compiled import (Frame, JFALSE, JUMP, MAX_CALL_DEPTH, Unit, label_key,
+                                     program_key)
+from nctrans.interp.evaluate import EvalError, Scope
+from nctrans.interp.offsets import copy_frame
+from nctrans.ir import nodes as n
+
+SHARED_SCOPE_CALLS = frozenset(("m98", "shared"))
+
+# Modal groups a SAVE subprogram does not restore: not G codes (spindle, coolant, tool length),
+# or state whose restoring mid-path would need its own approach (cutter compensation, cycles).
+NOT_SAVED_GROUPS = frozenset(("spindle", "coolant", "tool_length", "cutter_comp", "cycle"))
+SAVED_ATTRS = ("motion", "plane", "incremental", "arc_absolute", "scale", "feed_scale", "feed_mode",
+               "work_offset", "cycle_retract")
+
+
+class CallsMixin:
+    """Calls, returns, sections and the stack."""
+
+    def _calls_table(self) -> dict:
+        """Compilers of calls, modal-call cancel and program-section repeats."""
+        return {
+            n.SubCall: lambda s: (self._h_call, s),
+            n.ModalCallOff: lambda s: (self._h_modal_off, s),
+            n.SectionRepeat: lambda s: (self._h_section, (s, None if s.count is None
+                                                          else self.ev.compile(s.count))),
+        }
+
+    def _index_subprograms(self, program: n.Program) -> None:
+        for name, sub in (program.subprograms or {}).items():
+            self.sub_index.setdefault(program_key(name), (sub, program.file))
+            self.sub_index.setdefault(program_key(sub.name), (sub, program.file))
+
+    def _h_mcall_trigger(self, _):
+        """Sinumerik MCALL also calls after a block without path motion that programs G0/G1, or S
+        or F while G0/G1 is active (seed L5076-5080); ISO G66 calls after moves only."""
+        mc = self.modal_call
+        if mc is not None and mc[0].kind == "mcall" and self.st.motion in ("rapid", "linear"):
+            self.moved = True
+
+    def _h_call(self, s: n.SubCall):
+        if s.modal == "after_move":
+            self.modal_call = (s, self._call_args(s), self._depth())
+            return None
+        return ("call", s)
+
+    def _depth(self) -> int:
+        """The call level (a repeated section is not one: MCALL still calls in it)."""
+        return len(self.stack) - self.sections
+
+    def _h_section(self, d):
+        s, count = d
+        rep = 1
+        if count is not None:
+            r = self._value(count, "repeat count P")
+            rep = 1 if r is None else int(round(r))
+        return ("section", s, rep) if rep >= 1 else None
+
+    def _section(self, s: n.SectionRepeat, rep: int, unit: Unit, pc: int, sidx: int):
+        """Run a program section again `rep` times (nctrans.interp.sections), then resume after
+        the REPEAT statement at (pc, sidx)."""
+        first, last, problem = sections.section_bounds(s, unit.labels, label_key, pc)
+        key = ("section", id(unit), first, last)
+        callee = self.units.get(key)
+        if callee is None and not problem:
+            code, labels, problem = sections.section_code(unit.code, unit.labels, first, last,
+                                                          (JUMP, JFALSE))
+            if not problem:
+                callee = Unit(unit.name, unit.file, unit.params)
+                callee.code, callee.labels = code, labels
+                callee.seen = bytearray(len(code))
+                self.units[key] = callee
+        if problem:
+            self.diag("NC222", "error", f"{'REPEATB' if s.line_only else 'REPEAT'}: {problem}; "
+                      "the repetition is skipped")
+            return unit, unit.code, pc, sidx
+        if len(self.stack) >= MAX_CALL_DEPTH:
+            self.diag("NC105", "error", f"calls and repeated sections nested deeper than "
+                      f"{MAX_CALL_DEPTH}; REPEAT {s.start} skipped")
+            return unit, unit.code, pc, sidx
+        scope = self.ev.scope
+        self.stack.append(Frame(unit, pc, sidx, scope, callee, rep - 1, lambda: scope,
+                                section=True))
+        self.sections += 1
+        return callee, callee.code, 0, 0
+
+    def _h_modal_off(self, s):
+        self.modal_call = None
+        self.modal_cycle = None
+
+    def _call_args(self, s: n.SubCall, params: Optional[list] = None) -> tuple[list, dict]:
+        """Argument values; a VAR (by_ref) parameter of the callee gets a reference instead."""
+        byref = [bool(getattr(p, "by_ref", False)) for p in params or ()]
+        ev = self.ev
+        pos = [ev.make_ref(e) if i < len(byref) and byref[i] else ev.compile(e)()
+               for i, e in enumerate(s.args)]
+        named = {k.upper(): self.ev.compile(e)() for k, e in s.named_args.items()}
+        # ISO-style call arguments are in program units; they are passed as written
+        return pos, named
+
+    def _find_unit(self, name: str) -> Optional[Unit]:
+        key = program_key(name)
+        hit = self.sub_index.get(key)
+        if hit is None and self.resolver is not None:
+            if key not in self._resolved:
+                from_file = self.span.file if self.span else self.program.file
+                try:
+                    prog = self.resolver(name, from_file)
+                except Exception as ex:   # a resolver bug must not end the analysis
+                    self.diag("NC103", "warning", f"cannot load subprogram {name}: {ex}")
+                    prog = None
+                self._resolved[key] = prog
+                if prog is not None:
+                    self._index_subprograms(prog)
+                    if key not in self.sub_index:
+                        sub = n.Subprogram(name, n.Span(prog.file, 1), prog.body)
+                        self.sub_index[key] = (sub, prog.file)
+            hit = self.sub_index.get(key)
+        if hit is None:
+            return None
+        sub, file = hit
+        unit = self.unit_for(id(sub), sub.name, sub.body, file, sub.params)
+        unit.save = any(str(a).upper() == "SAVE" for a in (sub.attrs or ()))
+        return unit
+
+    def _make_scope(self, s: n.SubCall, unit: Unit, args: tuple) -> Callable[[], Scope]:
+        pos, named = args
+        # calls that open no parameter level of their own: ISO M98, and "shared" (Fagor LL, L,
+        # #CALL), which shares the caller's named locals too
+        share = s.kind in SHARED_SCOPE_CALLS and not pos and not named
+        caller = self.ev.scope
+
+        def make():
+            sc = Scope(num=caller.num if share else None, args=dict(named))
+            if share and s.kind == "shared":
+                sc.names, sc.args = caller.names, caller.args
+            for p, v in zip(unit.params, pos):
+                sc.names[p.name.upper()] = v
+            for p in unit.params[len(pos):]:       # not programmed in the call: preset to zero (seed
+                if not p.by_ref and not p.dims:    # "Incomplete parameter transfer")
+                    sc.names.setdefault(p.name.upper(), "" if p.type.upper().startswith("STRING") else 0)
+            for k, v in named.items():
+                var = s.bindings.get(k)
+                if var is None:
+                    continue
+                if var.space == "num" and isinstance(var.key, int):
+                    sc.num[var.key] = v
+                elif var.space in ("name", "arg", "local"):
+                    (sc.names if var.space == "name" else sc.args)[str(var.key).upper()] = v
+                elif var.space == "R" and isinstance(var.key, int):
+                    self.ev.R[var.key] = v
+            return sc
+        return make
+
+    def _opaque_call(self, s: n.SubCall) -> None:
+        """A call nothing here defines: a "call" record (name, evaluated arguments in binding
+        order: positional ones, then named ones by the local they bind), so a conversion that keeps
+        the call can be compared with its source."""
+        exprs = list(s.args)
+        named = sorted(s.named_args.items(), key=lambda kv: (
+            s.bindings[kv[0]].key if kv[0] in s.bindings and isinstance(s.bindings[kv[0]].key, int)
+            else 1000, kv[0]))
+        exprs += [e for _, e in named]
+        values = []
+        for e in exprs:
+            if type(e) is n.Num and e.text == "":
+                values.append(None)             # an omitted argument
+                continue
+            try:
+                values.append(self._value(self.ev.compile(e), "call argument"))
+            except EvalError:
+                values.append(None)
+        self._record("call", call=s.name, args=values)
+
+    def _return(self, to_label):
+        fr = self.stack[-1]
+        if fr.repeats > 0 and to_label is None:
+            fr.repeats -= 1
+            self.ev.scope = fr.make_scope()
+            return fr.callee, fr.callee.code, 0, 0
+        self.stack.pop()
+        self.moved = False       # the caller's block resumes after the call: no motion of its own
+        if fr.section:
+            self.sections -= 1
+        if fr.modal:
+            self.in_modal -= 1
+        self.ev.scope = fr.scope
+        if fr.saved is not None:
+            self._restore_state(fr.saved)
+        unit, pc, sidx = fr.unit, fr.pc, fr.sidx
+        if to_label is not None:
+            target = self._find_label(unit, to_label, "any", pc)
+            if target is None:
+                self.diag("NC102", "error", f"return target {to_label} not found in the caller")
+            else:
+                return unit, unit.code, target, 0
+        return unit, unit.code, pc, sidx
+
+    def _save_state(self) -> tuple:
+        st = self.st
+        return (dict(st.groups), {a: getattr(st, a) for a in SAVED_ATTRS}, st.feed,
+                copy_frame(self.frame))
+
+    def _restore_state(self, saved: tuple) -> None:
+        """Return from a SAVE subprogram (spec 1.6): the modal G codes, the settable and the
+        programmable frame as at the call; F too when the feed type (G group 15) changed."""
+        groups, attrs, feed, frame = saved
+        st = self.st
+        feed_mode = st.feed_mode
+        work = st.work_offset
+        for g, v in groups.items():
+            if g not in NOT_SAVED_GROUPS:
+                st.groups[g] = v
+        for a, v in attrs.items():
+            setattr(st, a, v)
+        if st.feed_mode != feed_mode:
+            st.feed = feed
+        if st.work_offset != work:
+            self.off.set_work(self._work_offset(st.work_offset) if st.work_offset else {})
+        copy_frame(frame, self.frame)
+        self._resync()

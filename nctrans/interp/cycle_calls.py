@@ -1,0 +1,354 @@
+"""Running canned cycles: ISO modal drilling cycles (G81..G89 with their hole positions), Sinumerik
+cycle calls (CYCLE81.., MCALL), hole patterns (HOLES1/HOLES2/CYCLE801), tapping and deep-hole
+infeeds, CYCLE800 swivel planes, and a cycle's own code found beside the program. What a cycle
+does, step by step, is nctrans.interp.cycles (and turning cycles lathe.py); this module feeds it
+the call's values and turns its steps into moves. A mixin of Interpreter.
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from nctrans.interp.compiled import BLOCK, Unit
+from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, expand_cycle,
+                                   hole_pattern, plane_cycle_levels, swivel_plan, tap_steps)
+from nctrans.interp.evaluate import UNKNOWN
+from nctrans.interp.frames import PLANE_AXES
+from nctrans.interp.lathe import TURNING_KINDS
+from nctrans.interp.milling_cycles import run_milling_cycle
+from nctrans.ir import nodes as n
+
+CYCLE_LENGTH_KEYS = frozenset(("bottom", "r_plane", "retract_plane", "safety", "peck", "shift",
+                               "depth_rel", "first_peck", "decrement", "min_peck", "relief"))
+
+
+class CycleCallsMixin:
+    """Cycle parameters, calls and hole positions."""
+
+    def _cycles_table(self) -> dict:
+        """Compilers of cycle parameter and cycle call statements."""
+        return {
+            n.CycleParams: lambda s: (self._h_cycle_params, s),
+            n.CycleCall: lambda s: (self._h_cycle_call, s),
+        }
+
+    def _cycle_off(self) -> None:
+        self.st.set("cycle", "off")
+        self.cycle_params = {}
+        self.cycle_initial = None
+
+    def _h_cycle_params(self, s: n.CycleParams):
+        scale = self.st.scale
+        for k, e in s.values.items():
+            v = self._value(self.ev.compile(e), f"cycle {k}")
+            if v is None:
+                continue
+            self.cycle_params[k] = v * scale if k in CYCLE_LENGTH_KEYS else v
+
+    def _cycle_hole(self, vals) -> None:
+        st = self.st
+        plane = st.plane
+        a1, a2, ax = PLANE_AXES[plane]
+        p = self.cycle_params
+        repeat = p.pop("repeat", 1)
+        for a, v, mode in vals:
+            if a == ax:
+                p["bottom"] = v
+        if not vals and "bottom" not in p:
+            return
+        missing = [k for k in ("bottom", "r_plane") if k not in p]
+        if missing:
+            self.diag("NC206", "error", f"canned cycle without {' and '.join(missing)}")
+            return
+        self._rc_cycle()
+        initial = self.cycle_initial if self.cycle_initial is not None else self.pos.get(ax, 0.0)
+        if st.incremental:
+            zr = initial + p["r_plane"]
+            zb = zr + p["bottom"]
+        else:
+            zr, zb = p["r_plane"], p["bottom"]
+        retract = initial if st.cycle_retract == "initial" else zr
+        plane_vals = [(a, v, m) for a, v, m in vals if a != ax]
+        hole = self._target(plane_vals)
+        hole[ax] = self.pos.get(ax, 0.0)
+        step = None
+        if st.incremental:
+            step = {a: v for a, v, m in plane_vals if m != "abs"}
+        self._expand(st.cycle, hole, zr, zb, retract, p, int(round(repeat)), step)
+
+    def _position_at(self) -> str:
+        mode = self.__dict__.get("_cycle_positioning")
+        if mode is None:
+            mode = self._cycle_positioning = cycle_table().position_at(self.program.dialect)
+        return mode
+
+    def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None,
+                steps=None) -> None:
+        st = self.st
+        feed = p.get("feed")
+        feed = feed * st.feed_scale if feed is not None else (st.feed or 0.0)
+        if not feed:
+            self._need_feed()
+        if repeat < 1:
+            return
+        if steps is None:
+            steps = expand_cycle(kind, plane=st.plane, position=dict(self.pos), hole=hole,
+                                 approach=approach, bottom=bottom, retract=retract,
+                                 peck=p.get("peck"), dwell_s=p.get("dwell"), shift=p.get("shift"),
+                                 feed=feed, spindle_dir=st.spindle_dir, units_mm=st.scale == 1.0,
+                                 repeat=repeat, step=step, position_at=self._position_at())
+        elif callable(steps):
+            steps = steps(feed)
+        pitch = None
+        if kind in ("tap", "tap_left"):
+            pitch = p.get("pitch")
+            if pitch is None:
+                pitch = feed if st.feed_mode == "per_rev" else (
+                    feed / st.spindle_speed if st.spindle_speed else None)
+        saved = st.feed
+        st.feed = feed
+        try:
+            for s in steps:
+                k = s[0]
+                if k in ("rapid", "linear"):
+                    pt = dict(self.pos)
+                    pt.update(s[1])
+                    mark = len(self.out)
+                    self._move(k, pt)
+                    if pitch is not None and k == "linear":
+                        for rec in self.out[mark:]:
+                            rec.pitch = pitch     # tapping: the feed is the spindle's times the lead
+                elif k == "feed":
+                    st.feed = s[1]
+                elif k == "dwell":
+                    self._record("dwell", dwell_s=float(s[1] or 0.0))
+                elif k == "spindle":         # the cycle turns it (tapping reversal, CYCLE84 SDAC)
+                    st.set("spindle", s[1])
+                    self.spindle_stopped = s[1] in ("off", "orient")
+                    self._record("spindle", spindle_dir=s[1], spindle=st.spindle_speed)
+                elif k == "stop":
+                    self._record("stop", stop_kind="stop")
+        finally:
+            st.feed = saved
+        if kind == "bore_manual":        # the operator retracted by hand (see cycles.py)
+            ax = PLANE_AXES[st.plane][2]
+            pos = dict(self.pos)
+            pos[ax] = max(retract, approach) if approach >= bottom else min(retract, approach)
+            self.pos = pos
+            self.mpos = self._to_machine(pos)
+
+    def _h_cycle_call(self, s: n.CycleCall):
+        if s.kind in TURNING_KINDS:
+            return self._turning_cycle(s)
+        if s.name and s.kind != "swivel_plane" and self._find_unit(s.name) is not None:
+            return self._cycle_code(s)
+        if s.kind in ("holes_line", "holes_circle", "holes_grid"):
+            return self._hole_pattern(s)
+        if s.kind == "swivel_plane":
+            self._swivel_plane(s)
+            return
+        if s.kind == "milling":
+            return run_milling_cycle(self, s)
+        if s.modal:
+            self.modal_cycle = s
+            return
+        self._run_cycle_call(s)
+
+    def _cycle_code(self, s: n.CycleCall):
+        """A cycle whose own code is in the program or beside it (CYCLE81.SPF on the search
+        path): the control runs that code, so the interpreter calls it with the call's
+        arguments in their places (omitted ones as the control passes them) instead of the
+        built-in model. MCALL makes it a modal call like any subprogram's."""
+        table = cycle_table()
+        spec = ({c.name: c for c in table.cycle} | {p.name: p for p in table.pattern}
+                | {m.name: m for m in table.milling}).get(s.name.upper())
+        params = list(spec.params) if spec is not None else []
+        args = [s.params.get(table.neutral(p), n.Num(0.0, "")) for p in params]
+        unit = self._find_unit(s.name)          # a PROC declaring fewer parameters than the table
+        given = [i for i, p in enumerate(params) if table.neutral(p) in s.params]
+        keep = max(len(unit.params) if unit is not None and unit.params else len(args),
+                   given[-1] + 1 if given else 0)
+        args = args[:keep]
+        if s.modal:
+            call = n.SubCall(s.name, args, modal="after_move", kind="mcall")
+            self.modal_cycle = None
+            self.modal_call = (call, self._call_args(call), self._depth())
+            return None
+        return ("call", n.SubCall(s.name, args, kind="proc"))
+
+    def _hole_pattern(self, s: n.CycleCall):
+        """Sinumerik HOLES1/HOLES2/CYCLE801: the modally called cycle at each position of the
+        pattern (only positioning when no cycle is modal). Under a modal subprogram call (MCALL
+        of a PROC, such as a CYCLE81.SPF beside the program) the positions run as blocks of
+        their own, so the call follows each of them as it follows any block that moves."""
+        pat = {p.name: p for p in cycle_table().pattern}.get((s.name or "").upper())
+        if pat is None:
+            self.diag("NC103", "warning", f"hole pattern {s.name or s.kind} is not known")
+            return
+        args = []
+        for p in pat.params:
+            e = s.params.get(p.lower())
+            args.append(None if e is None else self._value(self.ev.compile(e), p))
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        sc = self.st.scale
+        holes = hole_pattern(pat.name, args)
+        if self.modal_call is not None and self.modal_cycle is None and holes:
+            positions = Unit(pat.name, self.span.file if self.span else "", [])
+            positions.code = [(BLOCK, [(self._h_pattern_position, (a1, a2, p1 * sc, p2 * sc))],
+                               None, self.span) for p1, p2 in holes]
+            positions.seen = bytearray(b"\x01" * len(holes))
+            return ("pattern", positions)
+        for p1, p2 in holes:
+            hole = dict(self.pos)
+            hole[a1], hole[a2] = p1 * sc, p2 * sc
+            self._move("rapid", hole)        # the pattern's positioning block, even when there
+            if self.modal_cycle is not None:
+                self._run_cycle_call(self.modal_cycle)
+
+    def _h_pattern_position(self, d) -> None:
+        """One position of a hole pattern under a modal subprogram call: a rapid in the plane."""
+        a1, a2, p1, p2 = d
+        hole = dict(self.pos)
+        hole[a1], hole[a2] = p1, p2
+        self.moved = True
+        self._move("rapid", hole)            # a positioning block, even when already there
+
+    def _run_cycle_call(self, s: n.CycleCall, hole: Optional[dict] = None) -> None:
+        st = self.st
+        ax = PLANE_AXES[st.plane][2]
+        params = {}
+        for k, e in s.params.items():
+            v = self._value(self.ev.compile(e), f"cycle {k}")
+            if v is not None:
+                params[k] = v * st.scale if k in CYCLE_LENGTH_KEYS else v
+        if "bottom" not in params and "depth_rel" not in params:
+            self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
+            return
+        approach, bottom, retract = plane_cycle_levels(params, current=self.pos.get(ax, 0.0))
+        self._rc_cycle()
+        steps = None
+        if hole is not None and any(abs(hole.get(a, 0.0) - self.pos.get(a, 0.0)) > 0
+                                    for a in PLANE_AXES[st.plane][:2]):
+            self._move("rapid", {**self.pos, **{a: hole[a] for a in PLANE_AXES[st.plane][:2]}})
+        hole = dict(self.pos)
+        kind = s.kind
+        if kind in ("peck", "chip_break") and "peck" not in params:
+            steps = self._deep_hole(params, approach, bottom, retract)
+        elif kind in ("tap", "tap_left"):
+            kind, steps = self._tap(s, params, approach, bottom, retract)
+            if steps is None:
+                return
+        self._expand(kind, hole, approach, bottom, retract, params, steps=steps)
+
+    def _tap(self, s: n.CycleCall, p: dict, approach: float, bottom: float, retract: float):
+        """CYCLE84/CYCLE840: lead from PIT, else from the M size MPIT; its sign gives the hand;
+        feed = lead * S (spindle-synchronised)."""
+        st = self.st
+        lead = p.get("pit") or None
+        if lead is None and p.get("mpit"):
+            lead = coarse_pitch(p["mpit"])
+            if lead is not None and p["mpit"] < 0:
+                lead = -lead
+        if lead is None:
+            self.diag("NC206", "error", f"{s.name or 'tapping cycle'} without a thread pitch "
+                      "(PIT) or a known thread size (MPIT)")
+            return s.kind, None
+        kind = "tap_left" if lead < 0 else "tap"
+        lead = abs(lead) * (st.scale if "pit" in p and p.get("pit") else 1.0)
+        if not st.spindle_speed:
+            self.diag("NC206", "error", f"{s.name or 'tapping cycle'} with no spindle speed")
+            return kind, None
+        p["pitch"] = lead
+        p["feed"] = lead * st.spindle_speed / st.scale
+        after = {3: "cw", 4: "ccw", 5: "off"}.get(int(p.get("sdac", 0) or 0))
+        steps = tap_steps(plane=st.plane, approach=approach, bottom=bottom, retract=retract,
+                          dwell_s=p.get("dwell"), forward="ccw" if kind == "tap_left" else "cw",
+                          after=after)
+        return kind, steps
+
+    def _deep_hole(self, p: dict, approach: float, bottom: float, retract: float):
+        """CYCLE83 infeeds from FDEP/FDPR and DAM (cycles.deep_hole_steps)."""
+        rfp = p.get("r_plane", 0.0)
+        up = 1.0 if approach >= bottom else -1.0
+        first = p.get("first_peck")
+        if "fdpr" in p:
+            first = rfp - up * abs(p["fdpr"] * self.st.scale)
+        vari = int(p.get("vari", 0) or 0)
+        vari = 1 if vari % 10 == 1 else 0
+        anticipation = p.get("_dis1")     # _DIS1: re-approach distance (VARI=1), a length
+        if anticipation is not None:
+            anticipation *= self.st.scale
+
+        def make(feed: float):
+            return deep_hole_steps(plane=self.st.plane, vari=vari, approach=approach, rfp=rfp,
+                                   bottom=bottom, retract=retract, first=first,
+                                   decrement=p.get("decrement", 0.0), dwell_bottom=p.get("dwell"),
+                                   dwell_top=p.get("dts"), relief=p.get("relief"), feed=feed,
+                                   first_factor=p.get("frf"), anticipation=anticipation)
+        return make
+
+    def _swivel_plane(self, s: n.CycleCall) -> None:
+        """Sinumerik CYCLE800 [GK]: retract in machine coordinates (_FR), then the programmable
+        frame becomes TRANS(_X0..) : AROT(axis by axis) : ATRANS(_X1..) (_ST 1: composed on the
+        current frame). Rotary axes are not positioned: that needs the machine's swivel data
+        record (kinematics), which the machine model does not hold (NC107 info)."""
+        params: dict[str, Any] = {}
+        for k, e in s.params.items():
+            if k == "swivel_record":
+                v = self.ev.compile(e)()
+                params[k] = None if v is None or v is UNKNOWN else v
+            else:
+                v = self._value(self.ev.compile(e), f"CYCLE800 {k}")
+                if v is not None:
+                    params[k] = v
+        plan = swivel_plan(params)
+        self._swivel_retract(plan)
+        if plan.mode != "axis":
+            self.diag("NC107", "info", f"CYCLE800 swivel mode {plan.mode!r} (_MODE "
+                      f"{int(params.get('swivel_mode', 0))}) needs the machine's swivel data record "
+                      "and is not interpreted; the programmable frame is kept")
+            return
+        if plan.rotations:
+            rec = params.get("swivel_record")
+            self.diag("NC107", "info", f"rotary axis positioning needs the swivel data record "
+                      f"{str(rec or '')!r} (machine kinematics, not in the machine model); the rotary "
+                      "axes are not moved, only the programmable frame is swivelled")
+
+        def op(kind: str, vals: dict[str, float], additive: bool) -> None:
+            self._h_frame(n.FrameOp(kind, {a: n.Num(v) for a, v in vals.items()}, additive=additive))
+
+        op("trans", plan.ref, plan.additive)
+        for axis, angle in plan.rotations:
+            op("rot", {axis: angle}, True)
+        op("trans", plan.shift, True)
+
+    def _swivel_retract(self, plan) -> None:
+        """CYCLE800 _FR: rapid moves in machine Z (then X and Y) to the machine model's max travel."""
+        if plan.retract == "none":
+            return
+        if plan.retract == "unknown":
+            self.diag("NC105", "error", "CYCLE800 retract mode _FR must be 0, 1, 2, 4 or 5; no retract")
+            return
+        steps: list[dict[str, float]] = []
+        z = self.mpos.get("Z", 0.0)
+        if plan.retract == "tool_inc":
+            steps.append({"Z": z + plan.retract_inc * self.st.scale})
+        else:
+            axes = [("Z",)] + ([("X", "Y")] if plan.retract == "z_xy" else [])
+            for group in axes:
+                target = {}
+                for a in group:
+                    ax = self.machine.axes.get(a)
+                    if ax is None or ax.max is None:
+                        self.diag("NC107", "info", f"the machine model has no max travel for {a}; "
+                                  "CYCLE800 does not retract that axis")
+                        continue
+                    target[a] = float(ax.max)
+                if target:
+                    steps.append(target)
+        tot = self.off.total
+        for target in steps:
+            mend = dict(self.mpos)
+            mend.update(target)
+            if all(abs(mend[a] - self.mpos.get(a, 0.0)) < 1e-12 for a in target):
+                continue
+            self._move("rapid", self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()}))

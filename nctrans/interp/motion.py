@@ -1,0 +1,438 @@
+"""Motion statements: G0/G1 (with the Python fast path _h_fast for literal words in the plain
+state), G2/G3 by centre, radius, opening angle or turns, 3-point (CIP) and tangential (CT) arcs,
+G33 threads, polar words and poles, G53 machine moves, G28/G30 home returns; under a canned cycle
+the axis words position a hole instead (cycle_calls.py).
+
+Arcs: `turns` is the number of EXTRA full turns (LinuxCNC ARC_FEED |rotation| - 1); an arc whose
+start equals its end in the plane is a full circle. `center` holds the plane's two axes plus the
+normal axis at the arc's end height (as tests/rs274.py reads LinuxCNC).
+
+Each handler computes a target in program coordinates and hands it to records.py (_move).
+A mixin of Interpreter.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+from nctrans.interp import arcs, rigid_tap
+from nctrans.interp.frames import PLANE_AXES
+from nctrans.interp.state import LINEAR_AXES
+from nctrans.ir import nodes as n
+from nctrans.toolpath import ToolpathRecord
+
+class MotionMixin:
+    """Motion words to program-coordinate moves."""
+
+    def _motion_table(self) -> dict:
+        """Compilers of motion, home return and polar pole statements."""
+        return {
+            n.Motion: self._c_motion, n.HomeReturn: lambda s: (self._h_home, s),
+            n.PolarPole: lambda s: (self._h_pole, s),
+        }
+
+    def _c_motion(self, s: n.Motion):
+        if (s.center is None and s.radius is None and s.turns is None and not s.polar
+                and not s.machine_coords and s.via is None and s.aperture is None
+                and not s.indirect):
+            fast = []
+            AV, Num = n.AxisValue, n.Num
+            for axis, av in s.target.items():
+                if type(av) is AV and type(av.value) is Num and av.mode in (None, "abs", "inc") \
+                        and float(av.value.value) - float(av.value.value) == 0.0:
+                    a = axis.upper()
+                    fast.append((a, float(av.value.value), av.mode, a in LINEAR_AXES))
+                else:
+                    break
+            else:
+                return (self._h_fast, [tuple(fast), s, None])
+        return (self._h_motion, self._c_motion_full(s))
+
+    def _c_motion_full(self, s: n.Motion) -> tuple:
+        words = self._words(s.target)
+        if s.indirect:
+            words += tuple((self.ev.compile(axis), None, self.ev.compile(av.value), av.mode)
+                           for axis, av in s.indirect)
+        center = self._words(s.center)
+        radius = None if s.radius is None else self.ev.compile(s.radius)
+        turns = None if s.turns is None else self.ev.compile(s.turns)
+        polar = None
+        if s.polar:
+            polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
+        via = self._words(s.via)
+        ap = getattr(s, "aperture", None)
+        aperture = None if ap is None else self.ev.compile(ap)
+        return (words, center, radius, turns, s.machine_coords, polar, via, aperture)
+
+    def _slow(self, d):
+        full = d[2]
+        if full is None:
+            full = d[2] = self._c_motion_full(d[1])
+        return self._h_motion(full)
+
+    def _h_fast(self, d):
+        """The hot path: a rapid/linear move with literal words and no frame, comp or cycle."""
+        words = d[0]
+        st = self.st
+        if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
+                or self.comp_exit or st.comp_side != "off" or not self.frame.identity
+                or self.unmodelled_motion is not None or st.diameter
+                or self.css_surface is not None or self.spindle_stopped or self.watch):
+            return self._slow(d)
+        motion = st.motion
+        if motion == "rapid":
+            feed = None
+        elif motion == "linear":
+            feed = st.feed
+            if not feed:
+                self._need_feed()
+        else:
+            return self._slow(d)
+        self.moved = True
+        if not words:
+            return None
+        tgt = self.pos.copy()
+        scale = st.scale
+        inc = st.incremental
+        for axis, v, mode, lin in words:
+            if lin and scale != 1.0:
+                v = v * scale
+            cur = tgt.get(axis)
+            if cur is None:                  # first use of an axis: the general path adds it
+                return self._slow(d)
+            if (inc if mode is None else mode == "inc"):
+                v += cur
+            tgt[axis] = v
+        self.last_from = self.pos
+        self.last_arc = None
+        self.pos = tgt
+        tot = self.off.total
+        mend = {a: v + tot.get(a, 0.0) for a, v in tgt.items()} if tot else tgt.copy()
+        mstart = self.mpos
+        self.mpos = mend
+        sp = self.span
+        if feed is None:
+            rec = ToolpathRecord(0, sp.file, sp.line, "rapid", mstart, mend, None, None, None,
+                                 None, None, None, st.spindle_speed, st.tool)
+        else:
+            rec = ToolpathRecord(0, sp.file, sp.line, "linear", mstart, mend, None, None, None,
+                                 None, feed, st.feed_mode, st.spindle_speed, st.tool)
+        self.out.append(rec)
+        if self.hook is not None:
+            self._hookq.append(({a: v - tot.get(a, 0.0) for a, v in mend.items()}, None))
+        return None
+
+    def _h_motion(self, d):
+        words, center, radius, turns, machine, polar, via, aperture = d
+        st = self.st
+        if self.unmodelled_motion is not None:
+            if self._unmodelled_at is self.span:
+                return                  # the code's own block: reported with the code
+            self.diag("NC220", "warning", f"motion under {self.unmodelled_motion} is not modelled: "
+                      "this block's axis words move nothing in the analysed toolpath")
+            return
+        self.moved = True
+        vals = self._eval_words(words)
+        if polar:
+            vals = self._polar(vals, polar)
+        if self.modal_cycle is not None and st.cycle == "off" and not machine:
+            self._motion_plain(vals, d)
+            if any(a in PLANE_AXES[st.plane][:2] for a, _, _ in vals):
+                self._run_cycle_call(self.modal_cycle)
+            return
+        if st.cycle != "off" and not machine:
+            self._cycle_hole(vals)
+            return
+        if machine:
+            self._machine_move(vals)
+            return
+        self._motion_plain(vals, d)
+
+    def _motion_plain(self, vals, d):
+        _, center, radius, turns, _, _, via, aperture = d
+        st = self.st
+        motion = st.motion
+        if motion == "rapid":
+            if vals:
+                self._move("rapid", self._target(vals))
+            return
+        if motion == "linear":
+            if vals:
+                self._need_feed()
+                self._move("linear", self._target(vals))
+            return
+        if motion == "thread":
+            if vals:
+                self._g33_move(vals, center)
+            return
+        if motion in rigid_tap.MODES:
+            if vals:
+                rigid_tap.rigid_tap_move(self, vals, center, motion)
+            return
+        if motion in ("arc_cw", "arc_ccw"):
+            self._arc(vals, center, radius, turns, motion == "arc_cw", aperture)
+            return
+        if motion == "arc_3point":
+            self._arc_3point(vals, via)
+            return
+        if motion == "arc_tangent":
+            self._arc_tangent(vals)
+            return
+        if vals:
+            self.diag("NC207", "error", "axis words while no motion mode is active")
+
+    def _need_feed(self) -> None:
+        st = self.st
+        if not st.feed and not self.feed_reported:
+            self.feed_reported = True
+            self.diag("NC202", "error", "feed move with no feed rate programmed")
+        if self.spindle_stopped and not self.spindle_reported:
+            self.spindle_reported = True
+            self.diag("NC209", "warning", "feed move while the spindle is stopped (M5, or a tool change that stops it): the tool "
+                      "would rub or break; start the spindle (M3/M4) before cutting")
+
+    def _g33_move(self, vals, center) -> None:
+        """G33: a feed synchronised with the spindle, `lead` mm per revolution: the feed is
+        lead x S and the record carries the lead (pitch). The lead is the I/J/K word of the
+        block (Sinumerik, LinuxCNC, Fagor: the one of the axis that travels furthest when
+        several are given), else the F word in a dialect whose table says F is the lead
+        (`[options] thread_lead = "feed"`: ISO seed 4.5 `G33 Z.. F<lead>`)."""
+        st = self.st
+        target = self._target(vals)
+        leads = {a: abs(v) for a, v, _ in self._eval_words(center)} if center else {}
+        lead = None
+        if leads:
+            travel = {w: abs(target.get(a, 0.0) - self.pos.get(a, 0.0))
+                      for w, a in (("I", "X"), ("J", "Y"), ("K", "Z"))}
+            lead = leads[max(leads, key=lambda w: travel.get(w, 0.0))]
+        elif self._thread_lead_is_feed():
+            lead = st.feed if st.feed and st.feed_mode != "inverse_time" else None   # mm
+        if not lead:
+            self.diag("NC206", "error", "thread move (G33) without a lead: the move is not made")
+            return
+        if not st.spindle_speed:
+            self.diag("NC209", "warning", "thread move (G33) with no spindle speed: the feed "
+                      "(lead x S) is unknown")
+        saved, saved_mode = st.feed, st.feed_mode
+        st.feed = lead * st.spindle_speed if st.spindle_speed else None
+        st.feed_mode = "per_min"
+        mark = len(self.out)
+        try:
+            self._move("linear", target)
+        finally:
+            st.feed, st.feed_mode = saved, saved_mode
+        for rec in self.out[mark:]:
+            rec.pitch = lead
+
+    def _thread_lead_is_feed(self) -> bool:
+        v = getattr(self, "_lead_is_feed", None)
+        if v is None:
+            try:
+                from nctrans.rules import load_table
+                v = load_table(self.program.dialect).options.get("thread_lead") == "feed"
+            except Exception:          # no table for this dialect
+                v = False
+            self._lead_is_feed = v
+        return v
+
+    def _polar(self, vals, polar):
+        """Polar words (radius, angle in the active plane about the pole: program zero until
+        G110/G111/G112 sets one). A word left out keeps its value from the current point."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        r = self._value(polar["radius"], "polar radius") if "radius" in polar else None
+        ang = self._value(polar["angle"], "polar angle") if "angle" in polar else None
+        if r is None and ang is None:
+            return vals
+        c1, c2 = self.pole or (0.0, 0.0)
+        p1, p2 = self.pos.get(a1, 0.0) - c1, self.pos.get(a2, 0.0) - c2
+        if r is None:
+            r = math.hypot(p1, p2)
+        else:
+            r *= self.st.scale
+        if ang is None:
+            ang = math.degrees(math.atan2(p2, p1))
+        rest = [w for w in vals if w[0] not in (a1, a2)]
+        return rest + [(a1, c1 + r * math.cos(math.radians(ang)), "abs"),
+                       (a2, c2 + r * math.sin(math.radians(ang)), "abs")]
+
+    def _h_pole(self, s: n.PolarPole) -> None:
+        """G110/G111/G112: the pole relative to the last programmed point, the workpiece zero or
+        the last pole, whatever G90/G91 (spec 9.2); given by plane axis words or by polar words
+        about that point. Nothing moves."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        if s.relative_to == "last_point":
+            ref = (self.pos.get(a1, 0.0), self.pos.get(a2, 0.0))
+        elif s.relative_to == "pole":
+            ref = self.pole or (0.0, 0.0)
+        else:
+            ref = (0.0, 0.0)
+        if s.polar:
+            polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
+            r = self._value(polar["radius"], "pole radius") if "radius" in polar else None
+            ang = self._value(polar["angle"], "pole angle") if "angle" in polar else None
+            r = (r or 0.0) * self.st.scale
+            ang = math.radians(ang or 0.0)
+            self.pole = (ref[0] + r * math.cos(ang), ref[1] + r * math.sin(ang))
+            return
+        d = {a1: 0.0, a2: 0.0}
+        for axis, v, _ in self._eval_words(self._words(s.target)):
+            if axis in d:
+                d[axis] = v
+        self.pole = (ref[0] + d[a1], ref[1] + d[a2])
+
+    def _machine_move(self, vals) -> None:
+        """G53: the words are machine coordinates of the controlled point, this block only."""
+        mend = dict(self.mpos)
+        for a, v, _ in vals:
+            mend[a] = v
+        kind = "linear" if self.st.motion == "linear" else "rapid"
+        if kind == "linear":
+            self._need_feed()
+        tot = self.off.total
+        end = self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()})
+        self._move(kind, end)
+
+    def _arc_3point(self, vals, via) -> None:
+        """Sinumerik CIP: the circle through start, intermediate point and end."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        start = self.pos
+        end = self._target(vals)
+        mid = self._target(self._eval_words(via)) if via else None
+        self._need_feed()
+        if mid is None:
+            self.diag("NC203", "error", "3-point arc without an intermediate point")
+            return
+        p = [(q.get(a1, 0.0), q.get(a2, 0.0)) for q in (start, mid, end)]
+        (x1, y1), (x2, y2), (x3, y3) = p
+        den = 2 * (x1 * (y2 - y3) + x2 * (y3 - y1) + x3 * (y1 - y2))
+        if abs(den) < 1e-12:
+            self.diag("NC203", "error", "3-point arc through collinear points")
+            return
+        s1, s2, s3 = x1 * x1 + y1 * y1, x2 * x2 + y2 * y2, x3 * x3 + y3 * y3
+        cx = (s1 * (y2 - y3) + s2 * (y3 - y1) + s3 * (y1 - y2)) / den
+        cy = (s1 * (x3 - x2) + s2 * (x1 - x3) + s3 * (x2 - x1)) / den
+        cw = ((x2 - x1) * (y3 - y2) - (y2 - y1) * (x3 - x2)) < 0
+        self._move("arc", end, (cx, cy), cw, 0)
+
+    def _tangent(self) -> Optional[tuple[float, float]]:
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        e1, e2 = self.pos.get(a1, 0.0), self.pos.get(a2, 0.0)
+        if self.last_arc is not None:
+            (c1, c2), cw = self.last_arc
+            r1, r2 = e1 - c1, e2 - c2
+            t = (r2, -r1) if cw else (-r2, r1)
+        elif self.last_from is not None:
+            t = (e1 - self.last_from.get(a1, 0.0), e2 - self.last_from.get(a2, 0.0))
+        else:
+            return None
+        ln = math.hypot(*t)
+        return None if ln < 1e-12 else (t[0] / ln, t[1] / ln)
+
+    def _arc_tangent(self, vals) -> None:
+        """Sinumerik CT: an arc leaving tangentially from the previous path."""
+        a1, a2, _ = PLANE_AXES[self.st.plane]
+        t = self._tangent()
+        end = self._target(vals)
+        self._need_feed()
+        s1, s2 = self.pos.get(a1, 0.0), self.pos.get(a2, 0.0)
+        d1, d2 = end.get(a1, 0.0) - s1, end.get(a2, 0.0) - s2
+        if t is None:
+            self.diag("NC203", "error", "tangential arc without a previous direction")
+            return
+        nl = (-t[1], t[0])                       # left normal
+        dn = d1 * nl[0] + d2 * nl[1]
+        if abs(dn) < 1e-12:                      # end straight ahead: a line
+            self._move("linear", end)
+            return
+        k = (d1 * d1 + d2 * d2) / (2 * dn)
+        self._move("arc", end, (s1 + k * nl[0], s2 + k * nl[1]), k < 0, 0)
+
+    def _arc(self, vals, center, radius, turns, cw, aperture=None) -> None:
+        st = self.st
+        plane = st.plane
+        a1, a2, an = PLANE_AXES[plane]
+        start = self.pos
+        end = self._target(vals)
+        s1, s2 = start.get(a1, 0.0), start.get(a2, 0.0)
+        e1, e2 = end.get(a1, 0.0), end.get(a2, 0.0)
+        inch = st.scale != 1.0
+        if center:
+            self._rc_arc(center)
+        nturns = 0
+        if turns is not None:
+            t = self._value(turns, "turns")
+            if t is not None:
+                nturns = max(int(round(t)), 0)
+        self._need_feed()
+        try:
+            if aperture is not None:
+                ang = self._value(aperture, "opening angle")
+                if ang is None or not 0 < ang < 360:
+                    raise arcs.ArcError(f"arc opening angle {ang} outside 0..360")
+                cvals = self._eval_words(center)
+                if cvals and not any(a in (a1, a2) for a, _, _ in vals):
+                    # centre + angle: the end is the start turned about the centre
+                    cd = {a: v for a, v, _ in cvals}
+                    ci = {"I": "X", "J": "Y", "K": "Z"}
+                    c1, c2 = s1, s2
+                    for a, v in cd.items():
+                        ax = ci.get(a, a)
+                        absolute = dict((w, m == "abs") for w, _, m in cvals)[a] or st.arc_absolute
+                        if ax == a1:
+                            c1 = v if absolute else s1 + v
+                        elif ax == a2:
+                            c2 = v if absolute else s2 + v
+                    phi = math.radians(-ang if cw else ang)
+                    r1, r2 = s1 - c1, s2 - c2
+                    end = dict(end)
+                    end[a1] = c1 + r1 * math.cos(phi) - r2 * math.sin(phi)
+                    end[a2] = c2 + r1 * math.sin(phi) + r2 * math.cos(phi)
+                    self._move("arc", end, (c1, c2), cw, nturns)
+                    return
+                half = math.hypot(e1 - s1, e2 - s2) / 2
+                r = half / math.sin(math.radians(ang) / 2)
+                c1, c2 = arcs.center_from_radius(s1, s2, e1, e2, r if ang <= 180 else -r, cw, inch)
+            elif radius is not None:
+                r = self._value(radius, "arc radius")
+                if r is None:
+                    raise arcs.ArcError("arc radius is vacant")
+                c1, c2 = arcs.center_from_radius(s1, s2, e1, e2, r * st.scale, cw, inch)
+            else:
+                cvals = self._eval_words(center)
+                if not cvals:
+                    raise arcs.ArcError("arc without centre or radius")
+                c1, c2 = s1, s2
+                cd = {a: v for a, v, _ in cvals}
+                absolute = {a: (m == "abs") if m else st.arc_absolute for a, _, m in cvals}
+                ci = {"X": "X", "Y": "Y", "Z": "Z", "I": "X", "J": "Y", "K": "Z"}
+                for a, v in cd.items():
+                    ax = ci.get(a, a)
+                    if ax == a1:
+                        c1 = v if absolute[a] else s1 + v
+                    elif ax == a2:
+                        c2 = v if absolute[a] else s2 + v
+                err = arcs.check_center(s1, s2, e1, e2, c1, c2, inch)
+                if err:
+                    raise arcs.ArcError(err)
+        except arcs.ArcError as ex:
+            self.diag("NC203", "error", str(ex))    # the controller alarms: no motion
+            if st.diameter:
+                self._radius_x_check(vals, center, radius, cw)
+            return
+        self._move("arc", end, (c1, c2), cw, nturns)
+
+    def _h_home(self, s: n.HomeReturn):
+        """G28/G30: rapid to the intermediate point, then to the reference point (machine 0 for
+        every reference point, as LinuxCNC's default #5161.. / #5181..) on the named axes;
+        with no axis words every axis goes home directly."""
+        vals = self._eval_words(self._words(s.via))
+        if vals:
+            self._move("rapid", self._target(vals))
+            axes = [a for a, _, _ in vals]
+        else:
+            axes = list(self.mpos)
+        tot = self.off.total
+        mend = dict(self.mpos)
+        for a in axes:
+            mend[a] = 0.0
+        self._move("rapid", self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in mend.items()}))

@@ -1,0 +1,252 @@
+"""Frames and offsets: the statements that move the coordinate system rather than the tool.
+Work offsets (G54.., via ModeChange in statements.py), G92 / G92.1 set positions, tool length and
+radius offset selection (H/D), G10 data setting, programmable frames (ISO G52/G68/G51/G51.1,
+Sinumerik TRANS/ROT/SCALE/MIRROR and their additive forms, $P_PFRAME).
+
+Coordinates (all mm): program point -> programmable frame (frames.py) -> work point -> + G92 +
+work offset + tool length -> machine point. After any change here the program point is re-derived
+from the machine point (_resync): nothing moves. A mixin of Interpreter.
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
+from nctrans.interp.frames import PLANE_AXES, ProgrammableFrame
+from nctrans.interp.state import LINEAR_AXES
+from nctrans.ir import nodes as n
+
+NORMAL = {"XY": "Z", "ZX": "Y", "YZ": "X"}
+ROT_AXIS = NORMAL
+
+
+def copy_frame(src: ProgrammableFrame, dst: Optional[ProgrammableFrame] = None) -> ProgrammableFrame:
+    """A copy of a programmable frame (dicts copied, tuples shared), or `src` copied into `dst`."""
+    if dst is None:
+        dst = ProgrammableFrame.__new__(ProgrammableFrame)
+    for slot in ProgrammableFrame.__slots__:
+        v = getattr(src, slot)
+        setattr(dst, slot, dict(v) if type(v) is dict else v)
+    return dst
+
+
+class OffsetsMixin:
+    """Coordinate-system statements and the program <-> machine point mapping."""
+
+    def _offsets_table(self) -> dict:
+        """Compilers of offset selection, set position, frame and data-setting statements."""
+        return {
+            n.OffsetSelect: self._c_offset, n.SetPosition: lambda s: (self._h_setpos, s),
+            n.ResetSetPosition: lambda s: (self._h_resetpos, s),
+            n.FrameOp: lambda s: (self._h_frame, s), n.DataSetting: lambda s: (self._h_data, s),
+        }
+
+    def _resync(self) -> None:
+        """Program point from the machine point (after an offset or frame change)."""
+        tot = self.off.total
+        work = {a: v - tot.get(a, 0.0) for a, v in self.mpos.items()}
+        self.pos = self.frame.to_program(work)
+
+    def _to_machine(self, p: dict[str, float]) -> dict[str, float]:
+        w = p if self.frame.identity else self.frame.to_work(p)
+        tot = self.off.total
+        if not tot:
+            return dict(w)
+        return {a: v + tot.get(a, 0.0) for a, v in w.items()}
+
+    def _work_offset(self, name: str) -> dict[str, float]:
+        if name.upper() == "G53":
+            return {}
+        return self.machine.work_offset(name)
+
+    def _apply_length(self) -> None:
+        st = self.st
+        if st.length_mode == "off":
+            z = 0.0
+        else:
+            idx = st.length_index if st.length_index is not None else st.tool
+            z = self.machine.length_offset(int(idx)) if idx else 0.0
+            if st.length_mode == "minus":
+                z = -z
+        self.off.set_tool(z)
+        self._resync()
+        if self.travel_limits is not None:      # limits on the tool tip follow its length
+            self._send_limits()
+
+    def _c_offset(self, s: n.OffsetSelect):
+        return (self._h_offset, (s.kind, self.ev.compile(s.index)))
+
+    def _h_offset(self, d):
+        kind, f = d
+        v = self._value(f, "offset number")
+        if v is None:
+            return
+        i = int(round(v))
+        if kind == "length":
+            self.st.length_index = i
+            if self.st.length_mode != "off":
+                self._apply_length()
+        else:
+            self.st.radius_index = i
+            self.comp_radius = self.machine.radius_offset(i) if i else 0.0
+
+    def _h_data(self, s):
+        """G10 data setting: write work offsets or tool-offset registers into the machine copy."""
+        vals = {}
+        for k, e in s.values.items():
+            v = self._value(self.ev.compile(e), f"{k} value")
+            if v is not None:
+                vals[k.upper()] = v
+        idx = self._value(self.ev.compile(s.index), "offset number")
+        if idx is None:
+            return
+        idx = int(round(idx))
+        inc = self.st.incremental
+        if self.machine is not None and not getattr(self, "_machine_copied", False):
+            self.machine = self.machine.copy()
+            self._machine_copied = True
+        m = self.machine
+        if s.kind == "work_offset":
+            if s.extended:
+                name = f"G54.1P{idx}"
+            elif idx == 0:
+                name = "EXT"
+            elif 1 <= idx <= 6:
+                name = f"G{53 + idx}"
+            else:
+                self.diag("NC105", "error", f"work offset number {idx} out of range")
+                return
+            cur = dict(m.offsets.get(name, {}))
+            for a, v in vals.items():
+                v *= self.st.scale if a in LINEAR_AXES else 1.0
+                cur[a] = cur.get(a, 0.0) + v if inc else v
+            m.offsets[name] = cur
+            if self.st.work_offset and self.st.work_offset.upper() == name:
+                self.off.set_work(self._work_offset(name))
+                self._resync()
+        elif s.kind.startswith("tool_"):
+            v = vals.get("VALUE", 0.0) * self.st.scale
+            store = m.length_offsets if "length" in s.kind else m.radius_offsets
+            old = store.get(idx, m.length_offset(idx) if "length" in s.kind else m.radius_offset(idx))
+            store[idx] = old + v if inc else v
+
+    def _h_setpos(self, s: n.SetPosition):
+        vals = self._eval_words(self._words(s.target))
+        if not vals:
+            return
+        target = self._target(vals)
+        work = self.frame.to_work(target)
+        g92 = dict(self.off.g92)
+        wo = self.off.work
+        for a, _, _ in vals:
+            tl = self.off.tool_z if a == "Z" else 0.0
+            g92[a] = self.mpos.get(a, 0.0) - wo.get(a, 0.0) - tl - work[a]
+        self.off.set_g92(g92)
+        self.pos = target
+
+    def _h_resetpos(self, s):
+        self.off.set_g92({})
+        self._resync()
+
+    def _h_frame(self, s: n.FrameOp):
+        st = self.st
+        scale = st.scale
+        fr = self.frame
+        op = s.op
+
+        def num(e, what, lin=True):
+            v = self._value(self.ev.compile(e), what)
+            return None if v is None else v * (scale if lin else 1.0)
+
+        def center():
+            out = {}
+            for a, av in (s.center or {}).items():
+                e = av.value if isinstance(av, n.AxisValue) else av
+                v = num(e, f"{a} centre", a.upper() in LINEAR_AXES)
+                if v is not None:
+                    out[a.upper()] = v
+            return out
+
+        # A programmable op that is neither additive, local (ISO G52) nor pivoted (ISO G68/G51/
+        # G51.1 give a centre) replaces the whole programmable frame (Sinumerik TRANS/ROT/SCALE/
+        # MIRROR); the others replace only their own component.
+        replace_all = (not s.additive and not s.local and s.center is None and not s.clear
+                       and op in ("trans", "rot", "scale", "mirror"))
+        if replace_all:
+            fr.clear()
+        if op == "all":
+            if s.clear:
+                fr.clear()
+        elif op == "trans":
+            if s.clear:
+                fr.set_local({})
+            else:
+                vals = {}
+                for a, e in s.values.items():
+                    v = num(e, f"{a} shift", a.upper() in LINEAR_AXES)
+                    if v is not None:
+                        vals[a.upper()] = v
+                fr.set_local(vals, additive=s.additive)
+        elif op == "rot":
+            if s.clear:
+                fr.set_rotation(None, 0.0, {})
+            else:
+                plane = st.plane
+                if s.angle is not None:
+                    ang = num(s.angle, "rotation angle", False) or 0.0
+                    axis = ROT_AXIS[plane]
+                    piv = center()
+                    a1, a2, _ = PLANE_AXES[plane]
+                    if s.center is not None and not s.additive:
+                        # ISO G68: a missing centre coordinate is the current point
+                        for a in (a1, a2):
+                            piv.setdefault(a, self.pos.get(a, 0.0))
+                    fr.set_rotation(axis, ang, piv, additive=s.additive)
+                else:
+                    first = True
+                    for a, e in s.values.items():
+                        ang = num(e, f"{a} rotation", False)
+                        if ang is not None:
+                            fr.set_rotation(a.upper(), ang, center(),
+                                            additive=s.additive or not first)
+                            first = False
+        elif op == "scale":
+            if s.clear:
+                fr.set_scale({}, {})
+            else:
+                f = {a.upper(): num(e, f"{a} scale", False) for a, e in s.values.items()}
+                fr.set_scale({a: v for a, v in f.items() if v is not None}, center())
+        elif op == "mirror":
+            if s.clear:
+                keep = {a: v for a, v in fr.mirror_axes.items()
+                        if s.values and a not in {k.upper() for k in s.values}}
+                fr.set_mirror(keep)
+            else:
+                piv = center()
+                axes = {a.upper(): piv.get(a.upper(), 0.0) for a in s.values}
+                for a, v in piv.items():
+                    axes.setdefault(a, v)
+                fr.set_mirror(axes)
+        self._resync()
+
+    def _set_pframe(self, value: Any) -> None:
+        """$P_PFRAME = frame: the programmable frame becomes `value`, each step acting as the
+        frame instruction it stands for: the first replaces (TRANS/ROT/SCALE/MIRROR), the
+        following ones add in the system it produced (ATRANS/AROT/ASCALE/AMIRROR)."""
+        if value is UNKNOWN:
+            self.diag("NC107", "info", "the programmable frame variable is assigned a value unknown at "
+                      "analysis time; the programmable frame is kept")
+            return
+        if not isinstance(value, FrameValue):
+            raise EvalError("NC104", "the programmable frame needs a frame value (a frame expression or "
+                            "variable)")
+        self.frame.clear()
+        first = True
+        for step in value.steps:
+            op, vals = step
+            if op == "state":
+                copy_frame(vals, self.frame)
+            else:
+                self._h_frame(n.FrameOp(op, {a: n.Num(v) for a, v in vals}, additive=not first))
+            first = False
+        self._resync()

@@ -1,0 +1,159 @@
+"""From a move in program coordinates to toolpath records: the machine point (programmable frame,
+work offset, G92, tool length: offsets.py), cutter compensation (cutter_comp.py buffers moves and
+hands them back shifted), and the flatten hook's work-coordinate points.
+
+Records are in machine coordinates. The start of a record is the end dict of the previous motion
+record (shared, never mutated). Each record is appended to `out`; flow.py numbers and yields them.
+A mixin of Interpreter.
+"""
+from __future__ import annotations
+
+from nctrans.interp.cutter_comp import PlannedMove
+from nctrans.interp.frames import PLANE_AXES
+from nctrans.toolpath import ToolpathRecord
+
+class RecordsMixin:
+    """Moves and other records into `out`; cutter compensation glue."""
+
+    def _record(self, kind: str, **kw) -> None:
+        rec = ToolpathRecord(0, self.span.file if self.span else self.program.file,
+                             self.span.line if self.span else 1, kind, **kw)
+        if self.comp is not None:
+            self._comp_out(self.comp.push(rec))
+        else:
+            self.out.append(rec)
+            if self.hook is not None:
+                self._hookq.append(None)
+
+    def _move(self, kind: str, end: dict[str, float], center=None, cw=None, turns=None) -> None:
+        """Emit a move from the current program point to `end` (program coords); update position."""
+        if self.watch and self.capture is None:
+            self._rc_move(kind, end)
+        start = self.pos
+        self.pos = end
+        if self.capture is not None:            # reading a turning contour: no motion
+            self.capture.append((kind, start, end, center, cw, self.span))
+            return
+        if self.css_surface is not None:
+            self._css_move(end)
+        self.last_from = start
+        self.last_arc = (center, cw) if kind == "arc" else None
+        if self.comp_exit or self.comp is not None or (
+                self.st.comp_side != "off" and self.comp_radius):
+            if self._comp_move(kind, start, end, center, cw, turns):
+                return
+        elif self.st.comp_side != "off" and not self.st.radius_index:
+            self._comp_without_offset(kind, start, end, center, cw, turns)
+            return
+        self._finish_move(kind, start, end, center, cw, turns, self._payload())
+
+    def _comp_without_offset(self, kind, start, end, center, cw, turns) -> None:
+        """G41/G42 on with no D word. Where the dialect's table names the cutting edge a tool
+        brings by default (options.default_cutting_edge, Sinumerik D1), compensate with it as if
+        written; else the controller compensates by zero: NC208, and the move runs as programmed."""
+        edge = self.default_edge
+        if edge:
+            self.st.radius_index = edge
+            self.comp_radius = self.machine.radius_offset(edge)
+            if self.comp_radius and self._comp_move(
+                    kind, start, end, center, cw, turns):
+                return
+        elif not self.comp_d_reported:
+            self.comp_d_reported = True
+            self.diag("NC208", "error", f"cutter compensation ({self.st.comp_side}) is on but no D word "
+                      "selects a radius offset: the tool runs on the programmed contour uncompensated")
+        self._finish_move(kind, start, end, center, cw, turns, self._payload())
+
+    def _payload(self) -> tuple:
+        sp = self.span
+        st = self.st
+        return (sp.file if sp else self.program.file, sp.line if sp else 1, st.feed, st.feed_mode,
+                st.spindle_speed, st.tool, st.plane)
+
+    def _finish_move(self, kind, start, end, center, cw, turns, payload, start_given=False) -> None:
+        file, line, feed, feed_mode, speed, tool, plane = payload
+        mend = self._to_machine(end)
+        mstart = self._to_machine(start) if start_given else self.mpos
+        if len(mstart) != len(mend):
+            mstart = {**{a: mend[a] for a in mend if a not in mstart}, **mstart}
+        if kind == "rapid":
+            rec = ToolpathRecord(0, file, line, "rapid", mstart, mend, spindle=speed, tool=tool)
+        else:
+            rec = ToolpathRecord(0, file, line, "linear" if kind == "linear" else "arc", mstart,
+                                 mend, feed=feed, feed_mode=feed_mode, spindle=speed, tool=tool)
+        if self.css_surface is not None:    # constant surface speed, for `check` to judge
+            rec.css, rec.spindle_limit = self.css_surface, self.css_limit
+            rec.css_axis = mend.get("X", 0.0) - end.get("X", 0.0)
+        mc = None
+        if kind == "arc":
+            a1, a2, an = PLANE_AXES[plane]
+            cprog = {a1: center[0], a2: center[1], an: end.get(an, 0.0)}
+            full = dict(end)
+            full.update(cprog)
+            mfull = self._to_machine(full)
+            mc = {a1: mfull[a1], a2: mfull[a2], an: mfull[an]}
+            rec.center = mc
+            rec.plane = plane
+            rec.direction = ("cw" if cw else "ccw") if not self.frame.mirror_swap else (
+                "ccw" if cw else "cw")
+            rec.turns = turns
+        self.mpos = mend
+        self.out.append(rec)
+        if self.hook is not None:
+            tot = self.off.total
+            work = {a: v - tot.get(a, 0.0) for a, v in mend.items()}
+            wc = None if mc is None else {a: v - tot.get(a, 0.0) for a, v in mc.items()}
+            self._hookq.append((work, wc))
+
+    def _comp_move(self, kind, start, end, center, cw, turns) -> bool:
+        pm = PlannedMove(kind=kind, start=start, end=end,
+                         center=None if center is None else self._center_dict(center, end),
+                         direction=None if cw is None else ("cw" if cw else "ccw"),
+                         turns=turns, payload=self._payload())
+        if self.comp_exit:
+            comp, self.comp, self.comp_exit = self.comp, None, False
+            if comp is not None:
+                self._comp_out(comp.finish(pm), comp)
+                return True
+            return False
+        if self.comp is None:
+            side = self.st.comp_side
+            r = self.comp_radius
+            if r < 0:           # a negative stored radius swaps the side
+                side, r = ("right" if side == "left" else "left"), -r
+            self.comp = self._compensator(side, r)     # lathe.py: the tool-nose tip
+        self._comp_out(self.comp.push(pm))
+        return True
+
+    def _center_dict(self, center, end) -> dict[str, float]:
+        a1, a2, an = PLANE_AXES[self.st.plane]
+        return {a1: center[0], a2: center[1], an: end.get(an, 0.0)}
+
+    def _comp_out(self, items, comp=None) -> None:
+        comp = comp or self.comp
+        probs = getattr(comp, "problems", None)
+        if probs:
+            from nctrans.diagnostics import Diagnostic
+            for payload, msg in probs:
+                file, line = (payload[0], payload[1]) if isinstance(payload, tuple) else (
+                    self.program.file, 1)
+                self.diags.append(Diagnostic("NC204", "error", msg, file, line))
+            probs.clear()
+        for it in items:
+            if isinstance(it, PlannedMove):
+                c = it.center
+                plane = it.payload[6]
+                a1, a2, _ = PLANE_AXES[plane]
+                cc = None if c is None else (c[a1], c[a2])
+                cw = None if it.direction is None else it.direction == "cw"
+                self._finish_move(it.kind, it.start, it.end, cc, cw, it.turns, it.payload,
+                                  start_given=True)
+            else:
+                self.out.append(it)
+                if self.hook is not None:
+                    self._hookq.append(None)
+
+    def _comp_flush(self) -> None:
+        if self.comp is not None:
+            comp, self.comp = self.comp, None
+            self._comp_out(comp.finish(None), comp)
