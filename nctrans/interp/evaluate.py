@@ -333,6 +333,9 @@ class Evaluator:
         # writer; the interpreter registers them
         self.meanings: dict[str, Callable[[], Any]] = {}
         self.meaning_setters: dict[str, Callable[[Any], None]] = {}
+        # numbered system variables whose write changes machine data (ISO #2001 tool offsets,
+        # #5221 work offsets): number -> writer (nctrans.interp.sysvars registers them)
+        self.system_setters: dict[int, Callable[[Any], None]] = {}
         self.unknown_used = False     # set when UNKNOWN was read; the interpreter reports it
 
     # ---------------------------------------------------------------- compiler
@@ -681,6 +684,8 @@ class Evaluator:
             raise EvalError("NC105", f"variable #{k} does not exist")
         if k <= LOCAL_NUM_MAX:
             self.scope.num[k] = value
+        elif k in self.system_setters:
+            self.system_setters[k](value)       # the machine data itself: later moves use it
         else:
             self.num_globals[k] = value
 

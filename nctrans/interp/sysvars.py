@@ -5,6 +5,12 @@ of rules/<dialect>.toml; sources documented there).
 A number the table marks "unknown", or does not list, reads as UNKNOWN: the interpreter then says
 NC107 where the value drives motion or a condition. Reads are evaluated when they happen, so a G10
 write or a modal change before them is seen.
+
+Writes to offset numbers (sources "work_offset", "tool_length", "tool_radius" and the wear ranges,
+"zero" with `wear_of`) change the machine data as G10 does, so the moves after them use the new
+offset: `#2001=.004` then `G41 D1` compensates by .004. (Before, such a write was kept as a plain
+variable and the moves silently ran with the old offset.) The wear of an offset adds to its
+geometry, as on the control: the register the interpreter applies holds geometry + wear.
 """
 from __future__ import annotations
 
@@ -27,6 +33,8 @@ def entries(dialect: str) -> list[dict]:
 def register(interp, dialect: str) -> None:
     """Publish every mapped number in `interp.ev.system` (callables read at evaluation time)."""
     system = interp.ev.system
+    setters = interp.ev.system_setters
+    wear: dict[tuple[str, int], float] = {}          # (kind, offset number) -> wear written
     for e in entries(dialect):
         if not isinstance(e, dict) or "first" not in e:
             continue
@@ -35,12 +43,72 @@ def register(interp, dialect: str) -> None:
         for k in range(first, last + 1):
             if k in system:
                 continue                 # the interpreter's own (positions) win
-            f = _reader(interp, e, k - first)
+            f = _reader(interp, e, k - first, wear)
             if f is not None:
                 system[k] = f
+            w = _writer(interp, e, k - first, wear)
+            if w is not None:
+                setters.setdefault(k, w)
 
 
-def _reader(interp, e: dict, offset: int) -> Callable[[], Any] | None:
+def _machine(interp):
+    """The interpreter's own copy of the machine, made before its first write (as G10 does)."""
+    if not getattr(interp, "_machine_copied", False):
+        interp.machine = interp.machine.copy()
+        interp._machine_copied = True
+    return interp.machine
+
+
+def _value(k: str, v: Any) -> float:
+    from nctrans.interp.evaluate import EvalError
+    if v is UNKNOWN:
+        raise EvalError("NC107", f"{k} is written with a value the analysis cannot know: the "
+                        "offset keeps its old value in the analysed toolpath", "warning")
+    return 0.0 if v is None else float(v)
+
+
+def _writer(interp, e: dict, offset: int, wear: dict) -> Callable[[Any], None] | None:
+    """How writing the number changes the machine data; None for a number without machine data."""
+    src = e["source"]
+    st = interp.st
+    name = f"#{int(e['first']) + offset}"
+    if src == "work_offset":
+        step = int(e.get("step", 20))
+        index, axis = divmod(offset, step)
+        offsets = e["offsets"]
+        if index >= len(offsets) or axis >= len(AXES):
+            return None
+        which, a = offsets[index], AXES[axis]
+
+        def work_offset(v):
+            value = _value(name, v) * (st.scale if a in "XYZ" else 1.0)
+            m = _machine(interp)
+            m.offsets[which] = {**m.offsets.get(which, {}), a: value}
+            if st.work_offset and st.work_offset.upper() == which:
+                interp.off.set_work(interp._work_offset(which))
+                interp._resync()
+        return work_offset
+    kind = {"tool_length": "length", "tool_radius": "radius"}.get(src) or e.get("wear_of")
+    if kind not in ("length", "radius"):
+        return None
+    number = offset + 1
+    is_wear = src == "zero"
+
+    def tool_offset(v):
+        value = _value(name, v) * st.scale
+        m = _machine(interp)
+        store = m.length_offsets if kind == "length" else m.radius_offsets
+        read = m.length_offset if kind == "length" else m.radius_offset
+        old_wear = wear.get((kind, number), 0.0)
+        if is_wear:
+            store[number] = read(number) - old_wear + value
+            wear[(kind, number)] = value
+        else:
+            store[number] = value + old_wear
+    return tool_offset
+
+
+def _reader(interp, e: dict, offset: int, wear: dict) -> Callable[[], Any] | None:
     src = e["source"]
     st = interp.st
     if src == "modal":
@@ -79,11 +147,16 @@ def _reader(interp, e: dict, offset: int) -> Callable[[], Any] | None:
         return work_offset
     if src in ("tool_length", "tool_radius"):
         number = offset + 1
-        read = interp.machine.length_offset if src == "tool_length" else interp.machine.radius_offset
+        kind = "length" if src == "tool_length" else "radius"
 
-        def tool_offset():
-            return read(number) / st.scale
+        def tool_offset():              # the machine copy of the moment (a G10 may have made one)
+            m = interp.machine
+            read = m.length_offset if kind == "length" else m.radius_offset
+            return (read(number) - wear.get((kind, number), 0.0)) / st.scale
         return tool_offset
     if src == "zero":
+        if e.get("wear_of") in ("length", "radius"):
+            key = (e["wear_of"], offset + 1)
+            return lambda: wear.get(key, 0.0) / st.scale
         return lambda: 0.0
     return None                          # "unknown": UNKNOWN by default
