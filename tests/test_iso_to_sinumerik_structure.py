@@ -97,3 +97,44 @@ def test_any_g65_arguments_move_the_same_as_proc_parameters(tmp_path_factory, ca
     conv = _converted(src)
     assert "PROC L7000(" in conv.text
     _equiv(tmp_path_factory.mktemp("g65"), src, conv.text)
+
+
+# ---------------------------------------------------------------- modal-state numbers
+
+def test_modal_state_numbers_read_the_g_group_index(tmp_path):
+    src = ("G90 G17 G21 G54\n#100=#4007\nG1 G41 D1 X1 F100\n#101=#4007\nG55 G18\n"
+           "IF[#4014 EQ 55] GOTO 10\nG1 X99\nN10 G0 X[#100+#101+#4002+#4003]\nG40 G17 X0\nM30\n")
+    conv = _converted(src)
+    # hand-derived: G40/G41/G42 are indexes 1-3 of group 7, G500/G54..G57 1-5 of group 8,
+    # G17/G18/G19 1-3 of group 6, G90/G91 1-2 of group 14
+    assert "R100=($P_GG[7]+39)" in conv.text
+    assert "IF ($P_GG[8]+52)==55 GOTO N10" in conv.text
+    assert "($P_GG[6]+16)+($P_GG[14]+89)" in conv.text
+    _equiv(tmp_path, src, conv.text)
+    end = [r for r in nctrans.toolpath(conv.text, dialect="sinumerik") if r.kind == "rapid"][0]
+    assert end.end["X"] == 40 + 41 + 18 + 90
+
+
+def test_modal_number_off_the_index_line_is_refused_at_its_line():
+    # G54.1 P1 reads 54.1 in ISO; its Sinumerik code G505 is index 6 of group 8 (6 + 52 = 58)
+    conv = nctrans.transpile("G90 G21 G54\nG54.1 P1\n#100=#4014\nG0 X#100\nM30\n",
+                             read="iso-m", write="sinumerik")
+    assert any("#4014 has no Sinumerik equivalent" in d.message and d.line == 3
+               for d in conv.diagnostics)
+    assert "$P_GG" not in (conv.text or "")
+
+
+_MODES = {"plane": ["G17", "G18", "G19"], "distance": ["G90", "G91"], "comp": ["G40", "G41 D1"],
+          "offset": ["G54", "G55", "G56", "G57"]}
+
+
+@settings(max_examples=25, deadline=None)
+@given(picks=st.lists(st.tuples(*(st.sampled_from(v) for v in _MODES.values())), min_size=1,
+                      max_size=3),
+       number=st.sampled_from([4002, 4003, 4007, 4014]))
+def test_any_modal_state_reads_the_same_number_converted(tmp_path_factory, picks, number):
+    body = "".join(f"{' '.join(p)}\n#100=#100*2+#{number}\nG1 X0.5 F100\nG40 G90\n" for p in picks)
+    src = f"G90 G17 G21 G54\n#100=0\n{body}G0 X[#100/1000]\nM30\n"
+    conv = _converted(src)
+    assert "$P_GG[" in conv.text
+    _equiv(tmp_path_factory.mktemp("modal"), src, conv.text)

@@ -38,7 +38,7 @@ from nctrans.dialects.sinumerik.lexer import number_value
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
-from nctrans.lower import macro_procs
+from nctrans.lower import macro_procs, modal_numbers
 from nctrans.rules import load_table, system_meaning, system_spelling
 
 DIALECT = "sinumerik"
@@ -237,6 +237,10 @@ class Emitter:
         """An ISO system variable (#1000 and up) as the Sinumerik variable of the same neutral
         meaning (rules/<dialect>.toml [system_variables]: #5021 -> $AA_IM[X])."""
         found = system_spelling(DIALECT, v.key)
+        if found is None and not target:
+            modal = self.modal_number(v.key)
+            if modal is not None:
+                return modal
         if found is None:
             meaning = system_meaning(v.key)
             self.refuse(f"system variable #{v.key}" + (f" ({meaning.replace('_', ' ')})" if meaning else "")
@@ -247,6 +251,25 @@ class Emitter:
         name, axis = found
         self.info("sysvar", "ISO system variables written as the Sinumerik variables of the same meaning")
         return f"{name}[{axis}]" if axis else name
+
+    def modal_number(self, number: int) -> Optional[str]:
+        """A source modal-state number (ISO #4007) as the G-group index expression reading the
+        same number here (`($P_GG[7]+39)`, nctrans.lower.modal_numbers), or None."""
+        entries = ((self.p.meta or {}).get("options") or {}).get("numbered_variables") or ()
+        entry = next((e for e in entries if isinstance(e, dict) and e.get("source") == "modal"
+                      and int(e.get("first", -1)) == number), None)
+        if entry is None:
+            return None
+        if not hasattr(self, "_selected"):
+            self._selected = modal_numbers.selected_values(self.p)
+        values = (self._selected or {}).get(entry["group"])
+        found = modal_numbers.as_group_index(entry, values or set(), self.t) if values else None
+        if found is None:
+            return None
+        variable, group, constant = found
+        self.info("sysvar-modal", "ISO modal-state numbers (#4001..) written as the G-group index "
+                                  f"{variable}[n] plus the constant that gives the same number")
+        return f"({variable}[{group}]{constant:+d})" if constant else f"{variable}[{group}]"
 
     # ---------------------------------------------------------------- words
     def word(self, addr: str, e: ir.Expr) -> str:
