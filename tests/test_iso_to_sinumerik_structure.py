@@ -68,9 +68,28 @@ def test_nested_macro_keeps_its_callers_arguments(tmp_path):
     assert [(r.end["X"], r.end["Y"]) for r in moves] == [(0.0, 9.0), (4.0, 9.0)]
 
 
-def test_macro_called_without_an_argument_it_reads_keeps_r_parameters(tmp_path):
-    # B left out is vacant in ISO (#2 EQ 0 is false) but a PROC parameter left out is 0: no PROC
-    src = "O0001\nG90 G17 G21\nG65 P1000 A5. B2. Z1.\nG65 P1000 A7. Z3.\nM30\n" + MACRO
+def test_vacant_arguments_are_asked_with_p_subpar(tmp_path):
+    # B left out is vacant in ISO: `#2 EQ 0` is false and `#2 NE 2` true, though a PROC
+    # parameter left out reads 0; A left out takes the #0 branch
+    src = ("O0001\nG90 G17 G21\nG65 P1000 A5. B2. Z1.\nG65 P1000 A7. Z3.\nG65 P1000 Z4. B0\nM30\n"
+           "O1000\nIF[#1 EQ #0] GOTO 20\n#10=#1+#2\nIF[#2 EQ 0] GOTO 10\nIF[#2 NE 2] GOTO 10\n"
+           "G1 X#10 Z-#26 F100\nN10 M99\nN20 G1 X-1 Y-1 Z-#26\nM99\n")
+    conv = _converted(src)
+    lines = conv.text.splitlines()
+    assert "L1000(7., , 3.)" in lines and "L1000(, 0, 4.)" in lines
+    assert "IF NOT $P_SUBPAR[1] GOTO N20" in lines
+    assert "IF $P_SUBPAR[2] AND (ARG_B==0) GOTO N10" in lines
+    assert "IF NOT $P_SUBPAR[2] OR (ARG_B<>2) GOTO N10" in lines
+    _equiv(tmp_path, src, conv.text)
+    # the first call moves (X7), the second jumps to N10 (B vacant), the third takes N20
+    moves = [r for r in nctrans.toolpath(conv.text, dialect="sinumerik") if r.kind == "linear"]
+    assert [(r.end["X"], r.end["Z"]) for r in moves] == [(7.0, -1.0), (-1.0, -4.0)]
+
+
+def test_macro_called_without_an_argument_it_uses_bare_keeps_r_parameters():
+    # `Y#2` drops the word when B is vacant; a PROC parameter left out would move to Y0: no PROC
+    src = ("O0001\nG90 G17 G21\nG65 P1000 A5. B2.\nG65 P1000 A7.\nM30\n"
+           "O1000\nG1 X#1 Y#2 F100\nM99\n")
     conv = _converted(src)
     assert "PROC L1000\n" in conv.text and "PROC L1000(" not in conv.text
 
@@ -86,14 +105,14 @@ _LETTERS = {"A": 1, "B": 2, "C": 3, "X": 24, "Y": 25, "Z": 26, "R": 18}
 
 
 @settings(max_examples=25, deadline=None)
-@given(calls=st.lists(st.fixed_dictionaries({k: st.integers(-50, 50) for k in _LETTERS},
-                                            optional={"I": st.integers(-9, 9)}),
+@given(calls=st.lists(st.fixed_dictionaries({}, optional={k: st.integers(-50, 50) for k in _LETTERS}),
                       min_size=1, max_size=3))
 def test_any_g65_arguments_move_the_same_as_proc_parameters(tmp_path_factory, calls):
     body = "".join("G65 P7000 " + " ".join(f"{k}{v}." for k, v in sorted(c.items())) + "\n"
                    for c in calls)
     src = ("G90 G17 G21 G0 X0 Y0 Z0\n" + body + "M30\nO7000\n"
-           "G1 X[#24+#1] Y[#25-#2] Z[#26*#3+#18] F200\nM99\n")
+           "IF[#18 EQ #0] GOTO 5\nIF[#1 NE 3] GOTO 5\nG0 Z[#18+1]\nN5 G1 X[#24+#1] Y[#25-#2] Z[#26*#3+#18] F200\n"
+           "M99\n")
     conv = _converted(src)
     assert "PROC L7000(" in conv.text
     _equiv(tmp_path_factory.mktemp("g65"), src, conv.text)

@@ -147,6 +147,9 @@ class CallsMixin:
                 sc.names, sc.args = caller.names, caller.args
             for p, v in zip(unit.params, pos):
                 sc.names[p.name.upper()] = v
+            if unit.params:                        # which parameters the call wrote ($P_SUBPAR)
+                sc.programmed = {i + 1 for i, e in enumerate(s.args[:len(unit.params)])
+                                 if not (type(e) is n.Num and e.text == "")}
             for p in unit.params[len(pos):]:       # not programmed in the call: preset to zero (seed
                 if not p.by_ref and not p.dims:    # "Incomplete parameter transfer")
                     sc.names.setdefault(p.name.upper(), "" if p.type.upper().startswith("STRING") else 0)

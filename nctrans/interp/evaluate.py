@@ -124,14 +124,17 @@ _TYPE_DEFAULTS = {"INT": 0, "REAL": 0.0, "BOOL": False, "CHAR": "", "STRING": ""
 
 
 class Scope:
-    """One call level: ISO locals #1..#33, declared names, call arguments by letter."""
-    __slots__ = ("num", "names", "args", "lengths")
+    """One call level: ISO locals #1..#33, declared names, call arguments by letter; programmed:
+    the 1-based positions of the PROC parameters the call wrote (Sinumerik $P_SUBPAR), None at a
+    level no parameter call opened."""
+    __slots__ = ("num", "names", "args", "lengths", "programmed")
 
     def __init__(self, num: Optional[dict] = None, args: Optional[dict] = None):
         self.num: dict[int, Any] = {} if num is None else num
         self.names: dict[str, Any] = {}
         self.args: dict[str, Any] = args or {}
         self.lengths: dict[str, int] = {}     # declared STRING[n] lengths of `names`
+        self.programmed: Optional[set[int]] = None
 
 
 class Array:

@@ -33,6 +33,7 @@ def entries(dialect: str) -> list[dict]:
 def register(interp, dialect: str) -> None:
     """Publish every mapped number in `interp.ev.system` (callables read at evaluation time)."""
     system = interp.ev.system
+    _register_indexed(interp, dialect)
     setters = interp.ev.system_setters
     wear: dict[tuple[str, int], float] = {}          # (kind, offset number) -> wear written
     for e in entries(dialect):
@@ -49,6 +50,24 @@ def register(interp, dialect: str) -> None:
             w = _writer(interp, e, k - first, wear)
             if w is not None:
                 setters.setdefault(k, w)
+
+
+def _register_indexed(interp, dialect: str) -> None:
+    """Indexed system variables read by neutral meaning: "argument_programmed" (Sinumerik
+    $P_SUBPAR[i]) from the running call level's programmed parameter positions."""
+    try:
+        from nctrans.rules import load_table
+        spellings = load_table(dialect).system_variables
+    except Exception:            # no table for this dialect
+        return
+    for spelling, meaning in spellings.items():
+        if meaning == "argument_programmed":
+            def programmed(idx, ev=interp.ev):
+                done = ev.scope.programmed
+                if done is None or not idx or len(idx) != 1:
+                    return UNKNOWN
+                return 1.0 if int(idx[0]) in done else 0.0
+            interp.ev.indexed_system[spelling.upper()] = programmed
 
 
 def _machine(interp):

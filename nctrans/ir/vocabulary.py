@@ -63,6 +63,8 @@ SYSTEM_VARIABLES = (
     "probe_position_machine",    # in work / machine coordinates: not modelled (reads are unknown)
     "parts_machined",            # workpiece counters of the control: machine state the analysis
     "parts_required",            # cannot know (reads are unknown)
+    "argument_programmed",       # indexed by parameter position: whether the call of the running
+                                 # procedure wrote that parameter (TRUE) or left it out (FALSE)
 )
 AXIS_MEANINGS = ("axis_position_work", "axis_position_machine", "probe_position_work",
                  "probe_position_machine")

@@ -4,11 +4,15 @@ ISO G65 macros get their arguments as the locals #1-#33 of their own call level;
 procedures (Sinumerik PROC) can pass the same values as named parameters instead of global
 registers. A subprogram qualifies when every call of it in the program is a plain G65 macro call
 (its own level of locals), its body reaches its locals only by number (no `#[expr]` that could land
-on one), calls nothing that shares its locals (M98), and every call passes every argument the body
-reads and never sets. That last condition is the vacant value: an argument left out is vacant in
-ISO (`#2 EQ 0` is false, `X#24` drops the word) but a PROC parameter left out is 0, so only calls
-that pass all arguments mean the same in both (a call from another file is the target's concern:
-the emitter's note says so). The letters come from the source dialect's
+on one) and calls nothing that shares its locals (M98).
+
+The vacant value decides the rest: an argument left out is vacant in ISO (`#2 EQ 0` is false,
+`X#24` drops the word, `#3=#2` copies the vacancy) but a PROC parameter left out is 0, and the
+PROC can only ask whether it was programmed ($P_SUBPAR[i]). So an argument the body reads and never
+sets (`vacancy_tested`: the emitter writes `#k EQ #0` as NOT $P_SUBPAR[i] and `#k EQ 5` as
+$P_SUBPAR[i] AND ARG==5) may be left out by a call only where the body reads it in arithmetic or
+in such a comparison; a bare use (`X#24`, `#3=#24`, a comparison with another variable) needs every
+call to pass it, else the subprogram stays as it was (global R parameters). The letters come from the source dialect's
 table (`options.macro_arguments`, in the program's meta): #1 -> A ... #26 -> Z; a local without a
 letter (#10, #27-#33) is a plain local of the procedure. This module decides; the emitter spells.
 """
@@ -30,6 +34,7 @@ class MacroProc:
     plain_locals: the locals without a letter the body uses."""
     params: list[tuple[int, str]] = field(default_factory=list)
     plain_locals: list[int] = field(default_factory=list)
+    vacancy_tested: set[int] = field(default_factory=set)   # read, never set: $P_SUBPAR answers
 
     def position(self, local: int) -> int | None:
         """1-based parameter position of a local, as a call passes it."""
@@ -62,14 +67,14 @@ def plan(program: ir.Program) -> dict[str, MacroProc]:
         found = _locals_used(sub.body)
         if found is None or any(c.kind != "g65" for c in _calls(sub.body)):
             continue
-        used, written = found
+        used, written, bare = found
         passed = [{v.key for v in c.bindings.values() if isinstance(v.key, int)} for c in mine]
         arguments = {k for k in used - written if k in by_local}
-        if any(arguments - p for p in passed):
-            continue                         # a call leaves out an argument the body reads
+        if any((arguments & bare) - p for p in passed):
+            continue                         # a call leaves out an argument the body uses bare
         params = sorted(k for k in arguments.union(*passed) if k in by_local)
         out[key(name)] = MacroProc([(k, by_local[k]) for k in params],
-                                   sorted(k for k in used if k not in params))
+                                   sorted(k for k in used if k not in params), arguments)
     return out
 
 
@@ -80,15 +85,38 @@ def _calls(body: list):
                 yield s
 
 
-def _locals_used(body: list) -> tuple[set[int], set[int]] | None:
-    """(the locals #1-#33 a body names, those it assigns); None when it reaches variables by a
-    computed number."""
+def _locals_used(body: list) -> tuple[set[int], set[int], set[int]] | None:
+    """(the locals #1-#33 a body names, those it assigns, those it uses bare: as a whole value, or
+    compared with another variable); None when it reaches variables by a computed number."""
     used: set[int] = set()
     written: set[int] = set()
+    bare: set[int] = set()
     indirect = False
+
+    def local(e) -> int | None:
+        if type(e) is ir.Var and e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
+            return e.key
+        return None
+
+    def whole(e) -> None:
+        """A value used as it is: vacancy shows (a word dropped, a vacancy copied)."""
+        if type(e) is ir.AxisValue:
+            e = e.value
+        k = local(e)
+        if k is not None:
+            bare.add(k)
+
+    def compared(e) -> None:
+        if type(e) is ir.Binary and e.op in ("==", "!="):
+            sides = (e.left, e.right)
+            if any(type(x) is ir.Var and x.space == "num" and x.key != 0 for x in sides) and \
+                    not any(type(x) is ir.Var and x.key == 0 for x in sides):
+                if all(type(x) is ir.Var for x in sides):
+                    bare.update(k for k in map(local, sides) if k is not None)
 
     def visit(e) -> None:
         nonlocal indirect
+        compared(e)
         if type(e) is ir.Var:
             if e.space == "num":
                 if e.key is None:
@@ -113,6 +141,14 @@ def _locals_used(body: list) -> tuple[set[int], set[int]] | None:
             visit(node.body)
             written.update(s.target.key for s in node.body if type(s) is ir.Assign
                            and s.target.space == "num" and isinstance(s.target.key, int))
+            for s in node.body:
+                if type(s) is not ir.Assign:
+                    for f in s.__slots__:
+                        v = getattr(s, f, None)
+                        for x in (v.values() if isinstance(v, dict) else v if isinstance(v, list) else (v,)):
+                            whole(x)
+                else:
+                    whole(s.value)
         else:
             visit(node)
-    return None if indirect else (used, written)
+    return None if indirect else (used, written, bare)

@@ -114,6 +114,7 @@ class Emitter:
         # one is written, its locals #n by name
         self.procs = macro_procs.plan(program) if program.dialect != DIALECT else {}
         self.local_names: dict[int, str] = {}
+        self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -154,6 +155,10 @@ class Emitter:
             s = op + inner
             return f"({s})" if prec > 0 else s
         if isinstance(e, ir.Binary):
+            if self.vacancy and e.op in ("==", "!="):
+                test = self.vacancy_test(e)
+                if test is not None:
+                    return f"({test})" if prec > 0 else test
             if e.op == "pow":
                 return self.func(ir.Func("pow", [e.left, e.right]))
             p = _PREC.get(e.op)
@@ -173,6 +178,37 @@ class Emitter:
             return self.func(e)
         self.refuse(f"expression {type(e).__name__} cannot be written")
         return "0"
+
+    def vacancy_test(self, e: ir.Binary) -> Optional[str]:
+        """An ISO comparison that can see a vacant argument, inside a PROC: `#k EQ #0` asks whether
+        the call left the parameter out (NOT $P_SUBPAR[i]); `#k EQ 5` is false for a vacant #k
+        where the parameter reads 0 (so: $P_SUBPAR[i] AND (ARG==5)). None for other comparisons."""
+        def param(x):
+            if type(x) is ir.Var and x.space == "num" and x.key in self.vacancy and not x.indices:
+                return x
+            return None
+
+        def vacant(x):
+            return type(x) is ir.Var and x.space == "num" and x.key == 0
+
+        left, right = e.left, e.right
+        if param(left) is None:
+            left, right = right, left
+        if param(left) is None:
+            return None
+        spelling = next((sp for sp, m in self.t.system_variables.items()
+                         if m == "argument_programmed"), None)
+        if spelling is None:
+            return None
+        given = f"{spelling}[{self.vacancy[left.key]}]"
+        self.info("vacancy", "ISO vacancy tests of a macro argument written with "
+                             f"{spelling}[i] (whether the call programmed the parameter)")
+        if vacant(right):
+            return f"NOT {given}" if e.op == "==" else given
+        if type(right) is ir.Var:
+            return None                  # both sides may be vacant: macro_procs kept such calls whole
+        cmp = self.expr(left, 99) + _OPS[e.op] + self.expr(right, 99)
+        return f"{given} AND ({cmp})" if e.op == "==" else f"NOT {given} OR ({cmp})"
 
     def arg(self, e) -> str:
         """An element of an argument or index list: a name such as X or C1 stands bare there."""
@@ -243,7 +279,8 @@ class Emitter:
                 return modal
         if found is None:
             meaning = system_meaning(v.key)
-            self.refuse(f"system variable #{v.key}" + (f" ({meaning.replace('_', ' ')})" if meaning else "")
+            what = meaning.replace('_', ' ') if meaning else self.numbered_meaning(v.key)
+            self.refuse(f"system variable #{v.key}" + (f" ({what})" if what else "")
                         + " has no Sinumerik equivalent")
             return "R0"
         if target:
@@ -251,6 +288,22 @@ class Emitter:
         name, axis = found
         self.info("sysvar", "ISO system variables written as the Sinumerik variables of the same meaning")
         return f"{name}[{axis}]" if axis else name
+
+    def numbered_meaning(self, number: int) -> str:
+        """What the source's numbered-variable table says a number is (ISO #2001: tool length
+        offset 1), for a refusal that names it; "" when the table does not list it."""
+        for e in ((self.p.meta or {}).get("options") or {}).get("numbered_variables") or ():
+            first = int(e.get("first", -1)) if isinstance(e, dict) else -1
+            if not first <= number <= int(e.get("last", first)):
+                continue
+            src = e.get("source")
+            if src in ("tool_length", "tool_radius"):
+                return (f"tool {src[5:]} offset {number - first + 1}: Sinumerik keeps offsets per tool "
+                        "and cutting edge ($TC_DP..[t,d]), and an ISO offset number names neither")
+            if src == "work_offset":
+                return "work offset data: Sinumerik settable frames ($P_UIFR) are not analysed here"
+            return str(e.get("meaning") or e.get("group") or src)
+        return ""
 
     def modal_number(self, number: int) -> Optional[str]:
         """A source modal-state number (ISO #4007) as the G-group index expression reading the
@@ -731,6 +784,11 @@ class Emitter:
         return any(key(k) == key(name) for k in self.p.subprograms)
 
     def subcall(self, c: ir.SubCall, out: "_Line") -> None:
+        if not c.name and "P" in c.named_args and self.p.dialect != DIALECT:
+            # ISO M98 P#144: Sinumerik would say CALL "L" << R144, which nctrans does not analyse
+            self.refuse(f"the called program's number is computed (P={self.expr(c.named_args['P'])}): "
+                        "a Sinumerik indirect CALL is not analysed, so the conversion could not be proven")
+            return
         name = self.subname(c.name)
         if self.p.dialect != DIALECT and c.name and not self._defined(c.name):
             self.diags.append(at_span(
@@ -1048,6 +1106,7 @@ class Emitter:
                           f"(#n -> ARG_<letter>, locals without a letter -> LOC<n>)")
                 self.local_names = {k: f"ARG_{letter}" for k, letter in proc.params}
                 self.local_names.update({k: f"LOC{k}" for k in proc.plain_locals})
+                self.vacancy = {k: proc.position(k) for k in proc.vacancy_tested}
                 params = [f"REAL ARG_{letter}" for _, letter in proc.params]
             for prm in sub.params:
                 dims = "[" + ",".join(str(x) if x else "" for x in prm.dims) + "]" if prm.dims else ""
@@ -1061,7 +1120,7 @@ class Emitter:
                 self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
             self.st = _State()
             self.unit(sub.body)
-            self.local_names = {}
+            self.local_names, self.vacancy = {}, {}
 
 
 def _reads_arguments(body: list) -> bool:
