@@ -86,12 +86,29 @@ def test_vacant_arguments_are_asked_with_p_subpar(tmp_path):
     assert [(r.end["X"], r.end["Z"]) for r in moves] == [(7.0, -1.0), (-1.0, -4.0)]
 
 
-def test_macro_called_without_an_argument_it_uses_bare_keeps_r_parameters():
-    # `Y#2` drops the word when B is vacant; a PROC parameter left out would move to Y0: no PROC
-    src = ("O0001\nG90 G17 G21\nG65 P1000 A5. B2.\nG65 P1000 A7.\nM30\n"
+def test_call_leaving_out_an_argument_used_bare_is_lowered_alone(tmp_path):
+    # `Y#2` drops the word when B is vacant; neither a PROC parameter left out (0) nor an R
+    # parameter (the value of before) says that: that call is lowered to plain motion, the other
+    # call and the macro keep their structure
+    src = ("O0001\nG90 G17 G21\nG0 X0 Y0\nG65 P1000 A5. B2.\nG0 X0 Y0\nG65 P1000 A7.\nM30\n"
            "O1000\nG1 X#1 Y#2 F100\nM99\n")
     conv = _converted(src)
-    assert "PROC L1000\n" in conv.text and "PROC L1000(" not in conv.text
+    assert "L1000(5., 2.)" in conv.text.splitlines()
+    assert any(d.rule == "NC401" and d.line == 6 and "leaves out #2" in d.message
+               for d in conv.diagnostics)
+    _equiv(tmp_path, src, conv.text)
+
+
+def test_locals_a_g65_call_leaves_out_start_at_zero_in_r_parameters(tmp_path):
+    # M98 shares the caller's locals, so O1000 stays on R parameters; its G65 calls clear the
+    # locals they leave out that the macro reads as numbers (vacant is 0 in arithmetic), but not
+    # #4, which it sets before reading
+    src = ("O0001\nG90 G17 G21\nG0 X0 Y0\nM98 P1000\nG65 P1000 A5. B2.\nG0 X0 Y0\nG65 P1000 A7.\n"
+           "M30\nO1000\n#3=#3+1\n#4=#1*2\nG1 X#4 Y[#2+#3] F100\nM99\n")
+    conv = _converted(src)
+    lines = conv.text.splitlines()
+    assert "R1=5. R2=2. R3=0 L1000" in lines and "R1=7. R2=0 R3=0 L1000" in lines
+    _equiv(tmp_path, src, conv.text)
 
 
 def test_subprogram_also_called_by_m98_keeps_r_parameters():
@@ -138,7 +155,7 @@ def test_modal_number_off_the_index_line_is_refused_at_its_line():
     # G54.1 P1 reads 54.1 in ISO; its Sinumerik code G505 is index 6 of group 8 (6 + 52 = 58)
     conv = nctrans.transpile("G90 G21 G54\nG54.1 P1\n#100=#4014\nG0 X#100\nM30\n",
                              read="iso-m", write="sinumerik")
-    assert any("#4014 has no Sinumerik equivalent" in d.message and d.line == 3
+    assert any("#4014 (work_offset) has no Sinumerik equivalent" in d.message and d.line == 3
                for d in conv.diagnostics)
     assert "$P_GG" not in (conv.text or "")
 

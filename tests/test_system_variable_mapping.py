@@ -67,9 +67,10 @@ def _refusals(text: str, src: str, dst: str) -> list:
 
 
 def test_system_variables_without_an_equivalent_are_refused_at_their_line():
-    # #4014 (modal work offset: Fanuc reads 54..59, Sinumerik $P_GG an index), #2001 (length of
-    # offset H1: Sinumerik keeps lengths per tool edge, $TC_DP3[t,d])
-    for number in (4014, 2001):
+    # #4009 (modal canned cycle: no Sinumerik G group holds it; #4014 now maps to $P_GG[8]+52,
+    # tests/test_iso_to_sinumerik_structure.py), #2001 (length of offset H1: Sinumerik keeps
+    # lengths per tool edge, $TC_DP3[t,d])
+    for number in (4009, 2001):
         found = _refusals(f"G0 X0\n#1=#{number}\nM30\n", "iso-m", "sinumerik")
         assert found and found[0].line == 2 and f"#{number}" in found[0].message
     # a write to a position is refused, not turned into a write of $AA_IM

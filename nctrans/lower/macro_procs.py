@@ -67,12 +67,15 @@ def plan(program: ir.Program) -> dict[str, MacroProc]:
         found = _locals_used(sub.body)
         if found is None or any(c.kind != "g65" for c in _calls(sub.body)):
             continue
-        used, written, bare = found
+        used, written, bare, _ = found
         passed = [{v.key for v in c.bindings.values() if isinstance(v.key, int)} for c in mine]
         arguments = {k for k in used - written if k in by_local}
         if any((arguments & bare) - p for p in passed):
             continue                         # a call leaves out an argument the body uses bare
         params = sorted(k for k in arguments.union(*passed) if k in by_local)
+        use = local_use(sub.body)
+        if use is None or use.left_out(set(params))[1]:
+            continue                         # a plain local read while vacant: DEF would read 0
         out[key(name)] = MacroProc([(k, by_local[k]) for k in params],
                                    sorted(k for k in used if k not in params), arguments)
     return out
@@ -85,12 +88,78 @@ def _calls(body: list):
                 yield s
 
 
-def _locals_used(body: list) -> tuple[set[int], set[int], set[int]] | None:
+@dataclass
+class LocalUse:
+    """How a body uses its locals #1-#33: named anywhere, assigned, used bare (a whole value: a word
+    dropped or a vacancy copied when vacant), compared (== / !=, where vacant differs from 0), and
+    set first (the first top-level mention assigns it from other values: never read vacant)."""
+    used: set[int] = field(default_factory=set)
+    written: set[int] = field(default_factory=set)
+    bare: set[int] = field(default_factory=set)
+    compared: set[int] = field(default_factory=set)
+    set_first: set[int] = field(default_factory=set)
+
+    def left_out(self, passed: set[int]) -> tuple[list[int], list[int]]:
+        """For a call that passes the locals `passed`: (locals that start vacant and are read
+        only as 0 would be: a register for them must be cleared, locals whose vacancy shows)."""
+        fresh = sorted(k for k in self.used - passed if k not in self.set_first)
+        shows = [k for k in fresh if k in self.bare or k in self.compared]
+        return [k for k in fresh if k not in shows], shows
+
+
+def local_use(body: list) -> LocalUse | None:
+    """The LocalUse of a body; None when it reaches variables by a computed number."""
+    found = _locals_used(body)
+    if found is None:
+        return None
+    use = LocalUse(*found)
+    seen: set[int] = set()
+
+    for node in body:
+        if type(node) is not ir.Block:
+            seen |= _expr_locals(node)          # a structure: any of its locals may be read first
+            continue
+        for st in node.body:
+            if type(st) is ir.Assign and st.target.space == "num" and isinstance(st.target.key, int):
+                seen |= _expr_locals(st.value)
+                if st.target.key not in seen:
+                    use.set_first.add(st.target.key)
+                seen.add(st.target.key)
+            else:
+                seen |= _expr_locals(st)
+    return use
+
+
+def _expr_locals(e) -> set[int]:
+    out: set[int] = set()
+
+    def visit(x) -> None:
+        if type(x) is ir.Var:
+            if x.space == "num" and isinstance(x.key, int) and 1 <= x.key <= LOCAL_MAX:
+                out.add(x.key)
+            for i in x.indices or ():
+                visit(i)
+        elif isinstance(x, (list, tuple)):
+            for y in x:
+                visit(y)
+        elif isinstance(x, dict):
+            for y in x.values():
+                visit(y)
+        elif hasattr(x, "__slots__") and not isinstance(x, (ir.Num, ir.Str, ir.Span)):
+            for f in x.__slots__:
+                visit(getattr(x, f, None))
+    visit(e)
+    return out
+
+
+def _locals_used(body: list) -> tuple[set[int], set[int], set[int], set[int]] | None:
     """(the locals #1-#33 a body names, those it assigns, those it uses bare: as a whole value, or
-    compared with another variable); None when it reaches variables by a computed number."""
+    compared with another variable, those it compares with == / !=); None when it reaches
+    variables by a computed number."""
     used: set[int] = set()
     written: set[int] = set()
     bare: set[int] = set()
+    compares: set[int] = set()
     indirect = False
 
     def local(e) -> int | None:
@@ -109,6 +178,7 @@ def _locals_used(body: list) -> tuple[set[int], set[int], set[int]] | None:
     def compared(e) -> None:
         if type(e) is ir.Binary and e.op in ("==", "!="):
             sides = (e.left, e.right)
+            compares.update(k for k in map(local, sides) if k is not None)
             if any(type(x) is ir.Var and x.space == "num" and x.key != 0 for x in sides) and \
                     not any(type(x) is ir.Var and x.key == 0 for x in sides):
                 if all(type(x) is ir.Var for x in sides):
@@ -151,4 +221,4 @@ def _locals_used(body: list) -> tuple[set[int], set[int], set[int]] | None:
                     whole(s.value)
         else:
             visit(node)
-    return None if indirect else (used, written, bare)
+    return None if indirect else (used, written, bare, compares)

@@ -800,12 +800,13 @@ class Emitter:
         if proc is not None:
             out.words.append(f"{name}({self.proc_args(proc, c)})")
             return
-        if c.bindings:
+        if c.bindings or (c.kind == "g65" and self._defined(c.name)):
             self.info("g65", "macro call arguments passed in R parameters (global: a nested call can "
                              "overwrite them)")
             for letter, var in c.bindings.items():
                 if letter in c.named_args:
                     pre.append(f"{self.var(var)}={self.expr(c.named_args[letter])}")
+            pre.extend(self.fresh_locals(c))
         elif c.named_args:
             self.refuse(f"named call arguments of {c.name} have no binding to write")
         if c.kind == "call" and not c.args:
@@ -824,6 +825,30 @@ class Emitter:
             text += " " + self.word("P", c.repeat)
         out.words.extend(pre)
         out.words.append(text)
+
+    def fresh_locals(self, c: ir.SubCall) -> list[str]:
+        """A G65 call of a macro in this program written with R parameters: the macro's locals
+        start vacant in ISO, but R parameters keep the value of before. A local it reads only as
+        0 would be is cleared in the call (`R2=0`); one whose vacancy shows (a word dropped, an EQ
+        test) cannot be written so: refused (NC402), the call is lowered instead."""
+        k = macro_procs.key(c.name)
+        sub = next((s for n, s in self.p.subprograms.items() if macro_procs.key(n) == k), None)
+        if sub is None or type(sub.body) is not list:
+            return []
+        if not hasattr(self, "_uses"):
+            self._uses: dict = {}
+        if k not in self._uses:
+            self._uses[k] = macro_procs.local_use(sub.body)
+        use = self._uses[k]
+        if use is None:
+            return []
+        passed = {v.key for v in c.bindings.values() if isinstance(v.key, int)}
+        clear, shows = use.left_out(passed)
+        if shows:
+            self.refuse(f"the call of {c.name} leaves out #{', #'.join(map(str, shows))}, which the "
+                        "macro reads while vacant (a word dropped or an EQ/NE test): a Sinumerik "
+                        "R parameter would hold the value of before")
+        return [f"R{k}=0" for k in clear]
 
     def proc_args(self, proc: "macro_procs.MacroProc", c: ir.SubCall) -> str:
         """A G65 call's arguments by the position of the PROC parameter each letter binds; a
