@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import api, pipeline
-from nctrans.interp.milling_cycles import arc_slot_ring, depth_levels, milling_steps, rect_ring
+from nctrans.interp.milling_cycles import arc_slot_ring, depth_levels, milling_steps, rect_ring, thread_turn_steps
 from nctrans.machine import Machine, Tool
 from nctrans.source import from_text
 
@@ -512,3 +512,77 @@ def test_inch_programs_scale_lengths_and_g70_keeps_feeds_in_mm():
                      and r.end["X"] != pytest.approx(50.8))
         assert first.end["X"] == pytest.approx(50.8 + 22.4 / 5) and first.feed == pytest.approx(ffp1)
         assert recs[-1].end["Z"] == pytest.approx(0.5 * 25.4)
+
+
+# ---------------------------------------------------------------------------------------------
+# CYCLE97: thread cutting on a lathe
+
+def _lathe(body: str, speed: float = 500.0):
+    text = f"G18 G90 G54 T1 D1\nS{speed:g} M3\nG0 X30 Z10\n{body}\nM30\n"
+    ld = pipeline.load_source(from_text(text, "t.mpf"), "t.mpf", "sinumerik")
+    recs = [r for r in pipeline.toolpath_of(ld) if r.kind in ("rapid", "linear") and r.line == 4]
+    return [(r.kind, round(r.end["X"], 6), round(r.end["Z"], 6), r.pitch) for r in recs], ld.diagnostics
+
+
+def test_cycle97_external_by_hand():
+    # pitch 2 from Z0 to Z-20 on diameter 20, run-in 4, run-out 2, depth 1.2 with 0.2 finishing,
+    # two roughing cuts at constant infeed (0.5, 1.0), the finishing cut and one idle pass at 1.2;
+    # crest radius 10, clear 10 + 1 (_VRT 0 -> 1 mm); threads from Z4 to Z-22
+    moves, diags = _lathe("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0.2, 0, 0, 2, 1, 1, 1)")
+    assert not [d for d in diags if d.severity != "info"]
+    want = [("rapid", 11, 4, None)]
+    for x in (9.5, 9.0, 8.8, 8.8):
+        want += [("rapid", x, 4, None), ("linear", x, -22, 2.0), ("rapid", 11, -22, None), ("rapid", 11, 4, None)]
+    assert moves == [(k, pytest.approx(x), pytest.approx(z), p) for k, x, z, p in want]
+
+
+def test_cycle97_internal_constant_cross_section_and_flank_infeed():
+    # internal (VARI 4): crest 10 - 1.2 = 8.8, cuts outwards; roughing 1.0 in 4 cuts at sqrt(k/4);
+    # IANG 30: each cut (1.2 - depth) x tan 30 earlier along the thread (+Z here), the last on Z4
+    moves, _ = _lathe("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0.2, 30, 0, 4, 0, 4, 1)")
+    cuts = [(x, z) for k, x, z, p in moves if k == "rapid"][3::3]   # first into the bore at Z10, then to Z4
+    depths = [math.sqrt(k / 4) for k in range(1, 5)] + [1.2]
+    tan30 = math.tan(math.radians(30))
+    assert [x for x, _ in cuts] == pytest.approx([8.8 + d for d in depths])
+    assert [z for _, z in cuts] == pytest.approx([4 + (1.2 - d) * tan30 for d in depths])
+    threads = [r for r in moves if r[0] == "linear"]
+    assert all(p == 2.0 for *_, p in threads) and len(threads) == 5
+
+
+def test_cycle97_metric_size_taper_and_refusals():
+    # MPIT 10 -> 1.5 mm coarse pitch; DM2 18: the crest falls from radius 10 to 9 over SPL..FPL
+    moves, _ = _lathe("CYCLE97(, 10, 0, -20, 20, 18, 0, 0, 0.9, 0, 0, 0, 1, 0, 1, 1)")
+    thread = next(m for m in moves if m[0] == "linear")
+    assert thread == ("linear", pytest.approx(9 - 0.9), pytest.approx(-20), 1.5)
+    for call, rule in (("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0.2, 0, 0, 2, 1, 1, 2)", "NC224"),
+                       ("CYCLE97(2, , 0, 0, 20, 20, 4, 2, 1.2)", "NC225"),
+                       ("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 0)", "NC225"),
+                       ("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0, 0, 0, 2, 0, 7)", "NC225")):
+        moves, diags = _lathe(call)
+        assert not moves and [d.rule for d in diags if d.line == 4] == [rule], call
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(0.5, 4), st.floats(5, 60), st.floats(-60, -1), st.floats(0.2, 3), st.integers(1, 8),
+       st.sampled_from([1, 2, 3, 4]), st.floats(-40, 40))
+def test_cycle97_reaches_the_depth_and_stays_clear_between_cuts(pit, dm, length, tdep, nrc, vari, iang):
+    p = dict(PIT=pit, SPL=0, FPL=length, DM1=dm, DM2=dm, APP=2, ROP=1, TDEP=tdep, FAL=0, IANG=iang,
+             NRC=nrc, VARI=vari)
+    steps = thread_turn_steps(p, (dm, 5.0))
+    external = vari in (1, 3)
+    crest = dm / 2 if external else dm / 2 - tdep
+    threads = [s for s in steps if s[0] == "thread"]
+    assert len(threads) == nrc and all(s[2] == pit for s in threads)
+    root = [s[1][0] for s in threads][-1]
+    assert root == pytest.approx(crest - tdep if external else crest + tdep)
+    for s in threads:                          # never deeper than the root, always along the thread
+        assert (root - s[1][0]) * (1 if external else -1) <= 1e-9
+    assert steps[-1] == ("rapid", (crest + (1 if external else -1), 2.0))
+
+
+def test_cycle97_converted_is_lowered_to_threads_and_equivalent():
+    text = ("G18 G90 G54 T1 D1\nS500 M3\nG0 X30 Z10\n"
+            "CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0.2, 30, 0, 2, 1, 1, 1)\nG0 X40\nM30\n")
+    conv = api.transpile(text, "sinumerik", "iso-m")
+    assert conv.text is not None and "CYCLE97" not in conv.text and conv.text.count("G33") == 4
+    assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m")

@@ -35,7 +35,9 @@ Modelling choices [NC] where the manual leaves the path to the control (or the s
   most MIDA (0.8 x diameter when 0) apart, starting and ending FDP beyond the face;
 - thread milling (CYCLE90) climbs one pitch per turn from DP to RFP, entered from the centre
   (internal) or from outside (external) by a straight feed.
-Finishing spindle speed SSF has no effect on the path and is not modelled. Calls that ask for what
+The lathe's thread cutting cycle CYCLE97 is planned here as well (`thread_turn_steps`, its facts
+and choices in its docstring). Finishing spindle speed SSF has no effect on the path and is not
+modelled. Calls that ask for what
 is not modelled (helical or oscillating insertion, a pre-machined blank, a floor allowance in
 SLOT1/SLOT2) say so (NC224) and move nothing.
 """
@@ -709,6 +711,9 @@ def run_milling_cycle(interp, s) -> None:
         interp.diag("NC224", "warning", f"MCALL {cyc.name}: a modal call of a milling cycle is not "
                     "modelled; the call is ignored and the following positions do not run it")
         return
+    if cyc.shape == "thread_turn":
+        _run_thread_turn(interp, cyc, s)
+        return
     radius = _tool_radius(interp)
     if radius is None:
         interp.diag("NC224", "warning", f"{cyc.name} ({cyc.meaning}) needs the tool radius: no tool "
@@ -745,3 +750,108 @@ def run_milling_cycle(interp, s) -> None:
                 interp._move(kind, end)
     finally:
         st.feed = saved
+
+
+# ---------------------------------------------------------------------------------------------
+# CYCLE97: thread cutting on a lathe (X radius, Z along the axis)
+
+def thread_turn_steps(p: dict[str, float], start: tuple[float, float]) -> list[Step]:
+    """CYCLE97 passes from `start` = (X radius, Z): ("rapid", (x, z)) | ("thread", (x, z), lead).
+
+    [GK] Siemens cycles manual: the thread runs from SPL to FPL on the diameters DM1 (at SPL) and
+    DM2 (at FPL), lengthened by the run-in APP and the run-out ROP; TDEP deep, the roughing depth
+    TDEP - FAL in NRC cuts (VARI 1/2 external/internal with constant infeed, 3/4 with constant
+    cross-section: the k-th cut at depth x sqrt(k / NRC)), then FAL in one finishing cut and NID
+    idle passes; IANG infeeds along a flank (negative: alternating flanks); the lead is PIT, or
+    the metric coarse pitch of MPIT. [NC] DM is the nominal (outer) diameter for both external
+    and internal threads; the tool retracts _VRT (1 mm when 0) beyond the crest and goes back to
+    the thread's start with G0 after each pass; flank infeed puts each cut (TDEP - depth) x
+    tan(IANG) earlier along the thread, the last at the programmed start."""
+    vari = int(p.get("VARI", 1))
+    if vari not in (1, 2, 3, 4):
+        raise _impossible(f"with VARI {vari} (1/3 external, 2/4 internal thread)")
+    if int(p.get("NUMT", 1) or 1) > 1:
+        raise _unmodelled("with several thread starts NUMT: not modelled")
+    lead = abs(p.get("PIT", 0.0))
+    if not lead and p.get("MPIT"):
+        from nctrans.interp.cycles import coarse_pitch
+        lead = coarse_pitch(p["MPIT"]) or 0.0
+    if lead <= 0:
+        raise _impossible("without a thread pitch (PIT) or a known thread size (MPIT)")
+    spl, fpl = p.get("SPL", 0.0), p.get("FPL", 0.0)
+    if abs(fpl - spl) <= _EPS:
+        raise _impossible("with the thread's start SPL at its end FPL")
+    tdep = abs(p.get("TDEP", 0.0))
+    fal = abs(p.get("FAL", 0.0))
+    if tdep <= _EPS or fal >= tdep:
+        raise _impossible("with no thread depth TDEP (or a finishing allowance FAL not below it)")
+    _positive(p, "DM1")
+    dm2 = p.get("DM2") or p["DM1"]
+    nrc = max(1, int(p.get("NRC", 1) or 1))
+    if nrc > MAX_PASSES:
+        raise _impossible(f"with more than {MAX_PASSES} roughing cuts")
+    sp = 1.0 if fpl > spl else -1.0
+    z0, z1 = spl - sp * abs(p.get("APP", 0.0)), fpl + sp * abs(p.get("ROP", 0.0))
+
+    def nominal(z: float) -> float:
+        return (p["DM1"] + (dm2 - p["DM1"]) * (z - spl) / (fpl - spl)) / 2
+
+    external = vari in (1, 3)
+    sd = -1.0 if external else 1.0                  # the infeed: towards the axis outside
+    crest = (lambda z: nominal(z)) if external else (lambda z: nominal(z) - tdep)
+    vrt = abs(p.get("VRT", 0.0)) or 1.0
+    clear = (max(crest(z0), crest(z1)) + vrt) if external else (min(crest(z0), crest(z1)) - vrt)
+    rough = tdep - fal
+    if vari in (1, 2):
+        depths = [rough * k / nrc for k in range(1, nrc + 1)]
+    else:
+        depths = [rough * math.sqrt(k / nrc) for k in range(1, nrc + 1)]
+    if fal > 0:
+        depths.append(tdep)
+    depths += [tdep] * max(0, int(p.get("NID", 0) or 0))
+    iang = p.get("IANG", 0.0)
+    tan = math.tan(math.radians(abs(iang))) if iang else 0.0
+
+    steps: list[Step] = []
+    x, z = start
+    if (x - clear) * sd > 0:                         # first away from the thread, then along it
+        steps.append(("rapid", (clear, z)))
+    steps.append(("rapid", (clear, z0)))
+    for k, depth in enumerate(depths):
+        flank = -1.0 if iang < 0 and k % 2 else 1.0
+        shift = -sp * (tdep - depth) * tan * flank
+        steps.append(("rapid", (clear, z0 + shift)))
+        steps.append(("rapid", (crest(z0) + sd * depth, z0 + shift)))
+        steps.append(("thread", (crest(z1) + sd * depth, z1 + shift), lead))
+        steps.append(("rapid", (clear, z1 + shift)))
+    steps.append(("rapid", (clear, z0)))
+    return [s for i, s in enumerate(steps) if i == 0 or s[:2] != steps[i - 1][:2]]
+
+
+def _run_thread_turn(interp, cyc, s) -> None:
+    """CYCLE97 in the interpreter: X is the radius, Z the thread axis; the thread cuts are
+    spindle-synchronised (feed = lead x S, the records carry the lead as G33 moves do)."""
+    st = interp.st
+    try:
+        if not st.spindle_speed:
+            raise _impossible("with no spindle speed (the thread feed is the lead x S)")
+        steps = thread_turn_steps(call_values(interp, cyc, s), (interp.pos.get("X", 0.0), interp.pos.get("Z", 0.0)))
+    except MillingError as err:
+        interp.diag(err.rule, err.severity, f"{cyc.name} {err.message}; the call is skipped and "
+                    "moves nothing in the analysed toolpath")
+        return
+    saved, saved_mode = st.feed, st.feed_mode
+    try:
+        for step in steps:
+            end = dict(interp.pos)
+            end["X"], end["Z"] = step[1]
+            if step[0] == "rapid":
+                interp._move("rapid", end)
+                continue
+            st.feed, st.feed_mode = step[2] * st.spindle_speed, "per_min"
+            mark = len(interp.out)
+            interp._move("linear", end)
+            for rec in interp.out[mark:]:
+                rec.pitch = step[2]
+    finally:
+        st.feed, st.feed_mode = saved, saved_mode
