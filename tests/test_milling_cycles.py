@@ -586,3 +586,32 @@ def test_cycle97_converted_is_lowered_to_threads_and_equivalent():
     conv = api.transpile(text, "sinumerik", "iso-m")
     assert conv.text is not None and "CYCLE97" not in conv.text and conv.text.count("G33") == 4
     assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m")
+
+
+# Any values at all: a plan of finite moves within the budget, or a MillingError (never another
+# exception, never a runaway); every cycle in the table.
+CYCLES = {m["name"]: m for m in __import__("tomllib").loads(
+    (__import__("pathlib").Path(__file__).resolve().parents[1] / "rules" / "cycles.toml").read_text())["milling"]}
+any_value = st.one_of(st.none(), st.sampled_from([0.0, -1.0, 1e-12, 1e9, float("inf"), float("nan")]),
+                      st.floats(-200, 200))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.sampled_from(sorted(CYCLES)), st.data())
+def test_any_arguments_plan_or_refuse(name, data):
+    from nctrans.interp.milling_cycles import MAX_MOVES, MillingError
+    cyc = CYCLES[name]
+    p = {k: v for k in cyc["params"] if (v := data.draw(any_value, label=k)) is not None}
+    try:
+        if cyc["shape"] == "thread_turn":
+            steps = thread_turn_steps(p, (30.0, 10.0))
+        else:
+            steps = milling_steps(cyc["shape"], p, data.draw(st.floats(0.1, 10), label="radius"),
+                                  (0.0, 0.0, 50.0), 100.0)
+    except MillingError as err:
+        assert err.rule in ("NC206", "NC224", "NC225") and err.message
+        return
+    assert len(steps) <= MAX_MOVES + 1
+    for s in steps:
+        if s[0] != "feed":
+            assert all(math.isfinite(v) for v in s[1])

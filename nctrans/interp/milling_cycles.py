@@ -56,6 +56,9 @@ Step = tuple
 Seg = tuple
 _EPS = 1e-9
 MAX_PASSES = 10_000
+# A call planning more moves than this is refused (NC225): the plan is held in memory, and no
+# real pocket needs a tenth of it (a 10-cut pocket of 20 rings is under 2,000 moves).
+MAX_MOVES = 200_000
 
 
 class MillingError(Exception):
@@ -216,6 +219,9 @@ class _Plan:
             return
         self.steps.append((kind, to))
         self.at = to
+        if len(self.steps) > MAX_MOVES:
+            raise _impossible(f"with more than {MAX_MOVES} moves (infeeds MID/MIDA or a count too small "
+                              "for the sizes)")
 
     def approach(self, p1: float, p2: float, lv: Levels) -> None:
         """G0 to (p1, p2) at RTP (rising to RTP first when below it), then G0 to RFP+SDIS."""
@@ -423,6 +429,15 @@ def _g2_g3(p: dict[str, float]) -> bool:
     return cdir == 3
 
 
+def _finite(p: dict[str, float]) -> None:
+    """Every value a finite number, every feed not negative (the control stops on either)."""
+    for name, v in p.items():
+        if not math.isfinite(v):
+            raise _impossible(f"with {name} = {v} (not a finite number)")
+        if name in ("FFD", "FFP1", "FFP2", "FFR") and v < 0:
+            raise _impossible(f"with a negative feed {name} {v:g}")
+
+
 def _positive(p: dict[str, float], *names: str) -> None:
     for name in names:
         if p.get(name, 0.0) <= 0:
@@ -558,6 +573,7 @@ def milling_steps(shape: str, p: dict[str, float], radius: float, start: tuple[f
     planner = PLANNERS.get(shape)
     if planner is None:
         raise _unmodelled(f"shape {shape!r} is not modelled")
+    _finite(p)
     plan = _Plan(start)
     planner(plan, p, levels_of(p, start[2]), radius, feed, spindle_cw, shape)
     return plan.steps
@@ -767,6 +783,7 @@ def thread_turn_steps(p: dict[str, float], start: tuple[float, float]) -> list[S
     and internal threads; the tool retracts _VRT (1 mm when 0) beyond the crest and goes back to
     the thread's start with G0 after each pass; flank infeed puts each cut (TDEP - depth) x
     tan(IANG) earlier along the thread, the last at the programmed start."""
+    _finite(p)
     vari = int(p.get("VARI", 1))
     if vari not in (1, 2, 3, 4):
         raise _impossible(f"with VARI {vari} (1/3 external, 2/4 internal thread)")
@@ -808,7 +825,10 @@ def thread_turn_steps(p: dict[str, float], start: tuple[float, float]) -> list[S
         depths = [rough * math.sqrt(k / nrc) for k in range(1, nrc + 1)]
     if fal > 0:
         depths.append(tdep)
-    depths += [tdep] * max(0, int(p.get("NID", 0) or 0))
+    nid = int(p.get("NID", 0) or 0)
+    if nid > MAX_PASSES:
+        raise _impossible(f"with more than {MAX_PASSES} idle passes")
+    depths += [tdep] * max(0, nid)
     iang = p.get("IANG", 0.0)
     tan = math.tan(math.radians(abs(iang))) if iang else 0.0
 
