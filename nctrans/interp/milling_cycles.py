@@ -733,7 +733,7 @@ def run_milling_cycle(interp, s) -> None:
     radius = _tool_radius(interp)
     if radius is None:
         interp.diag("NC224", "warning", f"{cyc.name} ({cyc.meaning}) needs the tool radius: no tool "
-                    "offset (D) is active, or the machine model does not give the active tool's radius; "
+                    "offset (D) is active, or the machine model (--machine) does not give the active tool's radius; "
                     "the call is skipped and moves nothing in the analysed toolpath")
         return
     st = interp.st
