@@ -30,6 +30,11 @@
 enum { MOTION_RAPID, MOTION_LINEAR, MOTION_CW, MOTION_CCW, MOTION_OTHER };
 
 static const char AXIS_LETTERS[] = "XYZABCUVW";
+/* A..Z -> index in AXIS_LETTERS, -1 for a letter that is no axis */
+static const signed char AXIS_OF_LETTER[26] = {
+    3, 4, 5, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,      /* A B C D .. M */
+    -1, -1, -1, -1, -1, -1, -1, 6, 7, 8, 0, 1, 2,         /* N .. T U V W X Y Z */
+};
 
 typedef struct {
     int kind;
@@ -48,34 +53,74 @@ typedef struct {
     int has_number;
 } Block;
 
-/* Copy text[p:q) without spaces into buf (NUL-terminated); drop one trailing '\r'. Returns the
- * length, or -1 when the line cannot be plain (too long, non-ASCII, a comment character). */
-static int clean_line(const Text *t, Py_ssize_t p, Py_ssize_t q, char *buf)
+/* What a character of the text is to read_line: kept, a blank (dropped), a carriage return
+ * (kept: only a trailing one is dropped), or one that no plain line holds (a comment character,
+ * anything beyond ASCII). */
+enum { CH_KEEP, CH_BLANK, CH_CR, CH_STOP };
+
+static int char_class(Py_UCS4 c)
 {
-    int n = 0;
+    if (c == ' ')
+        return CH_BLANK;
+    if (c == '\r')
+        return CH_CR;
+    if (c >= 128 || c == '(' || c == ')' || c == ';')
+        return CH_STOP;
+    return CH_KEEP;
+}
+
+static unsigned char CLASS_OF_BYTE[256];   /* char_class of each Latin-1 character (module init) */
+
+/* A line no plain-run reader takes: LINE_BLANK when it holds only spaces and '\r' (no block: the
+ * front end skips it), LINE_OTHER when it cannot be plain (too long, non-ASCII, a comment). */
+enum { LINE_BLANK = 0, LINE_OTHER = -1 };
+
+/* Copy text[p:q) without spaces into buf (NUL-terminated) and drop one trailing '\r': the length
+ * (> 0), or LINE_BLANK / LINE_OTHER. One pass: the class of each character decides. */
+static int read_line(const Text *t, Py_ssize_t p, Py_ssize_t q, char *buf)
+{
+    int n = 0, only_cr = 1;
+    Py_ssize_t i = p;
     if (t->kind == PyUnicode_1BYTE_KIND) {
-        /* the usual text (Latin-1 storage): bytes read directly; one test per byte for the
-         * characters that stop a plain line ('(' ')' ';' and >= 128 have no other use here) */
+        /* the usual text (Latin-1 storage): bytes read directly */
         const unsigned char *d = (const unsigned char *)t->data;
-        for (Py_ssize_t i = p; i < q; i++) {
+        for (; i < q; i++) {
             unsigned char c = d[i];
-            if (c == ' ')
+            int k = CLASS_OF_BYTE[c];
+            if (k == CH_BLANK)
                 continue;
-            if (c >= 128 || c == '(' || c == ')' || c == ';' || n >= MAX_LINE - 1)
-                return -1;
+            if (k == CH_STOP)
+                return LINE_OTHER;
+            if (n >= MAX_LINE - 1)
+                break;
+            only_cr &= k == CH_CR;
             buf[n++] = (char)c;
         }
     } else {
-        for (Py_ssize_t i = p; i < q; i++) {
+        for (; i < q; i++) {
             Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
-            if (c == ' ')
+            int k = char_class(c);
+            if (k == CH_BLANK)
                 continue;
-            if (c >= 128 || c == '(' || c == ')' || c == ';' || n >= MAX_LINE - 1)
-                return -1;
+            if (k == CH_STOP)
+                return LINE_OTHER;
+            if (n >= MAX_LINE - 1)
+                break;
+            only_cr &= k == CH_CR;
             buf[n++] = (char)c;
         }
     }
-    if (n > 0 && buf[n - 1] == '\r')
+    if (i < q) {                       /* too long to be plain: still blank if it is all '\r' */
+        for (; i < q; i++) {
+            Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
+            if (c != ' ' && c != '\r')
+                return LINE_OTHER;
+        }
+        return only_cr ? LINE_BLANK : LINE_OTHER;
+    }
+    if (only_cr)
+        return LINE_BLANK;
+    if (buf[n - 1] == '\r')
         n--;
     buf[n] = '\0';
     return n;
@@ -182,9 +227,8 @@ static int parse_block_as(const char *buf, int n, Block *b, int strict)
                                                && (memchr(buf + at, '.', (size_t)len) != NULL
                                                    || buf[at] == '-' || buf[at] == '+'))))
             return 0;
-        const char *ax = strchr(AXIS_LETTERS, letter);
-        if (ax != NULL) {
-            int k = (int)(ax - AXIS_LETTERS);
+        int k = AXIS_OF_LETTER[letter - 'A'];
+        if (k >= 0) {
             if (b->axis_len[k] != 0)
                 return 0;
             b->axis_at[k] = at;
@@ -295,17 +339,6 @@ static Py_ssize_t line_end(const Text *t, Py_ssize_t p, Py_UCS4 sep)
     return p;
 }
 
-/* A line holding nothing but spaces and '\r': no block (the front end skips it). */
-static int blank_line(const Text *t, Py_ssize_t p, Py_ssize_t q)
-{
-    for (Py_ssize_t i = p; i < q; i++) {
-        Py_UCS4 c = PyUnicode_READ(t->kind, t->data, i);
-        if (c != ' ' && c != '\r')
-            return 0;
-    }
-    return 1;
-}
-
 /* Whether a parsed block is one the plain path lowers, given the static modal state before it
  * (Lowering.plain_block): centre words only in arc mode, incremental (G91.1), with no canned
  * cycle pending. Updates
@@ -352,13 +385,13 @@ static PyObject *scan(PyObject *self, PyObject *args)
     int last_g = -1;
     while (p >= 0 && p <= t.len) {
         Py_ssize_t q = line_end(&t, p, (Py_UCS4)sepc);
-        if (blank_line(&t, p, q)) {
+        int n = read_line(&t, p, q, buf);
+        if (n == LINE_BLANK) {
             if (blocks == 0)
                 break;
             blanks++;                  /* counted only if a block follows */
         } else {
-            int n = clean_line(&t, p, q, buf);
-            if (n <= 0 || (strict && !words_separated(&t, p, q)) || !parse_block_as(buf, n, &b, strict)
+            if (n < 0 || (strict && !words_separated(&t, p, q)) || !parse_block_as(buf, n, &b, strict)
                 || !plain_in_state(&b, &motion, &cycle_off, arc_abs))
                 break;
             if (b.gmode >= 0)
@@ -372,6 +405,67 @@ static PyObject *scan(PyObject *self, PyObject *args)
             pos = p;
     }
     return Py_BuildValue("(nnni)", pos, lines, blocks, last_g);
+}
+
+/* Whether a line, read the way scan() reads lines, is plain words in any state: the check is
+ * scan()'s in the state that takes the most lines (arc mode, no canned cycle, incremental centres). */
+static int plain_in_any_state(const char *buf, int n)
+{
+    Block b;
+    int motion = MOTION_CW, cycle_off = 1;
+    return n > 0 && parse_block_as(buf, n, &b, 0) && plain_in_state(&b, &motion, &cycle_off, 0);
+}
+
+/* quiet(text, pos, sep, marks) -> where the first line at or after pos starts that may hold a
+ * control mark (len(text) when none does). `marks` are the characters every mark begins with
+ * (the front end derives them from its pattern, see iso_m.frontend._CONTROL); a line is passed
+ * over when it holds none of them in either case and nothing beyond ASCII (whose upper case
+ * might be one), or when it is plain words (what scan() steps over). The front end then searches
+ * only the lines this stops at: most of a CAM program is never looked at in Python. */
+static PyObject *quiet(PyObject *self, PyObject *args)
+{
+    PyObject *str;
+    Py_ssize_t pos;
+    int sepc;
+    const char *marks;
+    if (!PyArg_ParseTuple(args, "UnCs", &str, &pos, &sepc, &marks))
+        return NULL;
+    Text t;
+    if (get_text(str, &t) < 0)
+        return NULL;
+    if (pos < 0 || pos > t.len) {
+        PyErr_SetString(PyExc_ValueError, "quiet: pos outside the text");
+        return NULL;
+    }
+    unsigned char mark[256] = {0};
+    for (const unsigned char *m = (const unsigned char *)marks; *m; m++) {
+        mark[*m] = 1;
+        if (*m >= 'A' && *m <= 'Z')
+            mark[*m - 'A' + 'a'] = 1;
+        else if (*m >= 'a' && *m <= 'z')
+            mark[*m - 'a' + 'A'] = 1;
+    }
+    for (int c = 128; c < 256; c++)
+        mark[c] = 1;
+    char buf[MAX_LINE + 1];
+    while (pos < t.len) {
+        Py_ssize_t q = line_end(&t, pos, (Py_UCS4)sepc);
+        int marked = 0;
+        if (t.kind == PyUnicode_1BYTE_KIND) {
+            const unsigned char *d = (const unsigned char *)t.data;
+            for (Py_ssize_t i = pos; i < q && !marked; i++)
+                marked = mark[d[i]];
+        } else {
+            for (Py_ssize_t i = pos; i < q && !marked; i++) {
+                Py_UCS4 c = PyUnicode_READ(t.kind, t.data, i);
+                marked = c >= 128 || mark[c];
+            }
+        }
+        if (marked && !plain_in_any_state(buf, read_line(&t, pos, q, buf)))
+            break;
+        pos = q + 1;
+    }
+    return PyLong_FromSsize_t(pos < t.len ? pos : t.len);
 }
 
 /* ------------------------------------------------------------------ output buffer */
@@ -651,13 +745,13 @@ static PyObject *run(PyObject *self, PyObject *args)
 
     while (pos < end && blocks < max_blocks) {
         Py_ssize_t q = line_end(&t, pos, (Py_UCS4)sepc);
-        if (blank_line(&t, pos, q)) {
+        int n = read_line(&t, pos, q, line);
+        if (n == LINE_BLANK) {
             pos = q + 1;
             lineno++;
             continue;
         }
-        int n = clean_line(&t, pos, q, line);
-        if (n <= 0 || !parse_block(line, n, &b))
+        if (n < 0 || !parse_block(line, n, &b))
             break;                      /* not a run scan() gave: Python takes over */
         /* Work out the whole block before changing any state, so a block the kernel cannot do
          * identically is left entirely to Python. Order as the interpreter: feed, mode, motion. */
@@ -897,6 +991,8 @@ static PyMethodDef methods[] = {
     {"spell", spell_py, METH_O, "spell(v) -> the JSON spelling of v, or None where only repr() spells it"},
     {"scan", scan, METH_VARARGS,
      "scan(text, pos, sep, motion, cycle_off, arc_abs[, strict]) -> (end, lines, blocks, motion)"},
+    {"quiet", quiet, METH_VARARGS,
+     "quiet(text, pos, sep, marks) -> where the first line that may hold a control mark starts"},
     {"run", run, METH_VARARGS, "run the plain blocks of a scanned run (see the module source)"},
     {NULL, NULL, 0, NULL},
 };
@@ -908,5 +1004,7 @@ static struct PyModuleDef module = {
 
 PyMODINIT_FUNC PyInit__plainrun(void)
 {
+    for (int c = 0; c < 256; c++)
+        CLASS_OF_BYTE[c] = (unsigned char)char_class((Py_UCS4)c);
     return PyModule_Create(&module);
 }

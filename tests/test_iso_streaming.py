@@ -136,3 +136,32 @@ def test_control_flow_check_same_with_and_without_the_kernel_scan():
         plainrun.native = saved
     assert with_kernel == without
     assert with_kernel[-5:] == [True, False, True, False, False]
+
+
+# Lines that a control-flow mark may hide in (or look like one): plain CAM words, the marks in
+# several spellings and cases, comments holding them, characters whose upper case is a mark's
+# ("ı" -> "I"), spaces inside words, CR line ends.
+_CAM_WORDS = st.sampled_from(["N10 ", "G1", "G01 ", "G2", "G3", "X1.5", "Y-2", "Z.5", "I1.", "J-0.5", "F300.",
+                              " ", "W2.", "g1", "x3"])
+_MARKED = st.sampled_from(["GOTO5", "goto 5", "IF[#1GT0]", "ıF", "WHILE[1]DO1", "END 1", "DO2", "#1=5",
+                           "G65P1", "G 6 6", "G0066", "M98P5", "M 9 9", "M17", "[", "(GOTO 5)", ";IF",
+                           "(G65", "M30", "M3", "G64", "END", "DOX", "E1", "D1", "(WHILE)X1"])
+_LINE = st.lists(st.one_of(*[_CAM_WORDS] * 6, _MARKED), max_size=5).map("".join)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(_LINE, max_size=30), st.sampled_from(["\n", "\r\n"]), st.booleans())
+def test_control_flow_found_at_the_same_place_with_and_without_the_kernel(lines, newline, semicolon):
+    """The kernel only passes over lines that hold no mark: the first mark (its offset, or none)
+    is the one the pattern finds searching the whole text."""
+    from nctrans import plainrun
+    from nctrans.dialects.iso_m.frontend import _control_flow_at
+    text = newline.join(lines)
+    saved = plainrun.native
+    try:
+        with_kernel = _control_flow_at(text, semicolon)
+        plainrun.native = None
+        without = _control_flow_at(text, semicolon)
+    finally:
+        plainrun.native = saved
+    assert with_kernel == without
