@@ -470,7 +470,10 @@ static PyObject *quiet(PyObject *self, PyObject *args)
 
 /* ------------------------------------------------------------------ output buffer */
 
+/* The JSON text is written straight into an ASCII str (no copy into one at the end): `str` holds
+ * `cap` characters, the first `len` written. */
 typedef struct {
+    PyObject *str;
     char *data;
     size_t len, cap;
 } Buf;
@@ -482,14 +485,31 @@ static int buf_grow(Buf *b, size_t extra)
     size_t cap = b->cap ? b->cap : 1 << 16;
     while (cap < b->len + extra)
         cap *= 2;
-    char *d = PyMem_Realloc(b->data, cap);
-    if (d == NULL) {
-        PyErr_NoMemory();
+    PyObject *s = PyUnicode_New((Py_ssize_t)cap, 127);
+    if (s == NULL)
         return -1;
-    }
+    char *d = (char *)PyUnicode_1BYTE_DATA(s);
+    if (b->len)
+        memcpy(d, b->data, b->len);
+    Py_XDECREF(b->str);
+    b->str = s;
     b->data = d;
     b->cap = cap;
     return 0;
+}
+
+/* The text written as a str of its length (the buffer is handed over), or None when empty. */
+static PyObject *buf_take(Buf *b)
+{
+    PyObject *s = b->str;
+    b->str = NULL;
+    if (s == NULL || b->len == 0) {
+        Py_XDECREF(s);
+        return Py_NewRef(Py_None);
+    }
+    if (PyUnicode_Resize(&s, (Py_ssize_t)b->len) < 0)
+        return NULL;                    /* s was released */
+    return s;
 }
 
 static int buf_put(Buf *b, const char *s, size_t n)
@@ -735,9 +755,11 @@ static PyObject *run(PyObject *self, PyObject *args)
     int feed_seen = 0, moved = 0, last_was_arc = 0, last_cw = 0, last_g = -1;
     double last_c1 = 0.0, last_c2 = 0.0;
     Py_ssize_t blocks = 0, records = 0;
-    Buf out = {NULL, 0, 0};
+    Buf out = {NULL, NULL, 0, 0};
     char line[MAX_LINE + 1];
-    char start_json[MAX_AXES * 48 + 4], end_json[MAX_AXES * 48 + 4], center_json[3 * 48 + 4];
+    /* the last move's end is the next one's start: two buffers that swap roles */
+    char point_a[MAX_AXES * 48 + 4], point_b[MAX_AXES * 48 + 4], center_json[3 * 48 + 4];
+    char *start_json = point_a, *end_json = point_b;
     char feed_json[40];
     int start_len = -1, feed_len = -1;
     double feed_spelled = 0.0;          /* the feed feed_json spells (valid when feed_len >= 0) */
@@ -895,7 +917,9 @@ static PyObject *run(PyObject *self, PyObject *args)
                 }
                 PUT(tail_json, tail_len);
                 PUTS("}\n");
-                memcpy(start_json, end_json, (size_t)el + 1);
+                char *was_start = start_json;
+                start_json = end_json;
+                end_json = was_start;
                 start_len = el;
             }
             memcpy(from, prog, sizeof prog);
@@ -921,16 +945,9 @@ static PyObject *run(PyObject *self, PyObject *args)
         pos = q + 1;
         lineno++;
     }
-    PyObject *chunk;
-    if (write && out.len) {
-        chunk = PyUnicode_DecodeASCII(out.data, (Py_ssize_t)out.len, NULL);
-        if (chunk == NULL)
-            goto fail;
-    } else {
-        chunk = Py_NewRef(Py_None);
-    }
-    PyMem_Free(out.data);
-    out.data = NULL;
+    PyObject *chunk = buf_take(&out);
+    if (chunk == NULL)
+        return NULL;
     PyObject *prog_l = doubles_list(prog, naxes), *mach_l = doubles_list(mach, naxes);
     PyObject *from_l = moved ? doubles_list(from, naxes) : Py_NewRef(Py_None);
     PyObject *feed_o = has_feed ? PyFloat_FromDouble(feed) : Py_NewRef(Py_None);
@@ -948,7 +965,7 @@ static PyObject *run(PyObject *self, PyObject *args)
     return Py_BuildValue("(nnnNnNNiNiNNi)", pos, lineno, blocks, chunk, records, prog_l, mach_l,
                          motion, feed_o, feed_seen, from_l, arc_o, last_g);
 fail:
-    PyMem_Free(out.data);
+    Py_XDECREF(out.str);
     return NULL;
 }
 
