@@ -135,6 +135,14 @@ class Lowering:
     dialect = DIALECT
     table_name = DIALECT
     code_kind = "an ISO milling code"       # NC403 wording for an unknown G code
+    # Whether a streamed parse may hand runs of plain lines to the native kernel (plainrun): only
+    # where a plain line means what Lowering.plain_line makes of it.
+    plain_runs = True
+
+    @classmethod
+    def program_defaults(cls, table) -> dict:
+        """The power-on modes the program starts from (Program.meta["defaults"])."""
+        return table.defaults()
 
     def __init__(self, file: str, diags: list[Diagnostic]):
         self.table = load_table(self.table_name)
@@ -923,7 +931,7 @@ def parse_stream(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lo
     # The interpreter reads the power-on modes when it starts, before the body is first iterated
     # (which is when _parse_lines fills the rest of meta): without them a streamed program ran
     # from no work offset while the full parse ran from G54.
-    program.meta["defaults"] = table.defaults()
+    program.meta["defaults"] = lowering.program_defaults(table)
     program.body = StreamedBody(_parse_lines(text, file, program, diags, [], True, lowering))
     return ParseResult(program, diags)
 
@@ -967,7 +975,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     semicolon_comment = opts.get("eob_semicolon", "comment") != "eob"
     max_do_nesting = int(opts.get("max_do_nesting", limits.MAX_STRUCTURE_NESTING))
     meta: dict = program.meta
-    meta.update({"program_number": None, "percent": False, "defaults": low.table.defaults(),
+    meta.update({"program_number": None, "percent": False, "defaults": low.program_defaults(low.table),
                  "options": dict(opts)})
     name = None
     subprograms: dict[str, Subprogram] = program.subprograms
@@ -985,7 +993,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     lines = _Lines(text, sep) if stream else enumerate(text.split(sep), 1)
     # Streamed and with the native kernel: runs of plain lines become one PlainRun each.
     plain_scan = plainrun.native.scan if stream and plainrun.native is not None and not low.standard \
-        else None
+        and low.plain_runs else None
     plain_line = low.plain_line
     fast_plain = PLAIN.fullmatch
     fast_words = WORD.findall

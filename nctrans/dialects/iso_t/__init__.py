@@ -47,7 +47,7 @@ class IsoTurning(IsoFamily):
         strong = any(m.weight >= 4.0 and m.pattern.search(head) for m in LATHE_MARKERS)
         return super().sniff(text) if strong else 0.0
 
-    streams = False                     # G70-G73 read their contour blocks from the whole body
+    streams = True                      # programs without G70-G73 (frontend.parse_stream)
 
     def lowering(self):
         from .frontend import TurningLowering
@@ -60,3 +60,7 @@ class IsoTurning(IsoFamily):
     def parse(self, text: str, file: str = "<stdin>") -> ParseResult:
         from .frontend import parse_program
         return parse_program(text, file)
+
+    def parse_stream(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        from .frontend import parse_stream
+        return parse_stream(text, file)

@@ -11,6 +11,7 @@ What differs from milling, and nothing else:
 """
 from __future__ import annotations
 
+import re
 from typing import Any, Optional
 
 from nctrans.diagnostics import Diagnostic
@@ -55,6 +56,17 @@ class TurningLowering(iso.Lowering):
             if target is not None:
                 return self.table.lookup(target)
         return super().code(letter, text)
+
+    plain_runs = False              # U/W are increments, T0101 selects and changes: no line is plain
+
+    @classmethod
+    def program_defaults(cls, table) -> dict:
+        """The family's power-on modes; the program starts in diameter mode when X is the
+        diameter axis (the table's diameter_axis)."""
+        defaults = super().program_defaults(table)
+        if table.options.get("diameter_axis", "X") == "X":
+            defaults["diameter"] = "diameter"
+        return defaults
 
     def hot(self, words: list):
         return None                 # every block goes through lower(): U/W, T and modal cycles
@@ -191,10 +203,21 @@ class TurningLowering(iso.Lowering):
                                               "parameters" if form != kind else "")))
 
 
+# G70-G73 (G72-G75 in G-code system C) read their contour blocks N<P>..N<Q> from the whole body
+# (nctrans.interp.lathe): a program with any G7x word is parsed whole. Matches in comments only
+# cost the streaming.
+_WHOLE_BODY = re.compile(r"G[ \t]*0*7[ \t]*\d", re.IGNORECASE)
+
+
 def parse_program(text: str, file: str = "<stdin>"):
-    """Parse ISO turning text; the program starts in diameter mode (the table's diameter_axis)."""
-    result = iso.parse_program(text, file, TurningLowering)
-    meta = result.program.meta
-    if meta.get("options", {}).get("diameter_axis", "X") == "X":
-        meta["defaults"]["diameter"] = "diameter"
-    return result
+    """Parse ISO turning text; the program starts in diameter mode (the table's diameter_axis,
+    TurningLowering.program_defaults)."""
+    return iso.parse_program(text, file, TurningLowering)
+
+
+def parse_stream(text: str, file: str = "<stdin>"):
+    """The ISO family's lazy parse (iso_m.frontend.parse_stream) for turning programs that run
+    straight through; None when a contour cycle needs the whole body."""
+    if _WHOLE_BODY.search(text) is not None:
+        return None
+    return iso.parse_stream(text, file, TurningLowering)
