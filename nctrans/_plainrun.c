@@ -476,13 +476,14 @@ typedef struct {
     PyObject *str;
     char *data;
     size_t len, cap;
+    size_t first_cap;           /* the size to start with: enough for the whole run as a rule */
 } Buf;
 
 static int buf_grow(Buf *b, size_t extra)
 {
     if (b->len + extra <= b->cap)
         return 0;
-    size_t cap = b->cap ? b->cap : 1 << 16;
+    size_t cap = b->cap ? b->cap : (b->first_cap > (1 << 12) ? b->first_cap : 1 << 12);
     while (cap < b->len + extra)
         cap *= 2;
     PyObject *s = PyUnicode_New((Py_ssize_t)cap, 127);
@@ -512,7 +513,7 @@ static PyObject *buf_take(Buf *b)
     return s;
 }
 
-static int buf_put(Buf *b, const char *s, size_t n)
+static inline int buf_put(Buf *b, const char *s, size_t n)
 {
     if (buf_grow(b, n) < 0)
         return -1;
@@ -755,7 +756,12 @@ static PyObject *run(PyObject *self, PyObject *args)
     int feed_seen = 0, moved = 0, last_was_arc = 0, last_cw = 0, last_g = -1;
     double last_c1 = 0.0, last_c2 = 0.0;
     Py_ssize_t blocks = 0, records = 0;
-    Buf out = {NULL, NULL, 0, 0};
+    /* Growing the output by doubling copies it about once more; start it at what the run will
+     * most likely write: up to max_blocks records of the longest likely size (the text holds at
+     * most one block per 3 characters, `X1\n`). The str is cut to its length at the end. */
+    Py_ssize_t likely_blocks = (end - pos) / 3 + 1 < max_blocks ? (end - pos) / 3 + 1 : max_blocks;
+    Buf out = {NULL, NULL, 0, 0,
+               (size_t)likely_blocks * (size_t)(160 + file_len + fm_len + tail_len + 2 * naxes * 24 + 3 * 24)};
     char line[MAX_LINE + 1];
     /* the last move's end is the next one's start: two buffers that swap roles */
     char point_a[MAX_AXES * 48 + 4], point_b[MAX_AXES * 48 + 4], center_json[3 * 48 + 4];
