@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Optional, Sequence, Union
 
+from nctrans import limits
 from nctrans import pipeline
 from nctrans import linting
 from nctrans import source as _source
@@ -248,10 +249,16 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
             program = ld.program
             flat_machine = _machine(machine, ld.dialect)
 
+            # the plain motion held whole is bounded, except where the caller asked for the
+            # whole flattened text (flatten=True and no `out` to stream to)
+            held = None if flatten and out is None else limits.setting(
+                "MAX_LOWERED_BLOCKS", limits.MAX_LOWERED_BLOCKS)
+
             def flatten_with(into: list[Diagnostic]) -> Program:
                 from nctrans.lower.flatten import flatten as _flatten
                 result: Program = _flatten(program, flat_machine, diagnostics=into,
-                                           resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
+                                           resolver=pipeline.make_resolver(ld.source_dir, ld.dialect),
+                                           max_blocks=held)
                 return result
 
             result: Any = None

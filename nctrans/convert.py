@@ -27,6 +27,9 @@ from nctrans.ir.nodes import Block, Program
 # structural-share benchmark counts them).
 WHOLE_PROGRAM_NOTE = "the program was lowered to plain motion"
 CONSTRUCT_NOTE = "lowered to plain motion here"
+# Words of the NC402 reason of a construct whose plain motion is over limits.MAX_LOWERED_BLOCKS: the
+# whole program lowered would be larger still, so it is not tried without --flatten (which streams).
+HELD_LIMIT_NOTE = "the most a conversion holds in memory"
 
 
 @dataclass
@@ -136,7 +139,8 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
             kept = {(d.file, d.line) for d in remaining}
             remaining = remaining + [d for d in again.diagnostics
                                      if _is_refusal(d) and (d.file, d.line) not in kept]
-        whole = _lower_whole(program, target, flatten_with, remaining) if remaining else None
+        too_large = any(HELD_LIMIT_NOTE in d.message for d in remaining)
+        whole = _lower_whole(program, target, flatten_with, remaining) if remaining and not too_large else None
         if whole is not None:
             # some construct could not be lowered on its own: the whole program as plain motion
             diags.extend(whole[1])

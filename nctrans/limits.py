@@ -39,6 +39,12 @@ MAX_STRING = 200
 # Repeated execution (loop iterations, jumps back, calls) of one run before NC205 stops it;
 # straight-line blocks run the first time are free. NCTRANS_MAX_STEPS overrides it.
 MAX_STEPS = 2_000_000
+# Blocks of plain motion a conversion holds in memory when it is not streamed: one construct the
+# target lacks, lowered on its own (an endless loop around it would otherwise grow until the step
+# budget: gigabytes), or a whole program lowered as the last resort. Beyond it the construct is
+# refused (NC402 at its line) and `convert --flatten` streams the whole program instead (~1 KiB of
+# IR per block: 100,000 blocks ~ 100 MiB). NCTRANS_MAX_LOWERED_BLOCKS overrides it.
+MAX_LOWERED_BLOCKS = 100_000
 # Elements of one declared array (DEF REAL A[n,m]): REP() and SET() walk them all.
 MAX_ARRAY_ELEMENTS = 1_000_000
 

@@ -60,3 +60,27 @@ def test_expressible_program_stays_structured():
     assert "WHILE" in res.text.upper()
     out = get("sinumerik").parse(res.text, "p.mpf").program
     assert equiv.compare(_records(program), _records(out)) is None
+
+
+def test_a_lowered_construct_holds_at_most_the_documented_number_of_blocks(monkeypatch):
+    """The label loop (3 passes, 2 moves each) is more than 4 blocks of plain motion: with the
+    held limit at 4 it is refused at the construct's line, naming the limit, and the whole program
+    is not lowered instead (it would be larger still)."""
+    from nctrans.convert import HELD_LIMIT_NOTE
+    monkeypatch.setenv("NCTRANS_MAX_LOWERED_BLOCKS", "4")
+    _, res = _convert(SIN, "sinumerik", "iso-m")
+    assert res.text is None and not res.flattened
+    refused = [d for d in res.diagnostics if d.rule == "NC402" and d.severity == "error"]
+    assert [d.line for d in refused] == [7]
+    assert HELD_LIMIT_NOTE in refused[0].message and "past 4 blocks" in refused[0].message
+    monkeypatch.setenv("NCTRANS_MAX_LOWERED_BLOCKS", "40")
+    _, res = _convert(SIN, "sinumerik", "iso-m")
+    assert res.text is not None
+
+
+def test_the_whole_program_held_in_memory_is_bounded_too():
+    program = get("iso-m").parse("G21 G90\nG1 X1 F100\nX2\nX3\nX4\nX5\nM30\n", "p.nc").program
+    diags: list = []
+    flat = flatten(program, None, diagnostics=diags, max_blocks=3)
+    assert len(flat.body) == 4
+    assert [(d.rule, d.severity, d.line) for d in diags if d.rule == "NC402"] == [("NC402", "error", 4)]

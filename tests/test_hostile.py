@@ -288,6 +288,36 @@ def test_sigterm_leaves_no_temporary_file(tmp_path):
 
 # --------------------------------------------------------------------------- scale (8)
 
+ENDLESS_AROUND_A_CYCLE = ("%\nO1\nG90 G54 G17\nT1 M6\nG43 H1 Z50.\nWHILE[1LT2]DO1\n"
+                          "G99 {cycle} X1. Y1. Z-5. R1. Q0.5 K2\nG80\nEND1\nM30\n%\n")
+
+
+@pytest.mark.parametrize("cycle, target", [("G73", "sinumerik"), ("G83", "fagor"), ("G83", "iso-m")])
+def test_endless_loop_around_a_lowered_cycle_is_refused_at_the_held_limit(tmp_path, cycle, target):
+    """An endless WHILE around a cycle the target lacks: lowering that loop alone to plain motion
+    would hold every record until the step budget (19 GB seen). It stops at the documented limit
+    of blocks held in memory, with NC402 at the cycle's line, default limits, and writes nothing."""
+    f = write(tmp_path, "e.nc", ENDLESS_AROUND_A_CYCLE.format(cycle=cycle))
+    rc, out, err = run("convert", f.name, "--from", "iso-m", "--to", target, "-o", "e.out", cwd=tmp_path)
+    if target == "iso-m":                   # the target writes the cycle: nothing to lower
+        assert rc == 0 and "WHILE" in (tmp_path / "e.out").read_text(), err
+        return
+    assert rc == 1 and located(err, "NC402", "e.nc", 7, 1), err
+    assert "NCTRANS_MAX_LOWERED_BLOCKS" in err and "--flatten" in err
+    assert not (tmp_path / "e.out").exists()
+
+
+def test_the_held_limit_also_bounds_the_whole_program_fallback(tmp_path):
+    """The loop sets #1, which the rest reads, so it cannot be lowered alone; the whole program
+    lowered (the last resort) is bounded the same way."""
+    text = ENDLESS_AROUND_A_CYCLE.format(cycle="G73").replace("G80\n", "G80\n#1=#1+1\n").replace(
+        "END1\n", "END1\nG0 X#1\n")
+    f = write(tmp_path, "e.nc", text)
+    rc, out, err = run("convert", f.name, "--from", "iso-m", "--to", "sinumerik", "-o", "e.out", cwd=tmp_path)
+    assert rc == 1 and located(err, "NC402", "e.nc", 7, 1), err
+    assert not (tmp_path / "e.out").exists()
+
+
 def test_long_straight_program_gives_all_its_moves_and_converts_streamed(tmp_path):
     """3 M straight blocks: every move comes out (the step budget counts repetition only), and the
     streamed conversion gives the text the whole-program conversion gives."""

@@ -16,7 +16,10 @@ A segment is left as a refusal (NC402, saying why) when replacing it alone would
 in the main program (a subprogram's body runs once per call), jumps cross its border, it sets
 variables read elsewhere, it runs more or less than once, cutter compensation, a programmable frame,
 G92 or a local offset is active at its border, or it holds what plain motion cannot carry (an
-unresolved call, an unmodelled construct).
+unresolved call, an unmodelled construct). A segment's plain motion is held in memory until the
+program is emitted again, so it is bounded (limits.MAX_LOWERED_BLOCKS): an endless loop around a
+construct is refused at that bound, not after the step budget (gigabytes later), and the run stops
+as soon as every segment is refused.
 """
 from __future__ import annotations
 
@@ -24,13 +27,17 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
+from nctrans import limits
 from nctrans.diagnostics import Diagnostic
 from nctrans.interp.interpreter import Interpreter
 from nctrans.lower.flatten import ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Walker
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks, walk
 
-from nctrans.convert import CONSTRUCT_NOTE as NOTE
+from nctrans.convert import CONSTRUCT_NOTE as NOTE, HELD_LIMIT_NOTE
+
+class _AllRefused(Exception):
+    """Raised from the run's hook once every segment is refused: the rest of the run is moot."""
 
 MARKER_FILE = "<nctrans:segment>"
 
@@ -423,6 +430,15 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
     interp_diags: list[Diagnostic] = []
     current: list[Optional[Segment]] = [None]
     interp: list[Optional[Interpreter]] = [None]
+    most = limits.setting("MAX_LOWERED_BLOCKS", limits.MAX_LOWERED_BLOCKS)
+
+    def refuse(seg: Segment, why: str) -> None:
+        """`seg` cannot be lowered: drop what it holds, and end the run once nothing is left to
+        lower."""
+        seg.why_not = seg.why_not or why
+        seg.flattener = None
+        if all(s.why_not is not None for s in segments):
+            raise _AllRefused()
 
     def hook(rec, work_end, work_center):
         if rec.file == MARKER_FILE:
@@ -432,6 +448,10 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
             if rec.line % 2 == 0:
                 seg.starts += 1
                 seg.diag_mark = len(interp_diags)
+                if seg.starts > 1:
+                    current[0] = None
+                    refuse(seg, "it does not run exactly once")
+                    return
                 if state["comp"]:
                     seg.why_not = "cutter radius compensation is on where it starts"
                 elif it.st.diameter or getattr(it, "css_surface", None) is not None:
@@ -467,11 +487,19 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
                 rec.end is not None and all(abs(rec.end[a] - rec.start.get(a, rec.end[a])) < 1e-9 for a in rec.end):
             return      # G28's intermediate point where the tool already is: LinuxCNC does not move
         seg.flattener.hook(rec, work_end, work_center)
+        if len(seg.flattener.blocks) > most:
+            current[0] = None
+            refuse(seg, f"its plain motion runs past {most:,} blocks, {HELD_LIMIT_NOTE} "
+                        "(NCTRANS_MAX_LOWERED_BLOCKS; an endless loop?); convert --flatten streams "
+                        "the whole program instead")
 
     it = Interpreter(marked, machine, diagnostics=interp_diags, resolver=resolver, flatten_hook=hook)
     interp[0] = it
-    for _ in it.run():
-        pass
+    try:
+        for _ in it.run():
+            pass
+    except _AllRefused:
+        return
     for seg in segments:
         if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
             for d in interp_diags[seg.diag_mark:]:

@@ -40,6 +40,7 @@ import dataclasses
 import re
 from typing import Any, Callable, Iterator, Optional
 
+from nctrans.convert import HELD_LIMIT_NOTE as HELD_LIMIT
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
@@ -428,11 +429,24 @@ def _walked(body, walker: "_Walker") -> Iterator:
 
 
 def flatten(program: n.Program, machine=None, *, diagnostics: list,
-            resolver: Optional[Callable] = None, max_steps: Optional[int] = None) -> n.Program:
+            resolver: Optional[Callable] = None, max_steps: Optional[int] = None,
+            max_blocks: Optional[int] = None) -> n.Program:
     """Plain-motion Program equivalent to `program` on `machine` (default mill); NC4xx diagnostics
-    (and the interpreter's own) are appended to `diagnostics`."""
-    blocks = list(flatten_blocks(program, machine, diagnostics=diagnostics, resolver=resolver,
-                                 max_steps=max_steps))
+    (and the interpreter's own) are appended to `diagnostics`. With `max_blocks` the program held
+    in memory stops there: the run ends and an NC402 error at the last block says so (the
+    flattened program is incomplete; flatten_blocks streams it instead)."""
+    stream = flatten_blocks(program, machine, diagnostics=diagnostics, resolver=resolver,
+                            max_steps=max_steps)
+    blocks: list = []
+    for block in stream:
+        blocks.append(block)
+        if max_blocks is not None and len(blocks) > max_blocks:
+            stream.close()
+            diagnostics.append(Diagnostic(
+                "NC402", "error", f"the program lowered to plain motion runs past {max_blocks:,} "
+                f"blocks, {HELD_LIMIT} (NCTRANS_MAX_LOWERED_BLOCKS; an endless loop?): convert "
+                "--flatten streams it instead", block.span.file, block.span.line))
+            break
     return n.Program(program.file, program.dialect, blocks, {}, flattened_meta(program), None)
 
 
