@@ -8,6 +8,7 @@ then on) and fuzzing goes on. Usage: python fuzz/fuzz_frontends.py [SECONDS per 
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import subprocess
@@ -24,8 +25,34 @@ SEEDS = {"iso-m": CORPUS / "iso-mill", "iso-t": CORPUS / "iso-turn", "sinumerik"
 RUNS_PER_DIALECT = 5        # fuzzing restarts after each crash kept, at most this often
 
 
+# Fuzzing looks for crashes, not for scale: with the default budgets one mutant that loops
+# forever runs 2 M steps four times over (minutes), and a seed with a real 100k-move loop
+# (dubovikov-konus.mpf) took 3.5 min per input. Smaller budgets give the same stops sooner;
+# tests/test_hostile*.py hold the defaults to their bounds.
+FUZZ_LIMITS = {"NCTRANS_MAX_STEPS": "5000", "NCTRANS_MAX_LOWERED_BLOCKS": "5000"}
+
+
+@contextlib.contextmanager
+def fuzz_limits():
+    saved = {k: os.environ.get(k) for k in FUZZ_LIMITS}
+    os.environ.update(FUZZ_LIMITS)
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
 def one_input(dialect: str, data: bytes) -> None:
     """Everything a user can run on `data` as `dialect`; only bugs raise."""
+    with fuzz_limits():
+        _run_all(dialect, data)
+
+
+def _run_all(dialect: str, data: bytes) -> None:
     from nctrans import api, pipeline, source
     src = source.decode(data[:16 * 1024], "fuzz")
     if not src.ok:

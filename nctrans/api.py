@@ -258,8 +258,21 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                 from nctrans.lower.flatten import flatten as _flatten
                 result: Program = _flatten(program, flat_machine, diagnostics=into,
                                            resolver=pipeline.make_resolver(ld.source_dir, ld.dialect),
-                                           max_blocks=held)
+                                           max_blocks=held, stop_when_incomplete=not flatten)
                 return result
+
+            stream_whole = None
+            if out is not None:
+                def stream_whole(notes: list[Diagnostic]) -> Any:
+                    """The last resort, lowering the whole program, written as it runs."""
+                    from nctrans.convert import Conversion as Converted
+                    done = _transpile_flat_stream(ld, target, strict, out, flat_machine,
+                                                  stop_when_incomplete=True)
+                    if done is None:
+                        return None
+                    if done.text is None:
+                        out.reset()
+                    return Converted(done.text, [*notes, *done.diagnostics], flattened=True)
 
             result: Any = None
             if flatten and out is not None:         # written as the run goes: flat memory
@@ -267,7 +280,8 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
             if result is None:
                 result = convert(program, target, flatten=flatten, strict_mode=strict,
                                  flatten_with=flatten_with, machine=flat_machine,
-                                 resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
+                                 resolver=pipeline.make_resolver(ld.source_dir, ld.dialect),
+                                 stream_whole=stream_whole)
             diags.extend(result.diagnostics)
             out_text = result.text
         elif strict:
@@ -283,9 +297,10 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
 
 
 def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any,
-                           machine: Machine) -> Optional[Conversion]:
+                           machine: Machine, stop_when_incomplete: bool = False) -> Optional[Conversion]:
     """--flatten with an output sink: the flattened blocks are written as the interpreter makes
-    them (convert_flat_stream); None when the target cannot stream (the sink is then reset)."""
+    them (convert_flat_stream); None when the target cannot stream (the sink is then reset).
+    `stop_when_incomplete`: see flatten_blocks."""
     from nctrans.convert import convert_flat_stream
     from nctrans.lower.flatten import flatten_blocks, flattened_meta
     program = ld.program
@@ -294,7 +309,8 @@ def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: 
     resolver = pipeline.make_resolver(ld.source_dir, ld.dialect)
 
     def blocks(into: list[Diagnostic]) -> Iterator[Any]:
-        return flatten_blocks(program, machine, diagnostics=into, resolver=resolver)
+        return flatten_blocks(program, machine, diagnostics=into, resolver=resolver,
+                              stop_when_incomplete=stop_when_incomplete)
 
     result = convert_flat_stream(program, target, blocks, flattened_meta(program), out.write, strict_mode=strict)
     if result is None:

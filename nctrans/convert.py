@@ -15,6 +15,7 @@ The policy, in one place (sqlglot's "unsupported level"):
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Optional
 
@@ -68,17 +69,24 @@ def _library_refusal(program: Program, entry: str, target: str) -> Diagnostic:
 
 def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list[Diagnostic]):
     """(emission, diagnostics) of the whole program lowered to plain motion, the last resort when
-    a construct cannot be lowered on its own; None when that is refused too."""
+    a construct cannot be lowered on its own; (None, [the held-limit error]) when that is refused
+    too (its other reasons are the refusals themselves; the limit is news to the user, so the
+    caller adds it to them)."""
     flat_diags: list[Diagnostic] = []
     flat = lower_for(flatten_with(flat_diags), target, flat_diags)
     again = target.emit(flat)
-    found = [*(Diagnostic("NC401", "info", f"{d.message} — {target.name} cannot express it, so "
-                          f"{WHOLE_PROGRAM_NOTE} (as with --flatten)", d.file, d.line, d.column,
-                          d.end_line, d.end_column) for d in refusals),
-             *flat_diags, *again.diagnostics]
+    found = [*(_whole_note(d, target) for d in refusals), *flat_diags, *again.diagnostics]
     if any(d.severity == "error" for d in found):
-        return None
+        return None, [d for d in found if d.severity == "error" and HELD_LIMIT_NOTE in d.message]
     return again, found
+
+
+def _whole_note(refusal: Diagnostic, target: Dialect) -> Diagnostic:
+    """The NC401 that says a refusal made the whole program plain motion."""
+    d = refusal
+    return Diagnostic("NC401", "info", f"{d.message} — {target.name} cannot express it, so "
+                      f"{WHOLE_PROGRAM_NOTE} (as with --flatten)", d.file, d.line, d.column,
+                      d.end_line, d.end_column)
 
 
 def header(program: Program) -> str:
@@ -110,11 +118,14 @@ def strict(diags: list[Diagnostic]) -> list[Diagnostic]:
 
 def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callable[[list], Program]],
             flatten: bool = False, strict_mode: bool = False, machine=None,
-            resolver: Optional[Callable] = None) -> Conversion:
+            resolver: Optional[Callable] = None,
+            stream_whole: Optional[Callable[[list], Optional[Conversion]]] = None) -> Conversion:
     """Emit `program` in `target`. `flatten_with(diagnostics) -> Program` lowers it to plain motion
     (it closes over the machine and the subprogram resolver); None when lowering is unavailable
     (single constructs are then not lowered either). `machine` and `resolver` serve the run that
-    lowers single constructs."""
+    lowers single constructs. `stream_whole(notes)`, when given, lowers the whole program (the last
+    resort) written as it runs, not held: a Conversion with `notes` first (its text "" when
+    written, None when refused and the output discarded), or None when the target cannot stream."""
     diags: list[Diagnostic] = []
     flattened = False
     library = _library_entry(program)
@@ -140,8 +151,16 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
             remaining = remaining + [d for d in again.diagnostics
                                      if _is_refusal(d) and (d.file, d.line) not in kept]
         too_large = any(HELD_LIMIT_NOTE in d.message for d in remaining)
-        whole = _lower_whole(program, target, flatten_with, remaining) if remaining and not too_large else None
-        if whole is not None:
+        streamed = stream_whole([_whole_note(d, target) for d in remaining]) \
+            if remaining and not too_large and stream_whole is not None else None
+        if streamed is not None and streamed.text is not None:
+            return streamed
+        whole = _lower_whole(program, target, flatten_with, remaining) \
+            if remaining and not too_large and streamed is None else None
+        if whole is not None and whole[0] is None and whole[1]:
+            remaining = [dataclasses.replace(d, message=f"{d.message}; {whole[1][0].message}")
+                         for d in remaining]
+        if whole is not None and whole[0] is not None:
             # some construct could not be lowered on its own: the whole program as plain motion
             diags.extend(whole[1])
             result, flattened = whole[0], True

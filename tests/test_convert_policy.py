@@ -84,3 +84,35 @@ def test_the_whole_program_held_in_memory_is_bounded_too():
     flat = flatten(program, None, diagnostics=diags, max_blocks=3)
     assert len(flat.body) == 4
     assert [(d.rule, d.severity, d.line) for d in diags if d.rule == "NC402"] == [("NC402", "error", 4)]
+
+
+class _Sink:
+    def __init__(self):
+        self.parts: list = []
+
+    def write(self, text):
+        self.parts.append(text)
+
+    def reset(self):
+        self.parts = []
+
+
+def test_the_whole_program_fallback_streams_past_the_held_limit(monkeypatch):
+    """The label loop sets R1, which outlives the program, so it cannot be lowered alone: the
+    whole program becomes plain motion (100 moves). Held in memory that is over a limit of 50
+    blocks (refused, saying so at the construct); written to an output as it runs it is not, and
+    the text is the one the default limit gives."""
+    from nctrans import api
+    from nctrans.convert import HELD_LIMIT_NOTE
+    text = "G17 G90 G71\nR1=0\nLBL:\nG1 X=AC(R1) Y=IC(1) F100\nR1=R1+1\nIF R1<100 GOTOB LBL\nM30\n"
+    held = api.transpile(text, "sinumerik", "iso-m")
+    assert held.text is not None and held.text.count("\nX") == 99
+    monkeypatch.setenv("NCTRANS_MAX_LOWERED_BLOCKS", "50")
+    refused = api.transpile(text, "sinumerik", "iso-m")
+    errors = [d for d in refused.diagnostics if d.severity == "error"]
+    assert refused.text is None and [d.line for d in errors] == [4]
+    assert HELD_LIMIT_NOTE in errors[0].message and "past 50 blocks" in errors[0].message
+    sink = _Sink()
+    streamed = api.transpile(text, "sinumerik", "iso-m", out=sink)
+    assert streamed.text == "" and "".join(sink.parts) == held.text
+    assert [d.format_text() for d in streamed.diagnostics] == [d.format_text() for d in held.diagnostics]

@@ -430,13 +430,14 @@ def _walked(body, walker: "_Walker") -> Iterator:
 
 def flatten(program: n.Program, machine=None, *, diagnostics: list,
             resolver: Optional[Callable] = None, max_steps: Optional[int] = None,
-            max_blocks: Optional[int] = None) -> n.Program:
+            max_blocks: Optional[int] = None, stop_when_incomplete: bool = False) -> n.Program:
     """Plain-motion Program equivalent to `program` on `machine` (default mill); NC4xx diagnostics
     (and the interpreter's own) are appended to `diagnostics`. With `max_blocks` the program held
     in memory stops there: the run ends and an NC402 error at the last block says so (the
-    flattened program is incomplete; flatten_blocks streams it instead)."""
+    flattened program is incomplete; flatten_blocks streams it instead). `stop_when_incomplete`:
+    see flatten_blocks."""
     stream = flatten_blocks(program, machine, diagnostics=diagnostics, resolver=resolver,
-                            max_steps=max_steps)
+                            max_steps=max_steps, stop_when_incomplete=stop_when_incomplete)
     blocks: list = []
     for block in stream:
         blocks.append(block)
@@ -461,11 +462,14 @@ def flattened_meta(program: n.Program) -> dict:
 
 
 def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
-                   resolver: Optional[Callable] = None, max_steps: Optional[int] = None
-                   ) -> Iterator[n.Block]:
+                   resolver: Optional[Callable] = None, max_steps: Optional[int] = None,
+                   stop_when_incomplete: bool = False) -> Iterator[n.Block]:
     """The blocks of flatten()'s program, one at a time as the run produces them, so a program
     whose loops unroll into millions of moves is never held whole. `diagnostics` is complete
-    once the iteration has ended."""
+    once the iteration has ended. `stop_when_incomplete`: the run ends at the first thing that
+    makes the flattened program incomplete (an unresolved call, the step budget) when the caller
+    only needs to know the lowering is refused (convert's last resort): a real program of 100k
+    moves would otherwise run to its end first."""
     if machine is None:
         from nctrans.machine import default_mill
         machine = default_mill()
@@ -496,11 +500,16 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
     interp = Interpreter(program, machine, **kwargs)
     fl.interp = interp
     last: Optional[n.Block] = None
+    seen = 0
     for _ in interp.run():
         if fl.blocks:
             last = fl.blocks[-1]
             yield from fl.blocks
             fl.blocks.clear()
+        if stop_when_incomplete and len(interp_diags) > seen:
+            if any(_incomplete(d) for d in interp_diags[seen:]):
+                break
+            seen = len(interp_diags)
     if fl.blocks:
         last = fl.blocks[-1]
     raised = getattr(interp, "alarm", None)
@@ -528,8 +537,13 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
         walker.diags = diagnostics
     diagnostics.extend(interp_diags)
     for d in interp_diags:
-        if d.rule in UNMODELLED_RULES or (d.rule == "NC205" and "budget" in d.message):
+        if _incomplete(d):
             diagnostics.append(Diagnostic("NC402", "error", f"--flatten output would be incomplete: "
                                           f"{d.message}", d.file, d.line, d.column, d.end_line,
                                           d.end_column))
     walker.report()
+
+
+def _incomplete(d: Diagnostic) -> bool:
+    """A run diagnostic after which the flattened program lacks motion the source has."""
+    return d.rule in UNMODELLED_RULES or (d.rule == "NC205" and "budget" in d.message)
