@@ -41,7 +41,8 @@ class Fagor(IsoFamily):
     gives the G/M codes their neutral meaning), but the rest of its block language (`[ ]`
     expressions, `( )` comments anywhere, `$` flow, `#` instructions, P/V variables, `N<n>:` and
     `[LABEL]` targets) has its own grammar of record, so it brings its own front end and emitter
-    instead of the ISO Lowering/IsoEmitter, and it does not stream (programs read as a whole)."""
+    instead of the ISO Lowering/IsoEmitter. Programs are read as a whole; a program converted to
+    Fagor that runs straight through is written as it is read (stream_emit)."""
     name = "fagor"
     description = "Fagor CNC 8060/8065"
     extensions = (".nc", ".pim", ".fnc")
@@ -79,3 +80,8 @@ class Fagor(IsoFamily):
     def emit(self, program) -> EmitResult:
         from .emitter import emit_program
         return emit_program(program)
+
+    def emit_stream(self, program, chunks, write):
+        """emit() chunk by chunk, for a program that runs straight through (stream_emit)."""
+        from .stream_emit import emit_stream
+        return emit_stream(program, chunks, write)
