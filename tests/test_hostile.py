@@ -143,6 +143,34 @@ def test_three_nested_iso_loops_are_fine(tmp_path):
     assert rc == 0 and out.count('"rapid"') == 8, err
 
 
+@pytest.mark.parametrize("code, column", [
+    ("P1=" + "[" * 2000 + "1" + "]" * 2000, 2003),          # where the 2000th level opens
+    ("P1=" + "+".join(["1"] * 5000), 403),                  # the 201st operator
+    ("P1=" + "-" * 3000 + "1", 203),                        # stacked unary signs
+    ("P1=" + "SIN[" * 500 + "1" + "]" * 500, 2003),
+])
+def test_fagor_brackets_and_operator_chains_have_a_depth_limit(tmp_path, code, column):
+    """Were RecursionErrors (internal error) or read silently at any depth: now NC008, as in the
+    ISO and Sinumerik front ends; text in quotes is not counted."""
+    f = write(tmp_path, "d.nc", f"{code}\nG00 XP1\nM30\n")
+    rc, out, _ = run("lint", f.name, "--from", "fagor", cwd=tmp_path)
+    assert rc == 1 and located(out, "NC008", "d.nc", 1, column), out
+    f = write(tmp_path, "m.nc", '#MSG ["' + "-" * 300 + '"]\nG00 X1\nM30\n')
+    rc, out, _ = run("lint", f.name, "--from", "fagor", cwd=tmp_path)
+    assert rc == 0 and "NC008" not in out, out
+
+
+def test_fagor_macros_that_expand_exponentially_stop_at_the_block_limit(tmp_path):
+    """Eleven #DEF macros, each naming the next ten times: 10^10 characters (a hang, then memory
+    exhaustion). The expansion is a block: beyond 64 KiB it is NC010 at the line that uses it."""
+    names = "ABCDEFGHIJKL"
+    lines = [f'#DEF "{a}"="' + f'\\"{b}\\" ' * 10 + '"' for a, b in zip(names, names[1:])]
+    lines += ['#DEF "L"="G01 X1 F100"', '"A"', "M30"]
+    f = write(tmp_path, "mac.nc", "\n".join(lines) + "\n")
+    rc, out, _ = run("lint", f.name, "--from", "fagor", cwd=tmp_path)
+    assert rc == 1 and located(out, "NC010", "mac.nc", 13, 1), out
+
+
 # --------------------------------------------------------------------------- infinity (7)
 
 @pytest.mark.parametrize("name, text, rule, line", [
@@ -336,7 +364,7 @@ def test_long_straight_program_gives_all_its_moves_and_converts_streamed(tmp_pat
     assert lines == n + 1                     # every move, and the stop
 
 
-@pytest.mark.parametrize("target", ["sinumerik", "iso-m"])
+@pytest.mark.parametrize("target", ["sinumerik", "iso-m", "fagor"])
 def test_streamed_conversion_equals_the_whole_one(tmp_path, target):
     from nctrans import api
     text = "%\nO1\nG21 G90 G17\nT1 M6\nS8000 M3\nG0 X0 Y0 Z5.\nG1 Z-1. F500.\n" + "".join(

@@ -832,6 +832,9 @@ class Parser:
                                                                    DIALECT)], number, line.label))
             return
         code = line.code
+        deep = _too_complex(code)
+        if deep is not None:
+            return self._not_read(line, span, "NC008", deep[1], deep[0])
         if "$GOTO" in code:
             code = re.sub(r'(\$GOTO\s*)\[\s*([A-Z0-9_]+)\s*\]', r'\1"\2"', code)
         found = find_instruction(code)
@@ -841,7 +844,14 @@ class Parser:
         if instr == "#DEF":
             self._define(tail, line)
         elif self.macros and '"' in head:
-            head = self._expand(head, line)
+            try:
+                head = self._expand(head, line)
+            except _MacroTooLong as e:
+                return self._not_read(line, span, "NC010", f"its macros expand to more than "
+                                      f"{e.args[0]:,} characters (NCTRANS_MAX_BLOCK_CHARS): block too long")
+            deep = _too_complex(head)       # the expanded text: its columns are not the source's
+            if deep is not None:
+                return self._not_read(line, span, "NC008", f"its macros expand to {deep[1]}")
         body: list = []
         try:
             fast = _plain_items(head)
@@ -867,6 +877,14 @@ class Parser:
             self.error("NC002", f"cannot read the block: {e}", line.lineno, line.col)
             body = [ir.Passthrough(code, "syntax error", DIALECT)]
         self.unit.current.append(ir.Block(span, body, number, line.label, 0 if line.skip else None,
+                                          line.comment))
+
+    def _not_read(self, line: blocks.Line, span: ir.Span, rule: str, message: str, index: int = 0) -> None:
+        """A block refused before its grammar sees it (error `rule` at the `index`-th character of
+        its code): kept in the IR as unread text, so it moves nothing."""
+        self.error(rule, message, line.lineno, line.col + index)
+        self.unit.current.append(ir.Block(span, [ir.Passthrough(line.code, "syntax error", DIALECT)],
+                                          line.number, line.label, 0 if line.skip else None,
                                           line.comment))
 
     def _syntax(self, e: UnexpectedInput, code: str, line: blocks.Line) -> None:
@@ -905,13 +923,22 @@ class Parser:
             self.macros[name.upper()] = text.replace('\\"', '"')
 
     def _expand(self, code: str, line: blocks.Line, depth: int = 0) -> str:
-        """A block's "NAME" macro references replaced by their text (nested ones too)."""
+        """A block's "NAME" macro references replaced by their text (nested ones too). The
+        expansion is a block like any other, so it is held to limits.MAX_BLOCK_CHARS as it grows:
+        ten macros each naming the next ten times would otherwise expand to 10^10 characters."""
+        most = limits.setting("MAX_BLOCK_CHARS", limits.MAX_BLOCK_CHARS)
+        size = [len(code)]
+
         def sub(m):
             key = m.group(1).upper()
             if key not in self.macros:
                 return m.group(0)
             text = blocks.upper_outside_strings(self.macros[key])
-            return " " + (self._expand(text, line, depth + 1) if depth < 10 else text) + " "
+            text = " " + (self._expand(text, line, depth + 1) if depth < 10 else text) + " "
+            size[0] += len(text) - len(m.group(0))
+            if size[0] > most:
+                raise _MacroTooLong(most)
+            return text
         return re.sub(r'"([A-Za-z0-9_]+)"', sub, code)
 
     # ---------------------------------------------------------------- # instructions
@@ -1221,6 +1248,22 @@ class _PlainWord:
     def __init__(self, letter: str, value: ir.Num):
         self.data = "gword" if letter == "G" else "word"
         self.children = (letter, value)
+
+
+_QUOTED = re.compile(r'"[^"]*"')
+
+
+class _MacroTooLong(Exception):
+    """A #DEF macro expansion grew past limits.MAX_BLOCK_CHARS (args: the limit)."""
+
+
+def _too_complex(code: str) -> Optional[tuple[int, str]]:
+    """(0-based index, message) when the block nests `[ ]` or chains operators past what the
+    expression walkers may recurse into (nctrans/limits.py, as the ISO and Sinumerik front ends);
+    text in quotes (#MSG) is not looked into."""
+    if '"' in code:
+        code = _QUOTED.sub(lambda m: '"' + " " * (len(m.group()) - 2) + '"', code)
+    return limits.too_complex(code, "[", "]")
 
 
 def _plain_items(code: str) -> Optional[list]:
