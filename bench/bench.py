@@ -405,6 +405,9 @@ PEAK_RUNS = (
     ("convert --to iso-m", ["convert", "SRC", "--from", "iso-m", "--to", "iso-m", "-o", "OUT"]),
     ("convert --flatten --to iso-m", ["convert", "SRC", "--from", "iso-m", "--to", "iso-m", "--flatten",
                                       "-o", "OUT"]),
+    ("convert --to fagor", ["convert", "SRC", "--from", "iso-m", "--to", "fagor", "-o", "OUT"]),
+    ("convert --flatten --to fagor", ["convert", "SRC", "--from", "iso-m", "--to", "fagor", "--flatten",
+                                      "-o", "OUT"]),
     ("equiv iso-m iso-m", ["equiv", "SRC", "SRC", "--from-a", "iso-m", "--from-b", "iso-m"]),
     ("equiv iso-m sinumerik", ["equiv", "SRC", "MPF", "--from-a", "iso-m", "--from-b", "sinumerik"]),
 )

@@ -160,6 +160,17 @@ def test_fagor_brackets_and_operator_chains_have_a_depth_limit(tmp_path, code, c
     assert rc == 0 and "NC008" not in out, out
 
 
+def test_fagor_block_repetition_is_bounded(tmp_path):
+    """#RPT copies its range into the program: a hundred million copies were a hang. Beyond the
+    blocks nctrans expands it is NC205 at the #RPT line; the corpus's #RPT of 2 still runs."""
+    f = write(tmp_path, "r.nc", "%RP\nN10: G91 G01 X1 F100\nN20: Y1\n#RPT [N10, N20, 100000000]\nM30\n")
+    rc, out, _ = run("lint", f.name, "--from", "fagor", cwd=tmp_path)
+    assert rc == 1 and located(out, "NC205", "r.nc", 4, 1), out
+    f = write(tmp_path, "r2.nc", "%RP\nN10: G91 G01 X1 F100\nN20: Y1\n#RPT [N10, N20, 2]\nM30\n")
+    rc, out, err = run("toolpath", f.name, "--from", "fagor", cwd=tmp_path)
+    assert rc == 0 and out.count('"linear"') == 6, err
+
+
 def test_fagor_macros_that_expand_exponentially_stop_at_the_block_limit(tmp_path):
     """Eleven #DEF macros, each naming the next ten times: 10^10 characters (a hang, then memory
     exhaustion). The expansion is a block: beyond 64 KiB it is NC010 at the line that uses it."""

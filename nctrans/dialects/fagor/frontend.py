@@ -1206,7 +1206,12 @@ class Parser:
 
     def _expand_rpts(self, prog: ir.Program) -> None:
         """#RPT [a, b, n]: the blocks from label a to label b run n times in place of the #RPT
-        block (copies without their labels), when both labels are plain blocks of the same body."""
+        block (copies without their labels), when both labels are plain blocks of the same body.
+        The copies are held in the IR, so all of them together are bounded like other blocks made
+        from one construct (limits.MAX_LOWERED_BLOCKS): `#RPT [N10, N20, 100000000]` is an NC205
+        error at its line, not a hang."""
+        most = limits.setting("MAX_LOWERED_BLOCKS", limits.MAX_LOWERED_BLOCKS)
+        held = 0
         for unit, marker, a, b, count, lineno in self.rpts:
             body = unit.body
             flat = [x for x in body]
@@ -1217,6 +1222,13 @@ class Parser:
             if ia is None or ib is None or ib < ia or host is None or n is None or n < 0:
                 self.diags.append(Diagnostic("NC415", "warning", "#RPT: the range is not a run of blocks "
                                              "of this body, or the count is computed; not analysed",
+                                             self.file, lineno, 1))
+                continue
+            held += int(n) * (ib - ia + 1)
+            if held > most:
+                self.diags.append(Diagnostic("NC205", "error", f"#RPT repeats {ib - ia + 1} blocks "
+                                             f"{int(n):,} times: more than the {most:,} repeated blocks "
+                                             "nctrans expands (NCTRANS_MAX_LOWERED_BLOCKS); not analysed",
                                              self.file, lineno, 1))
                 continue
             copies = []
