@@ -171,6 +171,18 @@ def test_fagor_block_repetition_is_bounded(tmp_path):
     assert rc == 0 and out.count('"linear"') == 6, err
 
 
+def test_sinumerik_define_macros_expand_within_the_block_limit(tmp_path):
+    """A 51 KB DEFINE used 15,000 times in one line expanded to 765 MB (a hang): the expansion is
+    a block, NC010 past 64 KiB at the line that uses it; a short macro still reads."""
+    f = write(tmp_path, "m.mpf", "DEFINE BIG AS " + "G1 X1 Y2 Z3 F100 " * 3000 + "\n" + "BIG " * 15000
+              + "\nM30\n")
+    rc, out, _ = run("lint", f.name, cwd=tmp_path)
+    assert rc == 1 and located(out, "NC010", "m.mpf", 2, 1), out
+    f = write(tmp_path, "ok.mpf", "DEFINE SHORT AS G1 X1 F100\nSHORT\nM30\n")
+    rc, out, err = run("toolpath", f.name, cwd=tmp_path)
+    assert rc == 0 and '"X":1.0' in out, err
+
+
 def test_fagor_macros_that_expand_exponentially_stop_at_the_block_limit(tmp_path):
     """Eleven #DEF macros, each naming the next ten times: 10^10 characters (a hang, then memory
     exhaustion). The expansion is a block: beyond 64 KiB it is NC010 at the line that uses it."""

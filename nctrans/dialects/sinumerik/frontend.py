@@ -1069,7 +1069,11 @@ class _FileParse:
             code = line.code
             # macro expansion (identifier macros of this file)
             if macros and code:
-                code = _expand(code, macros)
+                code = _expand(code, macros, max_block)
+                if code is None:        # the expansion is a block too: held to the same length
+                    low.error("NC010", f"its DEFINE macros expand to more than {max_block} characters, "
+                              "longer than the block nctrans reads; not analysed", n, 1)
+                    continue
                 line.code = code
             # ---- verbatim sections
             if iso_lines is not None:
@@ -1291,8 +1295,11 @@ def _expr_text(e) -> str:
     return Emitter(ir.Program("", DIALECT, [])).expr(e)
 
 
-def _expand(code: str, macros: dict[str, str]) -> str:
+def _expand(code: str, macros: dict[str, str], most: int) -> Optional[str]:
+    """`code` with the file's DEFINE macros replaced; None once it would pass `most` characters
+    (thousands of uses of a long macro in one line would otherwise build gigabytes)."""
     out, pos = [], 0
+    size = len(code)
     inq = False
     i = 0
     while i < len(code):
@@ -1308,6 +1315,9 @@ def _expand(code: str, macros: dict[str, str]) -> str:
                 out.append(code[pos:i])
                 out.append(macros[w])
                 pos = m.end()
+                size += len(macros[w]) - len(w)
+                if size > most:
+                    return None
             i = m.end()
             continue
         i += 1
