@@ -361,14 +361,16 @@ def test_endless_loop_around_a_lowered_cycle_is_refused_at_the_held_limit(tmp_pa
 def test_the_whole_program_fallback_of_an_endless_loop_streams_to_the_step_budget(tmp_path):
     """The loop sets #1, which the rest reads, so it cannot be lowered alone; the whole program
     lowered (the last resort) is written as it runs, so memory stays flat until the step budget
-    ends it (refused, nothing written). A smaller budget than the default: the same stop, sooner
-    (2 M steps of this loop take minutes, as `toolpath` of it does)."""
+    ends it (refused, nothing written). Smaller limits than the defaults: the same stop, sooner
+    (2 M steps of this loop take minutes, as `toolpath` of it does); written as it runs, the
+    plain motion passes the held limit without it being reported."""
     text = ENDLESS_AROUND_A_CYCLE.format(cycle="G73").replace("G80\n", "G80\n#1=#1+1\n").replace(
         "END1\n", "END1\nG0 X#1\n")
     f = write(tmp_path, "e.nc", text)
     rc, out, err = run("convert", f.name, "--from", "iso-m", "--to", "sinumerik", "-o", "e.out",
-                       cwd=tmp_path, env={"NCTRANS_MAX_STEPS": "100000"})
+                       cwd=tmp_path, env={"NCTRANS_MAX_STEPS": "5000", "NCTRANS_MAX_LOWERED_BLOCKS": "1000"})
     assert rc == 1 and located(err, "NC402", "e.nc", 7, 1), err
+    assert "NCTRANS_MAX_LOWERED_BLOCKS" not in err
     assert not (tmp_path / "e.out").exists()
 
 
