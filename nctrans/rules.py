@@ -39,6 +39,7 @@ class CodeRule:
     meaning: str = ""
     ref: str = ""                   # seed line reference
     args: dict[str, str] = field(default_factory=dict)   # address letter -> neutral parameter
+    spelling: str = ""              # how emitters write it when not as `code` (Fagor G00, M02)
 
 
 @dataclass

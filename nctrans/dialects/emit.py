@@ -264,32 +264,44 @@ class Emitter(Spelling):
 
     # -------------------------------------------------------------- codes
     def code_for(self, group: str, value: str = "") -> str:
-        """The dialect's code for a neutral meaning (rules table order = preferred spelling)."""
+        """The dialect's code for a neutral meaning (rules table order = preferred code), as the
+        dialect writes it (a rule's `spelling`: Fagor G00)."""
         rule = self.table.code_for(group, value)
         if rule is None:
             raise NotExpressible(f"mode {group}={value}")
-        return rule.code
+        return rule.spelling or rule.code
 
     def code_word(self, group: str, value: str = "") -> tuple[str, str]:
         """(modal-group key, code) of a meaning: two codes of one group of the dialect's manual
         cannot share a block, so the key makes the second start a new line."""
-        return self.word_of(self.code_for(group, value))
+        rule = self.table.code_for(group, value)
+        if rule is None:
+            raise NotExpressible(f"mode {group}={value}")
+        return self._word(rule)
 
     def word_of(self, code: str) -> tuple[str, str]:
         """(modal-group key, code) of a code of this dialect's table."""
         rule = self.table.lookup(code)
         if rule is None:
             raise NotExpressible(f"code {code}")
+        return self._word(rule)
+
+    @staticmethod
+    def _word(rule) -> tuple[str, str]:
         key = f"{rule.code[0]}:{rule.dialect_group}" if rule.dialect_group is not None else ""
-        return key, rule.code
+        return key, rule.spelling or rule.code
 
     # -------------------------------------------------------------- dispatch
     def dispatch(self, prefix: str, node: Any, *args: Any) -> Any:
         """Call `<prefix><NodeType>(node, *args)`; a node type without one is not expressible."""
         write = getattr(self, prefix + type(node).__name__, None)
         if write is None:
-            raise NotExpressible(f"the statement {type(node).__name__}")
+            raise NotExpressible(self.describe(node))
         return write(node, *args)
+
+    def describe(self, node: Any) -> str:
+        """How NC402 names a node the dialect has no spelling for."""
+        return f"the statement {type(node).__name__}"
 
     # -------------------------------------------------------------- position and frame
     def forget(self) -> None:

@@ -18,25 +18,17 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.dialects.base import EmitResult
 from nctrans.dialects.base import get as get_dialect
+from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
 from nctrans.ir import nodes as n
 from nctrans.ir import walk as ir_walk
 from nctrans.rules import load_table
 
+__all__ = ["FagorSpelling", "FagorEmitter", "NotExpressible", "format_number", "format_expr", "emit_program"]
+
 DIALECT = "fagor"
 AXES = "XYZUVWABC"
-
-# neutral op -> (Fagor spelling, precedence); higher binds tighter (spec §6.5)
-_OPS = {"bor": ("|", 1), "or": ("+", 4), "band": ("&", 2), "bxor": ("^", 2),
-        "==": ("==", 3), "!=": ("!=", 3), "<": ("<", 3), "<=": ("<=", 3), ">": (">", 3), ">=": (">=", 3),
-        "+": ("+", 4), "-": ("-", 4), "*": ("*", 5), "/": ("/", 5), "and": ("*", 5),
-        "pow": ("**", 6), "mod": ("MOD", 6)}
-_LOGICAL = frozenset(("and", "or"))
-_FUNCS = {"sin": "SIN", "cos": "COS", "tan": "TAN", "asin": "ASIN", "acos": "ACOS", "atan": "ATAN",
-          "sqrt": "SQRT", "abs": "ABS", "round": "ROUND", "fix": "INT", "trunc": "INT", "fup": "FUP",
-          "ln": "LN", "exp": "EXP", "bnot": "INV"}
 
 
 def _fagor_spelling(key) -> Optional[str]:
@@ -47,10 +39,6 @@ def _fagor_spelling(key) -> Optional[str]:
         return None
     own = load_table(DIALECT).system_variables
     return next((sp for sp, m in own.items() if m == meaning), None)
-
-
-class NotExpressible(Exception):
-    """Raised while spelling; the emitter turns it into NC402 at the statement's line."""
 
 
 def format_number(v: float) -> str:
@@ -68,76 +56,79 @@ def format_number(v: float) -> str:
     return text
 
 
-class _Spell:
-    """Expressions and variables in Fagor syntax; `ctx` receives lowerings (NC401)."""
+class FagorSpelling(Spelling):
+    """Expressions and variables in Fagor syntax (operators, precedence and functions from
+    rules/fagor.toml [expressions]); an emitter receives the lowerings (NC401)."""
+    syntax_table = DIALECT
 
-    def __init__(self, ctx=None):
-        self.ctx = ctx
+    def number(self, e: n.Num) -> str:
+        return format_number(e.value)
 
-    def info(self, what: str) -> None:
-        if self.ctx is not None:
-            self.ctx.lowered(what)
+    def string(self, e: n.Str) -> str:
+        raise NotExpressible("a string value outside a message")
 
-    def expr(self, e: Any) -> str:
-        return self._expr(e)[0]
+    def value(self, e: Any) -> str:
+        """An address value: numbers, parameters and variables as they are, the rest in brackets."""
+        if type(e) is n.Num:
+            return format_number(e.value)
+        if type(e) is n.Var:
+            return self.var_text(e)
+        if type(e) is n.Unary and e.op == "-" and type(e.operand) in (n.Num, n.Var):
+            return "-" + self.value(e.operand)
+        return f"[{self.expr(e)}]"
 
-    def _expr(self, e: Any) -> tuple[str, int]:
-        t = type(e)
-        if t is n.Num:
-            return format_number(e.value), 9 if e.value >= 0 else 7
-        if t is n.Var:
-            return self.var(e), 9
-        if t is n.Binary:
-            op = e.op
-            if op == "div":
-                return f"INT[{self.expr(n.Binary('/', e.left, e.right))}]", 9
-            if op == "xor":
-                return self._expr(n.Binary("!=", _truth(e.left), _truth(e.right)))
-            if op not in _OPS:
-                raise NotExpressible(f"operator {op!r}")
-            sym, prec = _OPS[op]
-            lt, lp = self._expr(e.left)
-            rt, rp = self._expr(e.right)
-            if op in _LOGICAL:        # "*" / "+" as AND / OR act on bracketed conditions
-                return f"[{lt}]{sym}[{rt}]", prec
-            left = lt if lp >= prec else f"[{lt}]"
-            right = rt if rp > prec else f"[{rt}]"
-            if op == "pow" and isinstance(e.right, n.Num) and e.right.value == 2:
-                return f"SQR[{lt}]", 9
-            return f"{left}{sym}{right}" if sym not in ("MOD",) else f"{left} MOD {right}", prec
-        if t is n.Unary:
-            if e.op == "-":
-                ot, op_ = self._expr(e.operand)
-                return f"-{ot if op_ >= 7 else '[' + ot + ']'}", 7
-            if e.op == "+":
-                return self._expr(e.operand)
-            if e.op == "not":
-                return f"[{self.expr(e.operand)}]==0", 3
-            if e.op == "bnot":
-                return f"INV[{self.expr(e.operand)}]", 9
-            raise NotExpressible(f"unary operator {e.op!r}")
-        if t is n.Func:
-            name = e.name.lower()
-            args = e.args
-            if name in ("atan2",) or (name == "atan" and len(args) == 2):
-                # ARG[x, y] is the angle of the vector (x, y) = atan2(y, x), 0..360
-                return f"ARG[{self.expr(args[1])},{self.expr(args[0])}]", 9
-            if name == "pow" and len(args) == 2:
-                return self._expr(n.Binary("pow", args[0], args[1]))
-            if name in ("minval", "maxval") and len(args) == 2:
-                a, b = args
-                total = n.Binary("-" if name == "minval" else "+", n.Binary("+", a, b),
-                                 n.Func("abs", [n.Binary("-", a, b)]))
-                self.info(f"{name.upper()} written as an ABS expression")
-                return self._expr(n.Binary("/", total, n.Num(2.0)))
-            if name not in _FUNCS:
-                raise NotExpressible(f"function {e.name.upper()}")
-            return f"{_FUNCS[name]}[{','.join(self.expr(a) for a in args)}]", 9
-        if t is n.Str:
-            raise NotExpressible("a string value outside a message")
-        raise NotExpressible(f"expression {t.__name__}")
+    @rewrites(n.Binary, "div")
+    def _div(self, e: n.Binary) -> tuple[str, int]:
+        return f"{self.syntax.functions['fix']}[{self.expr(n.Binary('/', e.left, e.right))}]", self.syntax.atom
 
-    def var(self, v: n.Var) -> str:
+    @rewrites(n.Binary, "xor")
+    def _xor(self, e: n.Binary) -> tuple[str, int]:
+        return self.term(n.Binary("!=", _truth(e.left), _truth(e.right)))
+
+    @rewrites(n.Binary, "pow")
+    def _pow(self, e: n.Binary) -> tuple[str, int]:
+        if isinstance(e.right, n.Num) and e.right.value == 2:
+            lt, _ = self.term(e.left)
+            return f"SQR[{lt}]", self.syntax.atom
+        return self.binary(e)
+
+    @rewrites(n.Unary, "+")
+    def _plus(self, e: n.Unary) -> tuple[str, int]:
+        return self.term(e.operand)
+
+    @rewrites(n.Unary, "not")
+    def _not(self, e: n.Unary) -> tuple[str, int]:
+        return f"[{self.expr(e.operand)}]==0", self.syntax.binary["=="].prec
+
+    @rewrites(n.Unary, "bnot")
+    def _bnot(self, e: n.Unary) -> tuple[str, int]:
+        return f"{self.syntax.functions['bnot']}[{self.expr(e.operand)}]", self.syntax.atom
+
+    @rewrites(n.Func, "atan2", "atan")
+    def _atan(self, e: n.Func) -> tuple[str, int]:
+        if e.name.lower() == "atan" and len(e.args) != 2:
+            return self.call(e), self.syntax.atom
+        # ARG[x, y] is the angle of the vector (x, y) = atan2(y, x), 0..360
+        return f"ARG[{self.expr(e.args[1])},{self.expr(e.args[0])}]", self.syntax.atom
+
+    @rewrites(n.Func, "pow")
+    def _pow_call(self, e: n.Func) -> tuple[str, int]:
+        if len(e.args) == 2:
+            return self.term(n.Binary("pow", e.args[0], e.args[1]))
+        return self.call(e), self.syntax.atom
+
+    @rewrites(n.Func, "minval", "maxval")
+    def _min_max(self, e: n.Func) -> tuple[str, int]:
+        name = e.name.lower()
+        if len(e.args) != 2:
+            return self.call(e), self.syntax.atom
+        a, b = e.args
+        total = n.Binary("-" if name == "minval" else "+", n.Binary("+", a, b),
+                         n.Func("abs", [n.Binary("-", a, b)]))
+        self.lowered(f"{name.upper()} written as an ABS expression")
+        return self.term(n.Binary("/", total, n.Num(2.0)))
+
+    def var_text(self, v: n.Var) -> str:
         sp, key = v.space, v.key
         if sp in ("arg", "local"):
             k = str(key).upper()
@@ -159,7 +150,7 @@ class _Spell:
             k = int(key)
             if k >= 100:
                 return f"P{k}"
-            self.info(f"R{k} written as the global parameter P{9000 + k}")
+            self.lowered(f"R{k} written as the global parameter P{9000 + k}")
             return f"P{9000 + k}"
         if sp == "num":
             if key is None and v.indices and len(v.indices) == 1:
@@ -179,13 +170,11 @@ class _Spell:
                 if spelling is None:
                     raise NotExpressible(f"system variable {key}")
                 return spelling
-            if k.startswith("V."):
-                idx = "".join(f"[{self.expr(i)}]" for i in v.indices or ())
-                if idx:
-                    head, _, tail = k.rpartition(".")
-                    return f"{head}{idx}.{tail}" if head.count(".") >= 2 else k + idx
-                return k
-            raise NotExpressible(f"system variable {key}")
+            idx = "".join(f"[{self.expr(i)}]" for i in v.indices or ())
+            if idx:
+                head, _, tail = k.rpartition(".")
+                return f"{head}{idx}.{tail}" if head.count(".") >= 2 else k + idx
+            return k
         raise NotExpressible(f"variable {sp}:{key}")
 
 
@@ -193,54 +182,34 @@ def _truth(e):
     return n.Binary("!=", e, n.Num(0.0))
 
 
+_BARE = FagorSpelling()
+
+
 def format_expr(e: Any) -> str:
     """An IR expression in Fagor syntax (for messages and verbatim text)."""
-    return _Spell().expr(e)
+    return _BARE.expr(e)
 
 
-def _value(sp: _Spell, e: Any) -> str:
-    """An address value: numbers, parameters and variables as they are, the rest in brackets."""
-    if type(e) is n.Num:
-        return format_number(e.value)
-    if type(e) is n.Var:
-        return sp.var(e)
-    if type(e) is n.Unary and e.op == "-" and type(e.operand) in (n.Num, n.Var):
-        return "-" + _value(sp, e.operand)
-    return f"[{sp.expr(e)}]"
+class FagorEmitter(FagorSpelling, Emitter):
+    dialect = DIALECT
+    table_name = DIALECT
+    target_text = "Fagor 8060/8065"
+    lowered_for = "Fagor"
 
-
-class _Emitter:
     def __init__(self, program: n.Program):
-        self.program = program
-        self.table = load_table(DIALECT)
-        self.diags: list[Diagnostic] = []
+        super().__init__(program)
         self.out: list[str] = []
-        self.span: Optional[n.Span] = None
-        self.spell = _Spell(self)
         self.targets: set = set()
         self.motion = "rapid"
-        self.distance = "absolute"
         self.plane = "XY"
         self.pending_motion: Optional[str] = None     # arc_3point / arc_tangent: one-shot G09/G08
         self.radius_index: Any = None
         self.length_on = False
         self.in_sub = False
-        self._reported: set = set()
 
-    # ---------------------------------------------------------------- reporting
-    def lowered(self, what: str) -> None:
-        key = (what, self.span.line if self.span else 0)
-        if key not in self._reported:
-            self._reported.add(key)
-            self.diags.append(at_span("NC401", "info", f"lowered for Fagor: {what}", self._where()))
-
-    def refuse(self, what: str) -> None:
-        line = self.span.line if self.span is not None else 1
-        self.diags.append(at_span("NC402", "error", f"Fagor 8060/8065 cannot express {what} (source "
-                                  f"line {line})", self._where()))
-
-    def _where(self):
-        return self.span if self.span is not None else n.Span(self.program.file, 1)
+    def lowered(self, what: str, once: Any = None) -> None:
+        """Each lowering once per source line."""
+        super().lowered(what, once=(what, self.span.line if self.span else 0))
 
     # ---------------------------------------------------------------- program
     def run(self) -> str:
@@ -257,7 +226,7 @@ class _Emitter:
             self._reset()
             self.nodes(sub.body)
             if not ir_walk.ends_with_return(sub.body):
-                self.out.append("M17")
+                self.out.append(self.code_for("return"))
         self.in_sub = False
         self._reset()
         self.out.append(f"%{_program_header(p)}")
@@ -290,7 +259,7 @@ class _Emitter:
                 continue
             rule = self.table.code_for(group, value)
             if rule is not None and rule.group == group:
-                words.append(_g(rule.code))
+                words.append(rule.spelling or rule.code)
                 if group == "plane":
                     self.plane = value
         if words:
@@ -327,19 +296,19 @@ class _Emitter:
                 self._flow_line(f"$ENDDO {self._cond(keep)}")
             elif t is n.ForLoop:
                 try:
-                    var = self.spell.var(node.var)
+                    var = self.var_text(node.var)
                     step = node.step if node.step is not None else n.Num(1.0)
-                    self.out.append(f"$FOR {var}={self.spell.expr(node.start)},"
-                                    f"{self.spell.expr(node.end)},{self.spell.expr(step)}")
+                    self.out.append(f"$FOR {var}={self.expr(node.start)},"
+                                    f"{self.expr(node.end)},{self.expr(step)}")
                 except NotExpressible as e:
                     self.refuse(str(e))
                 self.nodes(node.body)
                 self.out.append("$ENDFOR")
             elif t is n.Case:
                 try:
-                    subj = self.spell.expr(node.subject)
+                    subj = self.expr(node.subject)
                     for value, label in node.branches:
-                        self.out.append(f"$IF [{subj}]==[{self.spell.expr(value)}] $GOTO "
+                        self.out.append(f"$IF [{subj}]==[{self.expr(value)}] $GOTO "
                                         f"{self._target(label)}")
                     if node.default is not None:
                         self.out.append(f"$GOTO {self._target(node.default)}")
@@ -363,7 +332,7 @@ class _Emitter:
 
     def _cond(self, e) -> Optional[str]:
         try:
-            return self.spell.expr(e)
+            return self.expr(e)
         except NotExpressible as ex:
             self.refuse(str(ex))
             return "0"
@@ -428,123 +397,153 @@ class _Emitter:
                 parts.append(comment)
             self.out.append(" ".join(parts))
 
+    def describe(self, s) -> str:
+        return _describe(s)
+
     def statement(self, s, word, new_line, rest: list) -> int:
-        """Write one statement; returns how many following statements it consumed."""
-        sp = self.spell
-        t = type(s)
-        val = lambda e: _value(sp, e)            # noqa: E731
-        if t is n.ModeChange:
-            return self.mode(s, word, rest)
-        if t is n.Motion:
-            self.motion_words(s, word)
-            new_line()
-            return 0
-        if t is n.Feed:
-            word("F", "F" + val(s.value))
-        elif t is n.SpindleSpeed:
-            if s.spindle not in (0, 1):
-                word("", f"S{s.spindle}={sp.expr(s.value)}")
-            else:
-                word("S", "S" + val(s.value))
-        elif t is n.SpindleLimit:
-            word("G192", "G192")
-            word("S", "S" + val(s.value))
-        elif t is n.ToolSelect:
-            word("T", "T" + val(s.tool))
-        elif t is n.ToolChange:
-            word("M6", "M6")
-            # Fagor: D1 is implicit after a tool change (the front end writes it as these two)
-            if (len(rest) >= 2 and isinstance(rest[0], n.ModeChange) and rest[0].group == "tool_length"
-                    and rest[0].value == "plus" and isinstance(rest[1], n.OffsetSelect)
-                    and _num(rest[1].index) == 1):
-                self.length_on, self.radius_index = True, 1
-                return 2
-            if not self.length_on:
-                self.lowered("M06 on Fagor activates offset D1 of the new tool (tool length on)")
-            self.length_on, self.radius_index = True, 1
-        elif t is n.OffsetSelect:
-            if s.kind == "radius":
-                word("D", "D" + val(s.index))
-                self.radius_index = s.index
-                if not self.length_on and _num(s.index) != 0:
-                    self.lowered("D selects the tool length offset too on Fagor")
-            else:
-                word("D", "D" + val(s.index))
-                self.lowered("length offset H written as the Fagor offset D of the active tool")
-        elif t is n.Dwell:
-            if s.seconds is None:
-                raise NotExpressible("a dwell in spindle revolutions")
-            word("G4", "G4 K" + val(s.seconds))
-        elif t is n.Assign:
-            new_line()
-            word("", f"{sp.var(s.target)}={sp.expr(s.value)}", alone=True)
-        elif t is n.Goto:
-            new_line()
-            target = self._target(s.target)
-            if s.cond is not None:
-                word("", f"$IF {sp.expr(s.cond)} $GOTO {target}", alone=True)
-            else:
-                word("", f"$GOTO {target}", alone=True)
-        elif t is n.SubCall:
-            self.call(s, word)
-        elif t is n.ModalCallOff:
-            word("", "#MDOFF", alone=True)
-        elif t is n.Return:
-            if s.to_label is not None:
-                raise NotExpressible("a return to a label")
-            word("M", "M17" if self.in_sub else "M30")
-        elif t is n.ProgramEnd:
-            if s.kind == "restart":
-                raise NotExpressible("a program restart (M99 in a main program)")
-            word("M", "M02" if s.kind == "end" else "M30")
-        elif t is n.Stop:
-            word("M", "M01" if s.optional else "M00")
-        elif t is n.Message:
-            word("", f"#MSG [{self.message(s.text)}]", alone=True)
-        elif t is n.Alarm:
-            text = self.message(s.text) if s.text is not None else f'"ALARM %D", {sp.expr(s.number)}'
-            word("", f"#ERROR [{text}]", alone=True)
-        elif t is n.FrameOp:
-            self.frame(s, word)
-        elif t is n.PolarPole:
-            if s.relative_to == "last_point" and not s.target and not s.polar:
-                word("", "G30", alone=True)
-            elif s.relative_to == "zero" and not s.polar and len(s.target) <= 2:
-                a1, a2 = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}[self.plane]
-                if set(s.target) - {a1, a2}:
-                    raise NotExpressible("a polar pole outside the plane")
-                i = s.target.get(a1)
-                j = s.target.get(a2)
-                word("", f"G30 I{val(i.value if i else n.Num(0.0))} J{val(j.value if j else n.Num(0.0))}",
-                     alone=True)
-            else:
-                raise NotExpressible(f"a polar pole relative to the {s.relative_to.replace('_', ' ')}")
-        elif t is n.SetPosition:
-            words = " ".join(f"{a}{val(v.value)}" for a, v in s.target.items())
-            word("", f"G92 {words}".strip(), alone=True)
-        elif t is n.TravelLimit:
-            if s.dialect != DIALECT:
-                raise NotExpressible(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
-                                     f"({s.scope.replace('_', ' ')} limits differ between controls)")
-            word("", s.text, alone=True)
-        elif t is n.Passthrough:
-            if s.dialect == DIALECT:
-                word("", s.text, alone=s.text.startswith("#"))
-            else:
-                raise NotExpressible(f"{s.text!r} ({s.reason or 'kept verbatim'} from {s.dialect or 'the source'})")
-        else:
-            raise NotExpressible(_describe(s))
+        """Write one statement (`w_<NodeType>`); returns how many following statements it consumed."""
+        return self.dispatch("w_", s, word, new_line, rest) or 0
+
+    def w_Motion(self, s: n.Motion, word, new_line, rest: list):
+        self.motion_words(s, word)
+        new_line()
         return 0
+
+    def w_Feed(self, s: n.Feed, word, new_line, rest: list):
+        val = self.value
+        word("F", "F" + val(s.value))
+
+    def w_SpindleSpeed(self, s: n.SpindleSpeed, word, new_line, rest: list):
+        val = self.value
+        if s.spindle not in (0, 1):
+            word("", f"S{s.spindle}={self.expr(s.value)}")
+        else:
+            word("S", "S" + val(s.value))
+
+    def w_SpindleLimit(self, s: n.SpindleLimit, word, new_line, rest: list):
+        val = self.value
+        code = self.code_for("spindle_limit")
+        word(code, code)
+        word("S", "S" + val(s.value))
+
+    def w_ToolSelect(self, s: n.ToolSelect, word, new_line, rest: list):
+        val = self.value
+        word("T", "T" + val(s.tool))
+
+    def w_ToolChange(self, s: n.ToolChange, word, new_line, rest: list):
+        code = self.code_for("tool_change")
+        word(code, code)
+        # Fagor: D1 is implicit after a tool change (the front end writes it as these two)
+        if (len(rest) >= 2 and isinstance(rest[0], n.ModeChange) and rest[0].group == "tool_length"
+                and rest[0].value == "plus" and isinstance(rest[1], n.OffsetSelect)
+                and _num(rest[1].index) == 1):
+            self.length_on, self.radius_index = True, 1
+            return 2
+        if not self.length_on:
+            self.lowered("M06 on Fagor activates offset D1 of the new tool (tool length on)")
+        self.length_on, self.radius_index = True, 1
+
+    def w_OffsetSelect(self, s: n.OffsetSelect, word, new_line, rest: list):
+        val = self.value
+        if s.kind == "radius":
+            word("D", "D" + val(s.index))
+            self.radius_index = s.index
+            if not self.length_on and _num(s.index) != 0:
+                self.lowered("D selects the tool length offset too on Fagor")
+        else:
+            word("D", "D" + val(s.index))
+            self.lowered("length offset H written as the Fagor offset D of the active tool")
+
+    def w_Dwell(self, s: n.Dwell, word, new_line, rest: list):
+        val = self.value
+        if s.seconds is None:
+            raise NotExpressible("a dwell in spindle revolutions")
+        code = self.code_for("dwell")
+        word(code, f"{code} K" + val(s.seconds))
+
+    def w_Assign(self, s: n.Assign, word, new_line, rest: list):
+        new_line()
+        word("", f"{self.var_text(s.target)}={self.expr(s.value)}", alone=True)
+
+    def w_Goto(self, s: n.Goto, word, new_line, rest: list):
+        new_line()
+        target = self._target(s.target)
+        if s.cond is not None:
+            word("", f"$IF {self.expr(s.cond)} $GOTO {target}", alone=True)
+        else:
+            word("", f"$GOTO {target}", alone=True)
+
+    def w_SubCall(self, s: n.SubCall, word, new_line, rest: list):
+        self._subcall(s, word)
+
+    def w_ModalCallOff(self, s: n.ModalCallOff, word, new_line, rest: list):
+        word("", "#MDOFF", alone=True)
+
+    def w_Return(self, s: n.Return, word, new_line, rest: list):
+        if s.to_label is not None:
+            raise NotExpressible("a return to a label")
+        word("M", self.code_for("return") if self.in_sub else self.code_for("program_end", "end_rewind"))
+
+    def w_ProgramEnd(self, s: n.ProgramEnd, word, new_line, rest: list):
+        if s.kind == "restart":
+            raise NotExpressible("a program restart (M99 in a main program)")
+        word("M", self.code_for("program_end", "end" if s.kind == "end" else "end_rewind"))
+
+    def w_Stop(self, s: n.Stop, word, new_line, rest: list):
+        word("M", self.code_for("stop", "optional" if s.optional else "program"))
+
+    def w_Message(self, s: n.Message, word, new_line, rest: list):
+        word("", f"#MSG [{self.message(s.text)}]", alone=True)
+
+    def w_Alarm(self, s: n.Alarm, word, new_line, rest: list):
+        text = self.message(s.text) if s.text is not None else f'"ALARM %D", {self.expr(s.number)}'
+        word("", f"#ERROR [{text}]", alone=True)
+
+    def w_FrameOp(self, s: n.FrameOp, word, new_line, rest: list):
+        self.frame(s, word)
+
+    def w_PolarPole(self, s: n.PolarPole, word, new_line, rest: list):
+        val = self.value
+        if s.relative_to == "last_point" and not s.target and not s.polar:
+            word("", self.code_for("polar_pole"), alone=True)
+        elif s.relative_to == "zero" and not s.polar and len(s.target) <= 2:
+            a1, a2 = {"XY": ("X", "Y"), "ZX": ("Z", "X"), "YZ": ("Y", "Z")}[self.plane]
+            if set(s.target) - {a1, a2}:
+                raise NotExpressible("a polar pole outside the plane")
+            i = s.target.get(a1)
+            j = s.target.get(a2)
+            word("", f"{self.code_for('polar_pole')} I{val(i.value if i else n.Num(0.0))} "
+                 f"J{val(j.value if j else n.Num(0.0))}",
+                 alone=True)
+        else:
+            raise NotExpressible(f"a polar pole relative to the {s.relative_to.replace('_', ' ')}")
+
+    def w_SetPosition(self, s: n.SetPosition, word, new_line, rest: list):
+        val = self.value
+        words = " ".join(f"{a}{val(v.value)}" for a, v in s.target.items())
+        word("", f"{self.code_for('set_position')} {words}".strip(), alone=True)
+
+    def w_TravelLimit(self, s: n.TravelLimit, word, new_line, rest: list):
+        if s.dialect != DIALECT:
+            raise NotExpressible(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
+                                 f"({s.scope.replace('_', ' ')} limits differ between controls)")
+        word("", s.text, alone=True)
+
+    def w_Passthrough(self, s: n.Passthrough, word, new_line, rest: list):
+        if s.dialect == DIALECT:
+            word("", s.text, alone=s.text.startswith("#"))
+        else:
+            raise NotExpressible(f"{s.text!r} ({s.reason or 'kept verbatim'} from {s.dialect or 'the source'})")
 
     def message(self, e) -> str:
         if isinstance(e, n.Str):
             return '"' + e.value.replace("%", "%%").replace('"', '\\"') + '"'
         if isinstance(e, n.Func) and e.name == "format" and e.args and isinstance(e.args[0], n.Str):
             fmt = '"' + e.args[0].value.replace('"', '\\"') + '"'
-            return ", ".join([fmt] + [self.spell.expr(a) for a in e.args[1:]])
-        return f'"%D", {self.spell.expr(e)}'
+            return ", ".join([fmt] + [self.expr(a) for a in e.args[1:]])
+        return f'"%D", {self.expr(e)}'
 
-    def mode(self, s: n.ModeChange, word, rest: list) -> int:
+    def w_ModeChange(self, s: n.ModeChange, word, new_line, rest: list) -> int:
         g, v = s.group, s.value
         if g == "motion":
             if v in ("arc_3point", "arc_tangent"):
@@ -571,23 +570,21 @@ class _Emitter:
             if s.code.upper().startswith("D") and len(s.code) > 1:
                 word("D", s.code.upper())
             elif nxt is None:
-                word("D", "D" + (_value(self.spell, self.radius_index) if self.radius_index is not None
+                word("D", "D" + (self.value(self.radius_index) if self.radius_index is not None
                                  else "1"))
             return 0
         if g == "work_offset":
             if v.upper().startswith("G54.1P"):
-                word("G", f"G159={int(v[6:]) + 6}")
+                word("G", f"{self.code_for('work_offset')}={int(v[6:]) + 6}")
                 return 0
         rule = self.table.code_for(g, v)
         if rule is None or rule.group != g:
             raise NotExpressible(f"{s.code or g + ' ' + v} ({g} {v})")
-        word("G" + str(rule.dialect_group or rule.code), rule.code if rule.code[0] != "G" else
-             _g(rule.code))
+        word("G" + str(rule.dialect_group or rule.code), rule.spelling or rule.code)
         return 0
 
     def motion_words(self, s: n.Motion, word) -> None:
-        sp = self.spell
-        val = lambda e: _value(sp, e)        # noqa: E731
+        val = self.value
         if s.aperture is not None:
             raise NotExpressible("an arc by opening angle")
         if s.turns is not None and _num(s.turns) != 0:
@@ -599,15 +596,15 @@ class _Emitter:
                 raise NotExpressible("a three-point arc without an intermediate point")
             if self.distance != "absolute":
                 self.lowered("G09 intermediate point in incremental coordinates")
-            word("G", "G09")
+            word("G", self.code_for("arc_once", "three_point"))
         elif self.pending_motion == "arc_tangent":
-            word("G", "G08")
+            word("G", self.code_for("arc_once", "tangent"))
         elif s.via:
             raise NotExpressible("an intermediate point outside a three-point arc")
         if self.motion is None:
             # the first move of a unit: its mode is the power-on default, written out
             self.motion = "rapid"
-            word("GMOTION", "G00")
+            word("GMOTION", self.code_for("motion", "rapid"))
         for a, av in s.target.items():
             if av.mode is not None and av.mode != ("abs" if self.distance == "absolute" else "inc"):
                 raise NotExpressible(f"{a} in {av.mode} mode for one word")
@@ -626,7 +623,7 @@ class _Emitter:
         if s.center:
             absolute = {av.mode for av in s.center.values()} == {"abs"}
             if absolute:
-                word("G6", "G06")
+                word("G6", self.code_for("arc_once", "absolute_centre"))
             for a in "IJK":
                 if a in s.center:
                     word(a, a + val(s.center[a].value))
@@ -635,7 +632,7 @@ class _Emitter:
                 raise NotExpressible("an arc radius together with polar coordinates")
             word("R", "R" + val(s.radius))
 
-    def call(self, s: n.SubCall, word) -> None:
+    def _subcall(self, s: n.SubCall, word) -> None:
         if s.args:
             raise NotExpressible(f"positional arguments of the call to {s.name}")
         if s.repeat is not None and _num(s.repeat) != 1:
@@ -649,12 +646,12 @@ class _Emitter:
                 if key == "P" and not params and not local:
                     continue
                 raise NotExpressible(f"the call argument {key} of {name}")
-            target = self.spell.var(var)
+            target = self.var_text(var)
             if not (target.startswith("P") and target[1:].isdigit()):
                 raise NotExpressible(f"the call argument {key} of {name}")
             k = int(target[1:])
-            params.append(f"{'ABCDEFGHIJKLMNOPQRSTUVWXYZ'[k]}{_value(self.spell, e)}" if k < 26
-                          else f"P{k}={self.spell.expr(e)}")
+            params.append(f"{'ABCDEFGHIJKLMNOPQRSTUVWXYZ'[k]}{self.value(e)}" if k < 26
+                          else f"P{k}={self.expr(e)}")
         callee = _sub_name(name) if local else name
         if s.modal != "none":
             word("", " ".join([f"#MCALL {callee}"] + params), alone=True)
@@ -666,18 +663,19 @@ class _Emitter:
             word("", f"L {callee}", alone=True)
 
     def frame(self, s: n.FrameOp, word) -> None:
-        sp = self.spell
+        scale, rotation = self.code_for("frame", "scale"), self.code_for("frame", "rotation")
+        mirror_off, shift = self.code_for("frame", "mirror_off"), self.code_for("incremental_offset")
         if s.op == "scale":
             if s.clear:
-                word("", "G72", alone=True)
+                word("", scale, alone=True)
                 return
             vals = list(s.values.values())
-            if set(s.values) != {"X", "Y", "Z"} or len({sp.expr(v) for v in vals}) != 1 or s.center:
+            if set(s.values) != {"X", "Y", "Z"} or len({self.expr(v) for v in vals}) != 1 or s.center:
                 raise NotExpressible("a scale that differs per axis or has a centre")
-            word("", f"G72 S{_value(sp, vals[0])}", alone=True)
+            word("", f"{scale} S{self.value(vals[0])}", alone=True)
         elif s.op == "rot":
             if s.clear:
-                word("", "G73", alone=True)
+                word("", rotation, alone=True)
                 return
             if s.angle is None or s.values:
                 raise NotExpressible("a rotation about a named axis")
@@ -685,30 +683,30 @@ class _Emitter:
             if s.center:
                 ci = s.center.get("X")
                 cj = s.center.get("Y")
-                centre = (f" I{_value(sp, ci.value if ci else n.Num(0.0))}"
-                          f" J{_value(sp, cj.value if cj else n.Num(0.0))}")
+                centre = (f" I{self.value(ci.value if ci else n.Num(0.0))}"
+                          f" J{self.value(cj.value if cj else n.Num(0.0))}")
             if not s.additive:
-                word("", "G73", alone=True)     # G73 Q adds; a replacing rotation cancels first
+                word("", rotation, alone=True)     # G73 Q adds; a replacing rotation cancels first
                 self.lowered("a rotation that replaces the one in force written as G73 then G73 Q")
-            word("", f"G73 Q{_value(sp, s.angle)}{centre}", alone=True)
+            word("", f"{rotation} Q{self.value(s.angle)}{centre}", alone=True)
         elif s.op == "mirror":
             if s.clear and not s.values:
-                word("", "G10", alone=True)
+                word("", mirror_off, alone=True)
                 return
             if s.clear or s.center or not s.additive:
                 raise NotExpressible("a mirror about a point or that replaces other frames")
             axes = sorted(s.values)
             if not set(axes) <= set(AXES):
                 raise NotExpressible(f"mirror of {axes}")
-            word("", "G10", alone=True)
-            word("", "G14 " + " ".join(f"{a}-1" for a in axes), alone=True)
+            word("", mirror_off, alone=True)
+            word("", f"{self.code_for('frame', 'mirror_axes')} " + " ".join(f"{a}-1" for a in axes), alone=True)
         elif s.op == "trans" and s.local and not s.additive:
             if s.clear or not s.values:
-                word("", "G158", alone=True)
+                word("", shift, alone=True)
                 return
             # G158 replaces per axis: cancel first so axes left out of this one are 0 too
-            word("", "G158", alone=True)
-            word("", "G158 " + " ".join(f"{a}{_value(sp, e)}" for a, e in s.values.items()), alone=True)
+            word("", shift, alone=True)
+            word("", f"{shift} " + " ".join(f"{a}{self.value(e)}" for a, e in s.values.items()), alone=True)
         else:
             raise NotExpressible(f"the frame operation {s.op} (a translation)")
 
@@ -721,11 +719,6 @@ def _word_order(w: str) -> int:
     if w.startswith(("$", "P", "V.", "L", "LL")) and not w[:1] in "G":
         return 100 if not w.startswith("#") else 0
     return _ORDER.get(w[:1], 50)
-
-
-def _g(code: str) -> str:
-    """G0 -> G00 as Fagor manuals write them; longer codes as they are."""
-    return f"G{int(code[1:]):02d}" if code[1:].isdigit() and int(code[1:]) < 10 else code
 
 
 def _num(e) -> Optional[float]:
@@ -795,6 +788,6 @@ def _describe(s) -> str:
 
 
 def emit_program(program: n.Program) -> EmitResult:
-    e = _Emitter(program)
+    e = FagorEmitter(program)
     text = e.run()
     return EmitResult(text, e.diags)
