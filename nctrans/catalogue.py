@@ -45,7 +45,7 @@ class Rule(BaseModel):
     good: str
     fix: Optional[str] = None
     dialect: str = DEFAULT_DIALECT
-    example_command: Literal["lint", "convert", "check"] = "lint"
+    example_command: Literal["lint", "convert", "check", "backplot"] = "lint"
     example_args: list[str] = []
     example_files: dict[str, str] = {}
     example_machine: Optional[str] = None

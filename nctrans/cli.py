@@ -438,6 +438,7 @@ def cmd_backplot(args) -> int:
         diags += [f.to_diagnostic() for f in found]
         plotted += [f.to_dict() for f in found]
     scene = backplot.build_scene(records, ld.label, plotted)
+    diags += backplot.left_out_diagnostics(scene)
     sources = {ld.label: ld.source.text}
     comparison = None
     if args.compare:
@@ -450,6 +451,7 @@ def cmd_backplot(args) -> int:
             _err(f"{lb.label}: not plotted (errors above)")
             return EXIT_DIAGNOSTICS
         scene_b = backplot.build_scene(records_b, lb.label, lb.diagnostics)
+        diags += backplot.left_out_diagnostics(scene_b)
         sources.setdefault(lb.label, lb.source.text)
         comparison = compare_scenes(scene, scene_b, records, records_b, args.tol or DEFAULT_TOL)
     _print_text_diags(diags, sys.stderr)

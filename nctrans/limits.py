@@ -45,6 +45,11 @@ MAX_STEPS = 2_000_000
 # refused (NC402 at its line) and `convert --flatten` streams the whole program instead (~1 KiB of
 # IR per block: 100,000 blocks ~ 100 MiB). NCTRANS_MAX_LOWERED_BLOCKS overrides it.
 MAX_LOWERED_BLOCKS = 100_000
+# Moves one backplot draws: a scene holds each move it draws (~1 KiB with its record), so an endless
+# loop (2 M steps of a drilling cycle: 24 M moves) would need gigabytes. Past it the plot shows the
+# first moves, says so in the plot, and NC011 names the line of the first move left out; the run
+# goes on to its end (its diagnostics). NCTRANS_MAX_PLOTTED_MOVES overrides it.
+MAX_PLOTTED_MOVES = 250_000
 # Elements of one declared array (DEF REAL A[n,m]): REP() and SET() walk them all.
 MAX_ARRAY_ELEMENTS = 1_000_000
 

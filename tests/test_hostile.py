@@ -416,6 +416,18 @@ def test_streamed_conversion_equals_the_whole_one(tmp_path, target):
     assert [d.format_text() for d in streamed.diagnostics] == [d.format_text() for d in whole.diagnostics]
 
 
+def test_backplot_of_an_endless_loop_draws_a_bounded_number_of_moves(tmp_path):
+    """A scene holds each move it draws: 24 M moves of an endless loop needed gigabytes. Past
+    250,000 moves (the default) the plot shows the first ones and says so (NC011 at the first move
+    left out, and a note in the plot); the run still ends at the step budget (600,000 steps here:
+    360,000 moves)."""
+    f = write(tmp_path, "loop.nc", "G90 G1 F1000\nWHILE [1 EQ 1] DO1\nX1 Y1\nX0 Y0\nX1 Y0\nEND1\nM30\n")
+    rc, out, err = run("backplot", f.name, "--from", "iso-m", "-o", "loop.svg", cwd=tmp_path,
+                       env={"NCTRANS_MAX_STEPS": "600000"})
+    assert rc == 1 and located(err, "NC205", "loop.nc", 5) and located(err, "NC011", "loop.nc", 4, 1), err
+    assert "250000 moves" in out and "first 250,000 moves of 360,002" in (tmp_path / "loop.svg").read_text()
+
+
 # --------------------------------------------------------------------------- wrong dialect (11)
 
 @pytest.mark.parametrize("text, column, marked", [

@@ -37,6 +37,8 @@ def _run_example(rule: catalogue.Rule, text: str, tmp: Path, capsys, encoding="u
         argv += ["--machine", str(machine)]
     if rule.example_command == "convert":
         argv += ["-o", str(tmp / "converted.out")]
+    if rule.example_command == "backplot":
+        argv += ["-o", str(tmp / "plot.svg")]
     capsys.readouterr()
     status = cli.main(argv)
     out = capsys.readouterr()

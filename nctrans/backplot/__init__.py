@@ -19,7 +19,19 @@ class BackplotError(Exception):
     """Something the plot needs that cannot be had (a machine mesh that does not load): exit 2."""
 
 
-__all__ = ["BackplotError", "FORMATS", "VIEW_NAMES", "Finding", "Scene", "build_scene", "format_for", "render"]
+__all__ = ["BackplotError", "FORMATS", "VIEW_NAMES", "Finding", "Scene", "build_scene", "format_for",
+           "left_out_diagnostics", "render"]
+
+
+def left_out_diagnostics(scene: Scene) -> list:
+    """NC011 at the first move a scene leaves out (limits.MAX_PLOTTED_MOVES), or nothing."""
+    if not scene.left_out:
+        return []
+    from nctrans.diagnostics import Diagnostic
+    r = scene.first_left_out
+    return [Diagnostic("NC011", "warning", f"the backplot draws the first {len(scene.moves):,} moves; "
+                       f"this one and {scene.left_out - 1:,} more are not drawn (NCTRANS_MAX_PLOTTED_MOVES)",
+                       r.file, r.line, 1)]
 
 
 def format_for(path: str | Path) -> Optional[str]:

@@ -99,6 +99,9 @@ class Scene:
     warnings: list[str] = field(default_factory=list)
     lo: list[float] = field(default_factory=lambda: [math.inf] * 3)
     hi: list[float] = field(default_factory=lambda: [-math.inf] * 3)
+    # moves past limits.MAX_PLOTTED_MOVES: how many, and the first one's record (not drawn)
+    left_out: int = 0
+    first_left_out: Optional[ToolpathRecord] = None
 
     @property
     def empty(self) -> bool:
@@ -179,7 +182,10 @@ def arc_extremes(r: ToolpathRecord):
 
 def build_scene(records: Iterable[ToolpathRecord], label: str,
                 findings: Iterable = ()) -> Scene:
-    """Read the toolpath once. findings: Finding objects, diagnostics or plain dicts."""
+    """Read the toolpath once. findings: Finding objects, diagnostics or plain dicts. Moves past
+    limits.MAX_PLOTTED_MOVES are counted, not drawn (the scene warns; `left_out`)."""
+    from nctrans import limits
+    most = limits.setting("MAX_PLOTTED_MOVES", limits.MAX_PLOTTED_MOVES)
     scene = Scene(label)
     moves = scene.moves
     seen_tools: set = set()
@@ -189,6 +195,11 @@ def build_scene(records: Iterable[ToolpathRecord], label: str,
     last_pos: Optional[XYZ] = None
     for r in records:
         kind = r.kind
+        if kind in MOTION_KINDS and len(moves) >= most:
+            if not scene.left_out:
+                scene.first_left_out = r
+            scene.left_out += 1
+            continue
         if kind in MOTION_KINDS:
             start, end = xyz(r.start), xyz(r.end)
             if not math.isfinite(sum(start) + sum(end) + sum((r.center or {}).values())):
@@ -223,6 +234,10 @@ def build_scene(records: Iterable[ToolpathRecord], label: str,
     if hidden:
         scene.warnings.append(f"the program moves {', '.join(sorted(hidden))}: the plot shows X, Y and Z "
                               f"only, without {'that axis' if len(hidden) == 1 else 'those axes'}")
+    if scene.left_out:
+        first = scene.first_left_out
+        scene.warnings.append(f"the plot shows the first {len(moves):,} moves of {len(moves) + scene.left_out:,} "
+                              f"(NCTRANS_MAX_PLOTTED_MOVES); the first not drawn is at line {first.line}")
     if skipped:
         scene.warnings.append(f"{len(skipped)} move(s) with a non-finite coordinate not drawn "
                               f"(first at line {skipped[0]})")
