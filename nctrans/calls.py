@@ -7,6 +7,12 @@ name (Sinumerik: WARMUP_CYCLE, L1234) meet here:
 - any other name becomes a number from O9000..O9999: 9000 + CRC-32 of the upper-case name mod 1000,
   so every file converts the same name to the same number without seeing the others (a clash
   within one program takes the next free number, and NC404 names the number used).
+A string argument of a kept call (ISO passes numbers only) becomes its *string number*: CRC-32
+of its UTF-8 text mod 10^7 (the empty string is 0), so a converted caller and the subprogram the
+target control provides agree on it without seeing each other; the output names each in a comment.
+A kept call's arguments, as `equiv` compares them, are positional: a G65's letters count in the
+order a PROC's parameters are passed as letters (A B C D E F H M Q R S T U V W X Y Z, then I J K),
+a letter not passed is an omitted argument, so `CALL(1,,3)` and `G65 P.. A1. C3.` are one call.
 `call_keys` gives the identities one call may have, so `equiv` can tell that a kept call in the
 conversion is the same call as in the source (an opaque event: same call, same evaluated
 arguments, same point of the toolpath).
@@ -35,6 +41,35 @@ def stable_number(name: str, taken: set[int] = frozenset()) -> int:
     while num in taken:
         num = NAMED_FIRST + (num - NAMED_FIRST + 1) % NAMED_COUNT
     return num
+
+
+# the locals of the G65 letters in the order a PROC's parameters take them (nctrans.dialects.iso_m
+# plan.ARG_LETTERS), then I J K (#4-#6)
+LETTER_LOCALS = (1, 2, 3, 7, 8, 9, 11, 13, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 4, 5, 6)
+
+
+def call_arguments(call) -> list:
+    """The argument expressions of a kept call in the order equiv compares them (None: not
+    passed): positional ones as written; G65 letters by LETTER_LOCALS, gaps left as None; other
+    named arguments after the positional ones, by the local they bind."""
+    bound = {name: getattr(call.bindings.get(name), "key", None) for name in call.named_args}
+    if call.named_args and not call.args and all(k in LETTER_LOCALS for k in bound.values()):
+        by_local = {bound[name]: e for name, e in call.named_args.items()}
+        out = [by_local.get(k) for k in LETTER_LOCALS]
+        while out and out[-1] is None:
+            out.pop()
+        return out
+    named = sorted(call.named_args.items(), key=lambda kv: (
+        bound[kv[0]] if isinstance(bound[kv[0]], int) else 1000, kv[0]))
+    return list(call.args) + [e for _, e in named]
+
+
+STRING_NUMBERS = 10_000_000
+
+
+def string_number(text: str) -> int:
+    """The number a string argument of a kept call is passed as (0..9999999; "" is 0)."""
+    return zlib.crc32(text.encode("utf-8")) % STRING_NUMBERS
 
 
 def call_keys(name: str) -> frozenset[str]:

@@ -447,6 +447,9 @@ class KeptCall:
     __slots__ = ("name", "args")
 
     def __init__(self, name: str, args: tuple):
+        # omitted trailing arguments are not passed at all (an ISO G65 has no letter for them)
+        while args and args[-1] is None:
+            args = args[:-1]
         self.name, self.args = name, args
 
     def __eq__(self, other) -> bool:

@@ -167,21 +167,21 @@ class CallsMixin:
         return make
 
     def _opaque_call(self, s: n.SubCall) -> None:
-        """A call nothing here defines: a "call" record (name, evaluated arguments in binding
-        order: positional ones, then named ones by the local they bind), so a conversion that keeps
-        the call can be compared with its source."""
-        exprs = list(s.args)
-        named = sorted(s.named_args.items(), key=lambda kv: (
-            s.bindings[kv[0]].key if kv[0] in s.bindings and isinstance(s.bindings[kv[0]].key, int)
-            else 1000, kv[0]))
-        exprs += [e for _, e in named]
+        """A call nothing here defines: a "call" record (name, evaluated arguments in the order
+        nctrans.calls.call_arguments gives; a string as its string number), so a conversion that
+        keeps the call can be compared with its source."""
+        from nctrans.calls import call_arguments, string_number
         values = []
-        for e in exprs:
-            if type(e) is n.Num and e.text == "":
+        for e in call_arguments(s):
+            if e is None or (type(e) is n.Num and e.text == ""):
                 values.append(None)             # an omitted argument
                 continue
             try:
-                values.append(self._value(self.ev.compile(e), "call argument"))
+                raw = self.ev.compile(e)()
+                if isinstance(raw, str):        # passed as its string number (nctrans.calls)
+                    values.append(float(string_number(raw)))
+                else:
+                    values.append(self._value(lambda: raw, "call argument"))
             except EvalError:
                 values.append(None)
         self._record("call", call=s.name, args=values)

@@ -149,6 +149,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         # distance mode in source order, so a one-block G91 (incremental reference-point
         # approach from other dialects) can be followed by the G90 that restores it
         self.restore_absolute = False
+        self.restore_arc_incremental = False
+        self.rotation_plane: Optional[str] = None     # the plane a rotation about a named axis holds
         self.arc_distance = "incremental"
         # the plan: labels, locals and O numbers per unit (None = the main program)
         self.unit: Optional[str] = None
@@ -156,6 +158,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.targets: dict[Optional[str], set[str]] = {}
         self.sub_numbers: dict[str, int] = {}
         self.arrays: dict[tuple, pl.ArrayPlan] = {}
+        self.undeclared: set[str] = set()      # arrays used but not declared (NC410 once each)
+        self.strings: dict[int, str] = {}       # string number -> the string argument it stands for
         # (unit, array parameter) -> its dimensions
         self._slot_dims: dict[tuple, list[int]] = {
             (key, prm.name.upper()): list(prm.dims)
@@ -194,6 +198,8 @@ class IsoEmitter(IsoSpelling, Emitter):
                 return f"#{local}"
             if plan is not None and key in plan.slots:
                 return self._slot_var(plan, key, v)
+            if v.indices:
+                return self._undeclared_element(key, v)
         if v.space == "R" and v.key is None and v.indices and len(v.indices) == 1:
             self.lowered("R[expr] written as #[500+expr]")
             return f"#[500+{self.expr(v.indices[0])}]"
@@ -257,6 +263,32 @@ class IsoEmitter(IsoSpelling, Emitter):
             return f"#{arr.base + int(c)}"
         return f"#[{self.expr(n.Binary('+', n.Num(float(arr.base)), offset))}]"
 
+    def _undeclared_element(self, key: str, v: n.Var) -> str:
+        """An element of an array the program uses but does not declare (a GUD of the control's
+        definition files): with constant indices, the element gets a common variable of its own
+        in the #500 block, named in the table; its dimensions are unknown here, so an index
+        computed at run time has no place to go."""
+        idx = [constant(e) for e in v.indices]
+        if any(c is None or c != int(c) or c < 0 for c in idx):
+            raise NotExpressible(f"the array {v.key} indexed by an expression: it is not declared in "
+                                 "this program, so its dimensions (the element's place) are unknown")
+        element = f"{key}[{','.join(str(int(c)) for c in idx)}]"
+        number = self.var_map.get(("element", element))
+        if number is None:
+            if self.next_array > pl.COMMON_END:
+                raise NotExpressible(f"the array element {element}: no room left in #500-#{pl.COMMON_END}")
+            number = self.var_map[("element", element)] = self.next_array
+            self.next_array += 1
+            if key not in self.undeclared:
+                self.undeclared.add(key)
+                self.diags.append(at_span(
+                    "NC410", "warning", f"{v.key} is not declared in the program (a global of the "
+                    f"control's definition files): each element used is mapped to a common variable "
+                    f"of its own for this program only ({element} = #{number}; the table at the top "
+                    "names them); a program converted on its own that shares it may place it "
+                    "elsewhere, and its values must be loaded there", self._where()))
+        return f"#{number}"
+
     def map_var(self, v: n.Var) -> int:
         key = (v.space, v.key)
         if key not in self.var_map:
@@ -309,11 +341,13 @@ class IsoEmitter(IsoSpelling, Emitter):
             # O<its number>, the body, M99; callers elsewhere call the same number
             self.out.append(f"O{self.sub_numbers[library]} {self._comment(library)}")
             self.lowered(f"subprogram file {library} written as O{self.sub_numbers[library]}")
+            names_at = len(self.out)
             self._subprogram(library, p.subprograms[library])
             for key, sub in p.subprograms.items():
                 if key != library:
                     self.out.append(f"O{self.sub_numbers.get(key, pl.iso_number(key))}")
                     self._subprogram(key, sub)
+            self.out[names_at:names_at] = self._name_table()
             if percent:
                 self.out.append("%")
             return "\n".join(self.out) + "\n"
@@ -348,7 +382,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         `(VAR LEN = #100)`, `(VAR ARR[3] = #510..#512)`, `(VAR R1 = #501)`, per unit."""
         lines = []
         for (space, key), number in self.var_map.items():
-            if space in ("name", "R"):
+            if space in ("name", "R", "element"):
                 lines.append(f"(VAR {'R' if space == 'R' else ''}{key} = #{number})")
         for unit, plan in self.plans.items():
             where = f" IN {unit}" if unit else ""
@@ -358,6 +392,8 @@ class IsoEmitter(IsoSpelling, Emitter):
             where = f" IN {unit}" if unit else ""
             dims = ",".join(str(d) for d in arr.dims)
             lines.append(f"(VAR {name}[{dims}]{where} = #{arr.base}..#{arr.base + arr.size - 1})")
+        for number, text in self.strings.items():
+            lines.append(self._comment(f'STRING "{text}" = {number}'))
         return lines
 
     def _library_entry(self) -> Optional[str]:
@@ -506,6 +542,9 @@ class IsoEmitter(IsoSpelling, Emitter):
         if self.restore_absolute:
             self.restore_absolute = False
             self.out.append(self.code_for("distance", "absolute"))
+        if self.restore_arc_incremental:
+            self.restore_arc_incremental = False
+            self.out.append(self.code_for("arc_distance", "incremental"))
 
     def s_If(self, node: n.If) -> None:
         then = node.then
@@ -653,6 +692,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         return key, code
 
     def w_ModeChange(self, s: n.ModeChange):
+        if s.group in ("plane", "cutter_comp", "cycle"):
+            self._plane_held(f"mode {s.group}={s.value}")
         if s.group == "distance":
             self.distance = s.value
         if s.group == "arc_distance":       # under G90.1 ISO writes absolute centres as they are
@@ -752,6 +793,8 @@ class IsoEmitter(IsoSpelling, Emitter):
     def w_Motion(self, s: n.Motion):
         if self.named_cycle is not None and s.target:
             return self._named_hole(s)
+        if s.via or s.center or s.radius is not None or s.aperture is not None or s.turns is not None:
+            self._plane_held("an arc")
         if s.via:
             return self._cip(s)
         if self.cip_mode and s.target:
@@ -773,7 +816,18 @@ class IsoEmitter(IsoSpelling, Emitter):
         words += self._axes(s.target)
         if s.aperture is not None:
             words.append(("R", "R" + self._aperture_radius(s, start)))
-        if s.center:
+        if s.center and self.arc_distance != "absolute" and all(av.mode == "abs" for av in s.center.values()) \
+                and any(constant(av.value) is None or {"I": "X", "J": "Y", "K": "Z"}.get(k, k) not in start
+                        for k, av in s.center.items()):
+            # absolute centres (Sinumerik I=AC(..)) from a start point known only at run time:
+            # this block under G90.1, G91.1 again after it
+            self.lowered("absolute arc centre written under G90.1 (G91.1 after the block)")
+            words.insert(0, self._g("arc_distance", "absolute"))
+            self.restore_arc_incremental = True
+            for k, av in s.center.items():
+                letter = {"X": "I", "Y": "J", "Z": "K"}.get(k, k)
+                words.append((letter, self.addr(letter, av.value)))
+        elif s.center:
             for k, av in s.center.items():
                 letter = {"X": "I", "Y": "J", "Z": "K"}.get(k, k)
                 value = av.value
@@ -898,16 +952,16 @@ class IsoEmitter(IsoSpelling, Emitter):
                 return self._additive_trans(s)
             raise NotExpressible(f"an additive frame ({s.op})")
         other = self.frame_other
+        trans_before = self.frame_trans
         self.track_frame(s)
         if s.op == "all" and s.clear:
             # the whole programmable frame off (Sinumerik TRANS/ROT without values): cancel the
             # local shift, and rotation, scaling and mirroring when they may be active
             words = [self.code_word("nonmodal", "local_offset")] + [(k, k + "0.") for k in "XYZ"]
-            if other:
-                mirror = self._cancel("mirror_off")
-                words += self._cancel("rot_off") + self._cancel("scale_off") + mirror
-                words += [(k, k + "0.") for k in "XYZ"] if mirror else []
-            return words
+            if not other:
+                return words + self._plane_back()
+            # one cancel a line: G69 and G50 are one neutral group, and G52 and G50.1 both take X Y Z
+            return _Lines([words, *self._cancel_others(), *([w] for w in self._plane_back())])
         if s.op == "trans":
             shift = self.code_word("nonmodal", "local_offset")
             if s.clear:
@@ -917,10 +971,10 @@ class IsoEmitter(IsoSpelling, Emitter):
             return [shift] + [(k, self.addr(k, v)) for k, v in s.values.items()]
         if s.op == "rot":
             if s.clear:
-                return self._cancel("rot_off")
+                return self._cancel("rot_off") + self._plane_back()
             extra = {k: v for k, v in s.values.items() if k in "IJK"}
             if set(s.values) - set(extra):
-                raise NotExpressible("rotation about a named axis")
+                return self._rotation_about(s, other, trans_before)
             words = [self.code_word("frame", "rot")] + (self._axes(s.center) if s.center else [])
             words += [(k, self.addr(k, v)) for k, v in extra.items()]
             if s.angle is not None:
@@ -961,6 +1015,52 @@ class IsoEmitter(IsoSpelling, Emitter):
             return []
         return [self.code_word("frame", meaning)]
 
+    def _rotation_about(self, s: n.FrameOp, other: bool, trans_before) -> list:
+        """ROT about one named axis (Sinumerik ROT Y90): G68 in the plane that axis is normal to,
+        about the work zero (G68 turns positive from the plane's first axis to its second, as ROT
+        turns by the right-hand rule). Another plane than the source's is selected for the
+        rotation and the source's selected again at its cancel; in between, what depends on the
+        plane (arcs, cycles, compensation) has no ISO spelling."""
+        named = [k for k in s.values if k not in "IJK"]
+        plane = {"Z": "XY", "Y": "ZX", "X": "YZ"}.get(named[0]) if len(s.values) == 1 else None
+        if plane is None or s.center or s.angle is not None:
+            raise NotExpressible(f"rotation about {' and '.join(s.values)}")
+        # ROT replaces the whole programmable frame: what may be active is cancelled first
+        cancel = []
+        if trans_before != {}:
+            cancel.append([self.code_word("nonmodal", "local_offset")] + [(k, k + "0.") for k in "XYZ"])
+        if other:
+            cancel += self._cancel_others()
+        words = []
+        if plane != self.plane:
+            words.append(self.code_word("plane", plane))
+            self.rotation_plane = plane
+        first, second = pl.PLANE[plane][:2]
+        self.lowered(f"rotation about {named[0]} written as G68 in the {plane} plane about the work zero"
+                     + (f" ({words[0][1]}; the program's plane again at its cancel)" if words else ""))
+        words += [self.code_word("frame", "rot"), (first, first + "0."), (second, second + "0."),
+                  ("R", self.addr("R", s.values[named[0]]))]
+        return _Lines([*cancel, words]) if cancel else words
+
+    def _cancel_others(self) -> list:
+        """Rotation, scaling and mirroring off, each on a line of its own."""
+        mirror = self._cancel("mirror_off")
+        lines = [self._cancel("rot_off"), self._cancel("scale_off"),
+                 mirror + ([(k, k + "0.") for k in "XYZ"] if mirror else [])]
+        return [x for x in lines if x]
+
+    def _plane_back(self) -> list:
+        """The source's plane again where a rotation about another axis held another one."""
+        if self.rotation_plane is None:
+            return []
+        self.rotation_plane = None
+        return [self.code_word("plane", self.plane)]
+
+    def _plane_held(self, what: str) -> None:
+        if self.rotation_plane is not None:
+            raise NotExpressible(f"{what} while a rotation holds the ISO plane at {self.rotation_plane} "
+                                 f"(the program's is {self.plane})")
+
     def _factor(self, v) -> str:
         if type(v) is n.Num:
             return format_number(v.value, True)
@@ -985,6 +1085,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         return words
 
     def w_CycleCall(self, s: n.CycleCall):
+        self._plane_held(f"the cycle {s.name or s.kind}")
         if s.kind in ("holes_line", "holes_circle"):
             return self._hole_pattern(s)
         if s.kind == "swivel_plane":
@@ -1167,7 +1268,10 @@ class IsoEmitter(IsoSpelling, Emitter):
                                  "that is not in this program")
         taken = {num for num in self.sub_numbers.values()}
         taken.update(pl.iso_number(k) for k in self.program.subprograms if pl.iso_number(k) is not None)
-        number = pl.stable_number(s.name, taken)
+        from nctrans.calls import number_of
+        number = number_of(s.name)              # L140 is program 140 (nctrans.calls)
+        if number is None:
+            number = pl.stable_number(s.name, taken)
         params = self._extern_params(s)
         unit = pl.unit_plan(n.Subprogram(s.name, self._where(), [], params), [], self.fresh_label)
         if unit.refusal:
@@ -1212,6 +1316,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         for i, (letter, arg) in enumerate(zip(unit.params, s.args)):
             if type(arg) is n.Num and arg.text == "":
                 continue                    # an omitted argument stays vacant
+            if type(arg) is n.Str:
+                arg = self._string_argument(s.name, arg)
             if letter:
                 words.append(("", self.addr(letter, arg)))
                 continue
@@ -1225,6 +1331,20 @@ class IsoEmitter(IsoSpelling, Emitter):
         if not before and not after:
             return words
         return _Lines([*before, words, *after])
+
+    def _string_argument(self, callee: str, arg: n.Str) -> n.Num:
+        """A string argument (ISO passes numbers only) as its string number (nctrans.calls), named
+        in the table at the top; NC411 says the subprogram must take it so."""
+        from nctrans.calls import string_number
+        number = string_number(arg.value)
+        if self.strings.setdefault(number, arg.value) != arg.value:
+            raise NotExpressible(f"the strings {self.strings[number]!r} and {arg.value!r}: both are "
+                                 f"string number {number}")
+        self.diags.append(at_span(
+            "NC411", "warning", f"the string {arg.value!r} passed to {callee} is passed as its string "
+            f"number {number} (ISO has no strings): the subprogram the target control provides must "
+            "take it so", self._where()))
+        return n.Num(float(number))
 
     def _elements(self, arg, size: int, callee: str) -> list:
         """The argument expressions filling `size` slots: the value itself, or each element of an
@@ -1278,8 +1398,18 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def w_Message(self, s):
         self.lowered("message written as an (MSG, ...) comment")
-        text = s.text.value if type(s.text) is n.Str else self.expr(s.text)
-        return [("", self._comment(f"MSG, {text}"))]
+        return [("", self._comment(f"MSG, {self._message_text(s.text)}"))]
+
+    def _message_text(self, e) -> str:
+        """A message's text: string parts as they are, values (`"X: " << X`) as the ISO
+        expression that holds them in angle brackets, since an ISO comment shows no values."""
+        if type(e) is n.Str:
+            return e.value
+        if type(e) is n.Binary and e.op == "concat":
+            return self._message_text(e.left) + self._message_text(e.right)
+        self.lowered("a value in a message written as the expression that holds it (the comment "
+                     "shows no value)")
+        return f"<{self.expr(e)}>"
 
     def w_Alarm(self, s):
         self.lowered("alarm written as #3000")
@@ -1305,10 +1435,10 @@ class IsoEmitter(IsoSpelling, Emitter):
             init = s.init[0] if s.init else n.Num(0.0)
             self.lowered(f"local variable {s.name} written as #{local}")
             return [("#", f"#{local}={self.expr(init)}")]
-        if s.init:
-            return [("#", f"{self.val(var)}={self.expr(s.init[0])}")]
-        self.map_var(var)
-        return []
+        # DEF without a value starts at 0; a common variable keeps what it held (or is vacant,
+        # which a comparison or a G65 argument tells from 0)
+        init = s.init[0] if s.init else n.Num(0.0)
+        return [("#", f"{self.val(var)}={self.expr(init)}")]
 
     def _array(self, s: n.VarDecl):
         """A numeric array: a row-major block of common variables, every element set (DEF sets
