@@ -1,6 +1,6 @@
 """The Fagor emitter on a program that arrives in pieces (a streamed parse, or a flattened run).
 
-`_Emitter.run()` writes the local subroutines, then `%NAME`, the power-on modes and the main body.
+`FagorEmitter.run()` writes the local subroutines, then `%NAME`, the power-on modes and the main body.
 A program that streams has no subroutines, so the head is `%NAME` and the prologue, written by
 the emitter's own methods; the body is then written chunk by chunk by the same emitter, whose
 state (motion, distance, plane, tool length) carries over from chunk to chunk as in one pass, so
@@ -18,7 +18,7 @@ from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import CannotStream
 from nctrans.ir import nodes as n
 
-from .emitter import _Emitter, _program_header
+from .emitter import FagorEmitter, _program_header
 
 # Statements whose targets are planned over the whole program.
 _PLANNED = (n.Goto, n.SubCall, n.Return)
@@ -32,7 +32,7 @@ def emit_stream(program: n.Program, chunks: Iterable[list], write: Callable[[str
         raise CannotStream("subprograms")
     chunks = iter(chunks)
     first = next(chunks, None)      # a streamed parse fills program.meta as it starts
-    e = _Emitter(program)
+    e = FagorEmitter(program)
     e.in_sub = False
     e._reset()
     e.out.append(f"%{_program_header(program)}")
@@ -45,7 +45,7 @@ def emit_stream(program: n.Program, chunks: Iterable[list], write: Callable[[str
     return e.diags
 
 
-def _body(e: _Emitter, chunk: list, write: Callable[[str], None]) -> None:
+def _body(e: FagorEmitter, chunk: list, write: Callable[[str], None]) -> None:
     for node in chunk:
         if type(node) is not n.Block or node.label or any(type(s) in _PLANNED for s in node.body):
             raise CannotStream(f"{type(node).__name__} at line {node.span.line}")
@@ -53,7 +53,7 @@ def _body(e: _Emitter, chunk: list, write: Callable[[str], None]) -> None:
     _flush(e, write)
 
 
-def _flush(e: _Emitter, write: Callable[[str], None]) -> None:
+def _flush(e: FagorEmitter, write: Callable[[str], None]) -> None:
     if e.out:
         write("\n".join(e.out) + "\n")
         e.out = []
