@@ -115,6 +115,18 @@ def test_absolute_arc_centre_from_a_start_known_at_run_time_is_written_under_g90
     assert [(r.end["X"], r.center["X"], r.center["Y"]) for r in arcs] == [(-10.0, 0.0, 0.0), (-20.0, 0.0, 0.0)]
 
 
+def test_a_parameter_a_call_leaves_out_reads_zero_in_iso_too():
+    # Sinumerik: an unprogrammed parameter is 0 (X0); a vacant G65 local would drop the X word
+    src = "G0 X5 Y5\nP1(,3)\nM30\nPROC P1(REAL A, REAL B)\nG1 X=A Y=B F100\nRET\n"
+    conv = _convert(src)
+    lines = conv.text.splitlines()
+    assert lines[lines.index("IF[#1EQ#0]THEN#1=0") + 1] == "IF[#2EQ#0]THEN#2=0"
+    same = api.equiv(src, conv.text, read_a="sinumerik", read_b="iso-m")
+    assert same, same.message
+    moves = [r.end for r in nctrans.toolpath(conv.text, dialect="iso-m") if r.kind == "linear"]
+    assert [(m["X"], m["Y"]) for m in moves] == [(0.0, 3.0)]
+
+
 # ---------------------------------------------------------------- ROT about a named axis
 
 ROT_Y = "G17 G90 G0 X0 Y0 Z0\nTRANS X5\nROT Y90\nG1 X10 F100\nG1 Y5 Z3\nTRANS\nG0 Z50\nM30\n"

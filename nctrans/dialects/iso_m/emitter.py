@@ -424,10 +424,24 @@ class IsoEmitter(IsoSpelling, Emitter):
             self.lowered(f"{unit.frame} parameters and locals of {key} kept on the spill stack "
                          f"#{pl.SPILL_BASE}..#{pl.SPILL_END} (pointer #{pl.SPILL_POINTER})")
             self.out.append(f"#{pl.SPILL_POINTER}=#{pl.SPILL_POINTER}+{unit.frame}")
+        if not unit.refusal:
+            self._unprogrammed_zero(sub, unit)
         self.nodes(sub.body)
         if (key in self.sub_numbers or unit.frame) and not walk.ends_with_return(sub.body):
             self.out.extend(self._pop_frame())
             self.out.append(self.code_for("call", "m99"))
+
+    def _unprogrammed_zero(self, sub: n.Subprogram, unit: pl.UnitPlan) -> None:
+        """A parameter a call leaves out reads 0 in the source (Sinumerik: incomplete parameter
+        transfer) but is vacant in a G65 local, and a vacant X#24 drops the word: each letter
+        parameter is set to 0 on entry when it came vacant, whoever calls."""
+        letters = [letter for prm, letter in zip(sub.params, unit.params) if letter and not prm.by_ref]
+        if not letters:
+            return
+        self.lowered("parameters a call leaves out read 0 as in the source: IF[#nEQ#0]THEN#n=0 on entry")
+        for letter in letters:
+            k = pl.ARG_LOCALS[letter]
+            self.out.append(f"IF[#{k}EQ#0]THEN#{k}=0")
 
     def _pop_frame(self) -> list[str]:
         """What leaving the current unit must do first: release its spill frame."""
@@ -1315,7 +1329,9 @@ class IsoEmitter(IsoSpelling, Emitter):
         after: list = []
         for i, (letter, arg) in enumerate(zip(unit.params, s.args)):
             if type(arg) is n.Num and arg.text == "":
-                continue                    # an omitted argument stays vacant
+                if letter:
+                    continue                # an omitted argument stays vacant (the callee reads 0)
+                arg = n.Num(0.0)            # a spill slot holds what the last call left there
             if type(arg) is n.Str:
                 arg = self._string_argument(s.name, arg)
             if letter:
