@@ -681,6 +681,9 @@ def main(argv: Optional[list[str]] = None) -> int:
         # the process ends; frozen, no garbage collection walks it again (~10 ms of a run).
         import gc
         gc.freeze()
+        # a command reads at most two whole programs it keeps to the end (equiv); more (lint DIR)
+        # are read one after another and must be freed
+        pipeline.FREEZE_BUDGET = 2
     previous = None
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
