@@ -108,6 +108,10 @@ def _signed_float(text: str) -> float:
         sign = -1.0 if (len(text) - len(digits) - text[: len(text) - len(digits)].count("+")) % 2 else 1.0
         return sign * float(digits)
 
+# frame codes that cancel and read no words (rules value -> FrameOp kind)
+_WORDLESS_CLEARS = {"rot_off": "rot", "scale_off": "scale"}
+
+
 class _Blk:
     """Per-block lowering context (one per non-trivial block)."""
     __slots__ = ("vals", "out", "owner", "owner_rule", "machine", "motion_g", "cycle_g",
@@ -280,6 +284,11 @@ class Lowering:
         b.out.append((B_WCS, ModeChange("work_offset", value, "G" + text)))
 
     def _g_frame(self, b: _Blk, rule, text: str) -> None:
+        if rule.value in _WORDLESS_CLEARS:
+            # G69 / G50 take no words: written beside another frame code (`G69 G50`, `G69 G51 P2`)
+            # each must still act, so it never competes for the block's one word owner
+            b.out.append((B_NONMODAL, FrameOp(_WORDLESS_CLEARS[rule.value], clear=True)))
+            return
         b.owner = rule.value
         b.owner_rule = rule
 
