@@ -213,6 +213,13 @@ class MotionMixin:
         if not st.spindle_speed:
             self.diag("NC209", "warning", "thread move (G33) with no spindle speed: the feed "
                       "(lead x S) is unknown")
+        self._lead_move(target, lead)
+
+    def _lead_move(self, target, lead: float) -> None:
+        """A feed move synchronised with the spindle (G33, G331/G332): `lead` mm per revolution,
+        so the feed is lead x S (unknown without S); the records carry the lead as pitch and the
+        programmed feed comes back afterwards."""
+        st = self.st
         saved, saved_mode = st.feed, st.feed_mode
         st.feed = lead * st.spindle_speed if st.spindle_speed else None
         st.feed_mode = "per_min"

@@ -45,13 +45,4 @@ def rigid_tap_move(it, vals, center, motion: str) -> None:
         st.set("spindle", turning)
         it.spindle_stopped = False
         it._record("spindle", spindle_dir=turning, spindle=st.spindle_speed)
-    pitch = abs(lead)
-    saved, saved_mode = st.feed, st.feed_mode
-    st.feed, st.feed_mode = pitch * st.spindle_speed, "per_min"
-    mark = len(it.out)
-    try:
-        it._move("linear", target)
-    finally:
-        st.feed, st.feed_mode = saved, saved_mode
-    for rec in it.out[mark:]:
-        rec.pitch = pitch
+    it._lead_move(target, abs(lead))

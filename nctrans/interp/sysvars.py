@@ -86,18 +86,26 @@ def _value(k: str, v: Any) -> float:
     return 0.0 if v is None else float(v)
 
 
+def _work_offset_slot(e: dict, offset: int) -> tuple[str, str] | None:
+    """The work offset and axis a number of a work-offset range names (`step` numbers per
+    offset, one per axis), or None past the offsets or axes the table lists."""
+    index, axis = divmod(offset, int(e.get("step", 20)))
+    offsets = e["offsets"]
+    if index >= len(offsets) or axis >= len(AXES):
+        return None
+    return offsets[index], AXES[axis]
+
+
 def _writer(interp, e: dict, offset: int, wear: dict) -> Callable[[Any], None] | None:
     """How writing the number changes the machine data; None for a number without machine data."""
     src = e["source"]
     st = interp.st
     name = f"#{int(e['first']) + offset}"
     if src == "work_offset":
-        step = int(e.get("step", 20))
-        index, axis = divmod(offset, step)
-        offsets = e["offsets"]
-        if index >= len(offsets) or axis >= len(AXES):
+        slot = _work_offset_slot(e, offset)
+        if slot is None:
             return None
-        which, a = offsets[index], AXES[axis]
+        which, a = slot
 
         def work_offset(v):
             value = _value(name, v) * (st.scale if a in "XYZ" else 1.0)
@@ -154,12 +162,10 @@ def _reader(interp, e: dict, offset: int, wear: dict) -> Callable[[], Any] | Non
             return float(v) / (st.feed_scale if word == "feed" and st.feed_mode != "inverse_time" else 1.0)
         return modal_word
     if src == "work_offset":
-        step = int(e.get("step", 20))
-        index, axis = divmod(offset, step)
-        offsets = e["offsets"]
-        if index >= len(offsets) or axis >= len(AXES):
+        slot = _work_offset_slot(e, offset)
+        if slot is None:
             return None
-        name, a = offsets[index], AXES[axis]
+        name, a = slot
 
         def work_offset():
             return interp.machine.work_offset(name).get(a, 0.0) / (st.scale if a in "XYZ" else 1.0)
