@@ -602,6 +602,8 @@ def test_any_arguments_plan_or_refuse(name, data):
     from nctrans.interp.milling_cycles import MAX_MOVES, MillingError
     cyc = CYCLES[name]
     p = {k: v for k in cyc["params"] if (v := data.draw(any_value, label=k)) is not None}
+    if cyc["shape"] == "stock_removal":      # CYCLE95 needs a contour: tests/test_controls_cycle95.py
+        return
     try:
         if cyc["shape"] == "thread_turn":
             steps = thread_turn_steps(p, (30.0, 10.0))

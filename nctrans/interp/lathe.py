@@ -170,9 +170,13 @@ class LatheMixin:
 
     def _turning_control(self, s: n.CycleCall, unit, pc, sidx):
         """Run a turning cycle; returns where the interpreter continues (unit, code, pc, sidx)."""
+        resume = (unit, unit.code, pc, sidx)
+        if s.kind == "milling":                 # Sinumerik CYCLE95 (nctrans.interp.stock_removal)
+            from nctrans.interp.stock_removal import run_cycle95
+            run_cycle95(self, s, unit, pc)
+            return resume
         vals = self._turning_values(s)
         first = (self.turning_first or {}).get(s.kind, {})
-        resume = (unit, unit.code, pc, sidx)
         if s.kind in CONTOUR_KINDS:
             found = self._contour_blocks(vals, unit, pc)
             if found is None:
