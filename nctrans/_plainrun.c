@@ -357,19 +357,23 @@ static int plain_in_state(const Block *b, int *motion, int *cycle_off, int arc_a
     return 1;
 }
 
-/* scan(text, pos, sep, motion, cycle_off, arc_abs[, strict]) -> (end, lines, blocks, motion)
+/* scan(text, pos, sep, motion, cycle_off, arc_abs[, strict[, max_chars]]) -> (end, lines, blocks, motion)
  * The run of plain lines starting at pos, given the front end's static motion mode (a MOTION_*
  * code), whether no canned cycle is active and whether centres are absolute (G90.1): `end` is where the next line starts (len(text) + 1
  * when the run reaches the end of the text), `lines` how many lines it spans, `blocks` how many of
  * them are blocks (blank lines inside the run are not), `motion` the last G word's mode (-1:
  * none). The run never starts with a blank line. strict: see words_separated and parse_block_as
- * (run() needs no flag: it only reads runs scan() gave). */
+ * (run() needs no flag: it only reads runs scan() gave). max_chars: the longest line the front end
+ * reads (limits.MAX_BLOCK_CHARS, as set): a longer one, blank or not, ends the run, so the front
+ * end reports it (NC010) where it would without the kernel. */
 static PyObject *scan(PyObject *self, PyObject *args)
 {
     PyObject *str;
     Py_ssize_t pos;
     int sepc, motion, cycle_off, arc_abs, strict = 0;
-    if (!PyArg_ParseTuple(args, "UnCipp|p", &str, &pos, &sepc, &motion, &cycle_off, &arc_abs, &strict))
+    Py_ssize_t max_chars = PY_SSIZE_T_MAX;
+    if (!PyArg_ParseTuple(args, "UnCipp|pn", &str, &pos, &sepc, &motion, &cycle_off, &arc_abs, &strict,
+                          &max_chars))
         return NULL;
     Text t;
     if (get_text(str, &t) < 0)
@@ -385,6 +389,8 @@ static PyObject *scan(PyObject *self, PyObject *args)
     int last_g = -1;
     while (p >= 0 && p <= t.len) {
         Py_ssize_t q = line_end(&t, p, (Py_UCS4)sepc);
+        if (q - p > max_chars)
+            break;                     /* NC010: the front end reports it */
         int n = read_line(&t, p, q, buf);
         if (n == LINE_BLANK) {
             if (blocks == 0)
@@ -657,7 +663,8 @@ static double hyp(double a, double b) { return hypot(a, b); }
 #define PUTS(lit) PUT(lit, sizeof(lit) - 1)
 
 /* run(text, pos, end, sep, lineno, axes, prog, tot, mach, scale, incremental, motion, feed,
- *     feed_mode_json, rapid_tail, seq, file_json, max_blocks, write, plane, arc_absolute, inch_tol)
+ *     feed_mode_json, rapid_tail, seq, file_json, max_blocks, write, plane, arc_absolute, inch_tol
+ *     [, feed_scale])
  *   -> (pos, lineno, blocks, chunk, records, prog, mach, motion, feed, feed_seen, last_from,
  *       last_arc, last_g)
  *
@@ -668,7 +675,9 @@ static double hyp(double a, double b) { return hypot(a, b); }
  * active feed (mm/min) or None; feed_mode_json: ',"feed_mode":"per_min"' as the record writes it;
  * rapid_tail: the spindle and tool fields every motion record ends with; seq: the last record's
  * number; file_json: the file as a JSON string; plane: "XY", "ZX" or "YZ"; arc_absolute: I J K
- * are absolute (G90.1); center_tol: the arc centre tolerance (arcs.CENTER_TOL_*). Returns where
+ * are absolute (G90.1); center_tol: the arc centre tolerance (arcs.CENTER_TOL_*); feed_scale: what
+ * an F word is multiplied by (the feed unit -> mm; `scale` when not given, but Sinumerik G70 reads
+ * lengths in inch and feeds in mm: 25.4 and 1). Returns where
  * it stopped (the first block it cannot run identically, or `end`), the JSON lines (None unless
  * `write`) and the new state; last_arc is (c1, c2, cw) when the last move was an arc; last_g the
  * MOTION_* code of the last G word in the blocks run (-1: none). */
@@ -677,24 +686,27 @@ static PyObject *run(PyObject *self, PyObject *args)
     PyObject *str, *axes_obj, *prog_obj, *tot_obj, *mach_obj, *feed_obj;
     Py_ssize_t pos, end, lineno, seq, max_blocks;
     int sepc, incremental, motion, write, arc_absolute;
-    double scale, center_tol;
+    double scale, center_tol, feed_scale = NAN;
     const char *fm_json, *tail_json, *file_json, *plane;
     Py_ssize_t fm_len, tail_len, file_len, plane_len;
-    if (!PyArg_ParseTuple(args, "UnnCnUOOOdpiOs#s#ns#nps#pd", &str, &pos, &end, &sepc, &lineno,
+    if (!PyArg_ParseTuple(args, "UnnCnUOOOdpiOs#s#ns#nps#pd|d", &str, &pos, &end, &sepc, &lineno,
                           &axes_obj, &prog_obj, &tot_obj, &mach_obj, &scale, &incremental, &motion,
                           &feed_obj, &fm_json, &fm_len, &tail_json, &tail_len, &seq, &file_json,
                           &file_len, &max_blocks, &write, &plane, &plane_len, &arc_absolute,
-                          &center_tol))
+                          &center_tol, &feed_scale))
         return NULL;
+    if (PyTuple_GET_SIZE(args) < 23)
+        feed_scale = scale;
     Text t;
     if (get_text(str, &t) < 0)
         return NULL;
     /* validated at the boundary: the loop indexes the text, KIND[] and the tables with these */
     if (pos < 0 || end < pos || end > t.len || lineno < 0 || max_blocks < 0
         || motion < MOTION_RAPID || motion > MOTION_OTHER || !(scale > 0.0) || !isfinite(scale)
+        || !(feed_scale > 0.0) || !isfinite(feed_scale)
         || !(center_tol >= 0.0) || !isfinite(center_tol)) {
         PyErr_SetString(PyExc_ValueError, "run: pos/end outside the text, or lineno, max_blocks, "
-                        "motion, scale or center_tol out of range");
+                        "motion, scale, feed_scale or center_tol out of range");
         return NULL;
     }
     if (plane_len != 0 && !(strcmp(plane, "XY") == 0 || strcmp(plane, "ZX") == 0
@@ -791,7 +803,7 @@ static PyObject *run(PyObject *self, PyObject *args)
                 goto fail;
             if (!(v >= 0) || !isfinite(v))
                 break;                  /* negative feed: a diagnostic Python reports */
-            new_feed = v * scale;
+            new_feed = v * feed_scale;
             new_has_feed = 1;
         }
         int new_motion = b.gmode >= 0 ? b.gmode : motion;

@@ -291,18 +291,19 @@ def test_straight_blocks_do_not_spend_the_step_budget_with_or_without_kernel(bud
 @pytest.mark.skipif(NATIVE is None, reason="the native kernel is not built")
 @pytest.mark.parametrize("change", [{"pos": -1000}, {"pos": 10**6}, {"end": 10**6}, {"motion": 7},
                                     {"motion": -1}, {"lineno": -5}, {"max_blocks": -1},
-                                    {"scale": 0.0}, {"scale": float("nan")}, {"plane": "QQ"}])
+                                    {"scale": 0.0}, {"scale": float("nan")}, {"plane": "QQ"},
+                                    {"feed_scale": -1.0}, {"feed_scale": float("inf")}])
 def test_kernel_validates_its_arguments_at_the_boundary(change):
     """run() and scan() refuse out-of-range arguments with ValueError instead of reading outside
     the text or the kernel's tables (pos=-1000 was a use after free under ASan, motion=7 an
     out-of-bounds index)."""
     text = "G1X1.Y2.F100.\nX3.Y4.\n"
-    args = dict(pos=0, end=len(text), lineno=1, motion=1, max_blocks=10, scale=1.0, plane="XY")
+    args = dict(pos=0, end=len(text), lineno=1, motion=1, max_blocks=10, scale=1.0, plane="XY", feed_scale=1.0)
     args.update(change)
     with pytest.raises(ValueError):
         NATIVE.run(text, args["pos"], args["end"], "\n", args["lineno"], "XYZ", [0.0, 0.0, 0.0], None,
                    [0.0, 0.0, 0.0], args["scale"], False, args["motion"], 100.0, ',"feed_mode":"per_min"',
-                   "", 0, '"t.nc"', args["max_blocks"], True, args["plane"], False, 1e-6)
+                   "", 0, '"t.nc"', args["max_blocks"], True, args["plane"], False, 1e-6, args["feed_scale"])
     if set(change) <= {"pos", "motion"}:
         with pytest.raises(ValueError):
             NATIVE.scan(text, args["pos"], "\n", args["motion"], True, False)

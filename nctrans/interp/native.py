@@ -52,8 +52,7 @@ class NativeLaneMixin:
                 or self.comp is not None or self.comp_exit or st.comp_side != "off"
                 or not self.frame.identity or self.modal_call is not None or self.hook is not None
                 or st.feed_mode not in ("per_min", "per_rev") or self.out
-                or self.unmodelled_motion is not None or self.spindle_stopped or self.watch
-                or st.feed_scale != st.scale):     # the kernel scales F as it scales lengths
+                or self.unmodelled_motion is not None or self.spindle_stopped or self.watch):
             return False
         axes = "".join(self.pos)
         return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)
@@ -76,7 +75,8 @@ class NativeLaneMixin:
             [tot.get(a, 0.0) for a in axes] if tot else None, list(mpos.values()), st.scale,
             st.incremental, motion, st.feed, f',"feed_mode":"{st.feed_mode}"', tail, self._seq,
             _json_str(run.file), budget, write, st.plane, st.arc_absolute,
-            arcs.CENTER_TOL_INCH if st.scale != 1.0 else arcs.CENTER_TOL_MM)
+            arcs.CENTER_TOL_INCH if st.scale != 1.0 else arcs.CENTER_TOL_MM,
+            st.feed_scale)                          # Sinumerik G70: inch lengths, feeds in mm
         if blocks:
             self.pos = dict(zip(axes, prog))
             self.mpos = dict(zip(axes, mach))

@@ -1034,7 +1034,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
         if plain_scan is not None and cur is main:
             end, nlines, nblocks, motion = plain_scan(text, lines.start, sep,
                                                       plainrun.motion_code(low.motion),
-                                                      low.cycle is None, low.arc_abs)
+                                                      low.cycle is None, low.arc_abs, False, max_block)
             if nblocks >= PLAIN_RUN_MIN:
                 cur.append(plainrun.PlainRun(file, text, lines.start, end, lineno, sep, nblocks,
                                              plain_line, low.motion, low.cycle, low.arc_abs))

@@ -1036,7 +1036,7 @@ class _FileParse:
             if scan is not None and len(units) == 1 and not unit.stack and unit.proc is None \
                     and iso_lines is None and section is None and not macros:
                 run_end, nlines, nblocks, last = scan(text, start, "\n", plainrun.motion_code(motion),
-                                                      True, False, True)
+                                                      True, False, True, max_block)
                 if nblocks >= PLAIN_RUN_MIN:
                     main.append(plainrun.PlainRun(file, text, start, run_end, n, "\n", nblocks, plain_line,
                                                   motion, None, False))
