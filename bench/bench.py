@@ -3,8 +3,8 @@
 For each program: lines/s in-process (parse + interpret, and parse + interpret + JSONL serialisation
 to a null sink, with the whole IR; then the streamed path the CLI takes: pipeline.load(stream=True)
 + toolpath_io.write_jsonl with the native plain-run kernel, and the same without it, "py strm"),
-the CLI end to end (subprocess wall time, output to /dev/null), LinuxCNC
-rs274 on the same file in the same run and the CLI/rs274 time ratio. Then peak memory (tracemalloc)
+the CLI end to end (subprocess wall time and CPU time, user + system, output to /dev/null), LinuxCNC
+rs274 on the same file in the same run and the CLI/rs274 ratios of both. Then peak memory (tracemalloc)
 for one program and for the same program repeated 10x: the full parse holds the IR (it grows with
 the text) and the interpreter's peak is measured above it; the streamed parse + run + serialisation
 (source text held by the caller) must stay flat. Then lint as users run it (lines/s in-process
@@ -19,6 +19,7 @@ import gc
 import json
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -119,25 +120,46 @@ def best_time(fn, repeat: int) -> float:
     return best
 
 
-def wall(cmd: list[str], repeat: int) -> tuple[float, int]:
-    """Best wall time and the exit code; exit 3 stands for a crash (traceback on stderr)."""
-    best, rc = float("inf"), 0
+def _children_cpu() -> float:
+    """User + system seconds of this process's children that have ended and been waited for."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
+def timed(cmd: list[str], repeat: int) -> tuple[float, float, int]:
+    """(best wall time, best CPU time (user + system of the child), exit code); exit 3 stands for a
+    crash (traceback on stderr). On a loaded machine the wall time includes waiting for a core; the
+    CPU time is the work the command did, so ratios of CPU times stay meaningful there."""
+    best, best_cpu, rc = float("inf"), float("inf"), 0
     for _ in range(repeat):
+        c0 = _children_cpu()
         t0 = time.perf_counter()
         proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         best = min(best, time.perf_counter() - t0)
+        best_cpu = min(best_cpu, _children_cpu() - c0)
         rc = 3 if b"Traceback" in proc.stderr else proc.returncode
-    return best, rc
+    return best, best_cpu, rc
 
 
-def rs274_time(path: Path, repeat: int, tmp: Path) -> float | None:
+def wall(cmd: list[str], repeat: int) -> tuple[float, int]:
+    """Best wall time and the exit code (see timed)."""
+    t, _cpu, rc = timed(cmd, repeat)
+    return t, rc
+
+
+def rs274_timed(path: Path, repeat: int, tmp: Path) -> tuple[float | None, float | None]:
+    """(best wall, best CPU) seconds of LinuxCNC rs274 on the file; None, None without rs274."""
     if not Path(RS274).exists():
-        return None
+        return None, None
     tbl = tmp / "zero.tbl"
     if not tbl.exists():
         tbl.write_text("".join(f"T{n} P{n} Z0 D0 ;\n" for n in range(1, 100)))
-    t, _ = wall([RS274, "-t", str(tbl), "-g", str(path), str(tmp / "rs274.out")], repeat)
-    return t
+    t, cpu, _ = timed([RS274, "-t", str(tbl), "-g", str(path), str(tmp / "rs274.out")], repeat)
+    return t, cpu
+
+
+def rs274_time(path: Path, repeat: int, tmp: Path) -> float | None:
+    return rs274_timed(path, repeat, tmp)[0]
 
 
 def repeated(text: str, times: int) -> str:
@@ -170,7 +192,7 @@ TARGET_SINUMERIK_MEMORY = 1.5  # Sinumerik x10 / x1: peak resident memory of the
 
 
 def conditions() -> str:
-    """What the machine was doing: the numbers are wall times on a shared machine."""
+    """What the machine was doing: wall times on a shared machine include waiting for a core."""
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     return f"{os.cpu_count()} cores, load average {load}"
 
@@ -179,7 +201,9 @@ def targets(base: Path, repeat: int, tmp: Path) -> None:
     """The issue #7 targets in one run, side by side with rs274: the ISO program repeated ten
     times; the same program written as Sinumerik (nctrans convert --to sinumerik: `;` comments,
     G74 homing, tool length from D) against rs274 on the ISO original; the Sinumerik program's
-    peak memory at 10x against 1x; and the per-file start-up of `lint` on a small Sinumerik file."""
+    peak memory at 10x against 1x; and the per-file start-up of `lint` on a small Sinumerik file.
+    Times are shown as wall and CPU (user + system of the process); a target is judged on the CPU
+    ratio, which waiting for a core on a loaded machine does not inflate."""
     text = read_text(base)
     iso = {1: base, 10: tmp / "target-x10.nc"}
     iso[10].write_text(repeated(text, 10))
@@ -192,21 +216,23 @@ def targets(base: Path, repeat: int, tmp: Path) -> None:
     rows = []
 
     def toolpath(path: Path, dialect: str):
-        t, rc = wall(NCTRANS + ["toolpath", str(path), "--from", dialect, "--format", "jsonl"], repeat)
-        return t if rc < 2 else None
+        t, cpu, rc = timed(NCTRANS + ["toolpath", str(path), "--from", dialect, "--format", "jsonl"], repeat)
+        return (t, cpu) if rc < 2 else (None, None)
 
     def ratio(a, b):
         return a / b if a is not None and b else None
 
-    iso10, rs10 = toolpath(iso[10], "iso-m"), rs274_time(iso[10], repeat, tmp)
-    rows.append((f"ISO x10 ({iso[10].read_text().count(chr(10))} lines): toolpath s", iso10, rs10,
-                 ratio(iso10, rs10), TARGET_ISO_X10))
-    rs1 = rs274_time(base, repeat, tmp)
-    iso1 = toolpath(base, "iso-m")
-    rows.append(("ISO x1: toolpath s", iso1, rs1, ratio(iso1, rs1), None))
+    def timed_row(label, ours, theirs, target):
+        """A row of wall times, then the same measure as CPU times (the one the target judges)."""
+        rows.append((label + " wall s", ours[0], theirs[0], ratio(ours[0], theirs[0]), None))
+        rows.append((label + " CPU s", ours[1], theirs[1], ratio(ours[1], theirs[1]), target))
+
+    timed_row(f"ISO x10 ({iso[10].read_text().count(chr(10))} lines): toolpath", toolpath(iso[10], "iso-m"),
+              rs274_timed(iso[10], repeat, tmp), TARGET_ISO_X10)
+    rs1 = rs274_timed(base, repeat, tmp)
+    timed_row("ISO x1: toolpath", toolpath(base, "iso-m"), rs1, None)
     if sin[1].exists():
-        s1 = toolpath(sin[1], "sinumerik")
-        rows.append(("Sinumerik x1: toolpath s (rs274: ISO x1)", s1, rs1, ratio(s1, rs1), TARGET_SINUMERIK))
+        timed_row("Sinumerik x1: toolpath (rs274: ISO x1)", toolpath(sin[1], "sinumerik"), rs1, TARGET_SINUMERIK)
     mem = {}
     for times, path in sin.items():
         if path.exists():
@@ -218,11 +244,13 @@ def targets(base: Path, repeat: int, tmp: Path) -> None:
                      TARGET_SINUMERIK_MEMORY))
     small = STARTUP_PROGRAM
     if small.exists():
-        t, rc = wall(NCTRANS + ["lint", str(small)], repeat)
-        floor, _ = wall([sys.executable, "-c", "pass"], repeat)
-        rows.append((f"lint start-up, {small.name} ({read_text(small).count(chr(10))} lines) s "
-                     "(vs python -c pass)", t if rc < 2 else None, floor, None, None))
-    print(f"issue #7 targets on {base.name} ({conditions()}; best of {repeat})")
+        t, cpu, rc = timed(NCTRANS + ["lint", str(small)], repeat)
+        floor, floor_cpu, _ = timed([sys.executable, "-c", "pass"], repeat)
+        label = f"lint start-up, {small.name} ({read_text(small).count(chr(10))} lines)"
+        rows.append((label + " wall s (vs python -c pass)", t if rc < 2 else None, floor, None, None))
+        rows.append((label + " CPU s", cpu if rc < 2 else None, floor_cpu, None, None))
+    print(f"issue #7 targets on {base.name} ({conditions()}; best of {repeat}; "
+          "a target is judged on CPU time, user + system of the process)")
     print(f"{'measure':58} {'nctrans':>8} {'rs274':>8} {'ratio':>6} {'target':>7} {'met':>4}")
     for label, ours, theirs, r, target in rows:
         met = "" if target is None or r is None else ("yes" if r <= target else "NO")
@@ -274,7 +302,8 @@ def main(argv=None) -> int:
         return 0
     head = (f"{'program':34} {'lines':>6} {'records':>8} {'lint l/s':>10} {'toolpath l/s':>12} {'stream l/s':>10} "
             f"{'py strm l/s':>11} "
-            f"{'CLI lint s':>10} {'CLI tp s':>9} {'CLI tp l/s':>10} {'rs274 s':>8} {'CLI/rs274':>9}")
+            f"{'CLI lint s':>10} {'CLI tp s':>9} {'CLI tp l/s':>10} {'rs274 s':>8} {'CLI/rs274':>9} "
+            f"{'tp CPU s':>8} {'rs CPU s':>8} {'CPU ratio':>9}")
     print(head)
     print("-" * len(head))
     notes = []
@@ -293,20 +322,22 @@ def main(argv=None) -> int:
             except Exception as e:                      # a missing stage: report, keep benchmarking
                 notes.append(f"{path.name}: in-process: {type(e).__name__}: {e}")
             cli_lint, rc_l = wall(NCTRANS + ["lint", str(path), "--from", "iso-m"], args.repeat)
-            cli_tp, rc_t = wall(NCTRANS + ["toolpath", str(path), "--from", "iso-m", "--format", "jsonl"],
-                                args.repeat)
+            cli_tp, cli_cpu, rc_t = timed(NCTRANS + ["toolpath", str(path), "--from", "iso-m", "--format",
+                                                     "jsonl"], args.repeat)
             if rc_t >= 2:
                 notes.append(f"{path.name}: CLI toolpath exit {rc_t}")
-                cli_tp = None
+                cli_tp = cli_cpu = None
             if rc_l >= 2:
                 notes.append(f"{path.name}: CLI lint exit {rc_l}")
                 cli_lint = None
-            rs = rs274_time(path, args.repeat, tmp)
+            rs, rs_cpu = rs274_timed(path, args.repeat, tmp)
             ratio = cli_tp / rs if cli_tp and rs else None
+            cpu_ratio = cli_cpu / rs_cpu if cli_cpu and rs_cpu else None
             print(f"{path.name[:34]:34} {lines:>6} {fmt(records):>8} {fmt(lint_rate):>10} {fmt(tp_rate):>12} "
                   f"{fmt(st_rate):>10} {fmt(py_rate):>11} "
                   f"{fmt(cli_lint, '.3f'):>10} {fmt(cli_tp, '.3f'):>9} "
-                  f"{fmt(lines / cli_tp if cli_tp else None):>10} {fmt(rs, '.3f'):>8} {fmt(ratio, '.2f'):>9}")
+                  f"{fmt(lines / cli_tp if cli_tp else None):>10} {fmt(rs, '.3f'):>8} {fmt(ratio, '.2f'):>9} "
+                  f"{fmt(cli_cpu, '.3f'):>8} {fmt(rs_cpu, '.3f'):>8} {fmt(cpu_ratio, '.2f'):>9}")
         print()
         print("peak memory (tracemalloc, MiB; fresh process, after one warm-up run): the full parse holds")
         print("the IR, interpret+serialise is measured above it; streamed = parse+run+jsonl as the CLI does")
