@@ -323,6 +323,7 @@ def cmd_check(args) -> int:
     import json
 
     from nctrans import check as _check
+    from nctrans.interp.unmodelled import not_analysed_rules
     _check_dialect(args.from_)
     base_machine = pipeline.load_machine(args.machine, args.from_) if args.machine else None
     files = list(pipeline.iter_inputs(args.paths))
@@ -345,7 +346,8 @@ def cmd_check(args) -> int:
             _err(str(e))
             status = EXIT_USAGE
             continue
-        all_diags.extend(d for d in diags if d.rule.startswith("NC3") or d.severity == "error")
+        all_diags.extend(d for d in diags if d.rule.startswith("NC3") or d.severity == "error"
+                         or d.rule in not_analysed_rules())
         if result is not None:
             times[ld.label] = result.cycle.to_dict()
             findings.extend(x.to_dict() for x in result.findings)

@@ -3,6 +3,8 @@ function the interpreter does not model, and a walk over every code and function
 table. Expected positions are computed by hand in the comments."""
 from __future__ import annotations
 
+import math
+import re
 import subprocess
 import sys
 import tomllib
@@ -14,7 +16,7 @@ from nctrans import pipeline
 from nctrans.dialects import base
 from nctrans.interp.unmodelled import no_motion_effect
 from nctrans.ir import nodes as n
-from nctrans.ir.vocabulary import UNMODELLED_MODES
+from nctrans.ir.vocabulary import MODAL_GROUPS, UNMODELLED_MODES
 from nctrans.source import from_text
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -140,6 +142,17 @@ def test_fail_on_warning_exits_1(tmp_path, command):
 
 
 # --------------------------------------------------------------------------- every code of every table
+#
+# Every entry of every rules table (G/M codes, machine commands, words, address letters, predefined
+# functions, system variables, numbered variables, the cycles of rules/cycles.toml) is run on a line
+# of its own. Each must be modelled (it parses to IR the interpreter knows, a system variable reads a
+# number) or said at its line; and every construct said only by a warning must also be said by
+# `lint`, `toolpath` and `check` at its line, with exit 1 under --fail-on warning.
+
+_TWO_ARGS = ("ATAN2", "MINVAL", "MAXVAL", "POW", "ATAN")
+_SET_UP = {"sinumerik": "T1 D1 S1000 F100", "iso-m": "T1 D1 H1 S1000 F100",
+           "iso-t": "T0101 S1000 F1", "fagor": "T1 D1 S1000 F100"}
+
 
 def _tables():
     for path in sorted(RULES.glob("*.toml")):
@@ -148,16 +161,52 @@ def _tables():
             yield path.stem, data
 
 
-def _constructs(data: dict) -> list[str]:
-    """One line per G/M code and per named word or function the table lists."""
-    lines = [c["code"] for c in data["codes"]]
+def _function_line(dialect: str, f: str) -> str:
+    args = "1,1" if f.upper() in _TWO_ARGS else "1"
+    if dialect == "sinumerik":
+        return f"R1={f}({args})"
+    if dialect == "fagor":
+        return f"P1={f}({args})"
+    return f"#1={f}[{args.replace(',', ',')}]"
+
+
+def _variable_line(dialect: str, var: str) -> str:
+    """The variable drives an axis word: its value is seen in the move (or said unknown)."""
+    if dialect == "sinumerik":
+        indexed = var.upper() in ("$AA_IW", "$AA_IM", "$AA_MW", "$AA_MM", "$P_EP")
+        return f"G1 X={var}[X]" if indexed else f"G1 X={var}"
+    if dialect == "fagor":
+        return f"P1={var} G1 XP1"
+    return f"G1 X[{var}]"
+
+
+def _constructs(dialect: str, data: dict) -> list[tuple[str, str]]:
+    """(kind, line) per entry of the table: kind "code" for words and codes, "function",
+    "variable"."""
+    out = [("code", c["code"].split(":")[-1]) for c in data["codes"]]
     opts = data.get("options", {})
     for section in ("machine_commands", "unsupported_functions"):
-        lines += list(opts.get(section, {}))
-    lines += [f"{w}=1" for w in opts.get("passthrough_words", {}) if w.isalpha()]
-    lines += [f"R1={f}(1)" if f.upper() not in ("ATAN2", "MINVAL", "MAXVAL") else f"R1={f}(1,1)"
-              for f in opts.get("functions", {})]
-    return lines
+        out += [("code", w) for w in opts.get(section, {})]
+    nme = opts.get("no_motion_effect", {})
+    out += [("code", w) for w in nme.get("words", []) + nme.get("mill_only", [])]
+    out += [("code", w) for w in opts.get("unmodelled_motion", {}).get("codes", [])]
+    for codes in opts.get("g_group_index", {}).values():
+        out += [("code", c) for c in codes if c]
+    out += [("code", f"{w}=1" if dialect == "sinumerik" else f"{w}1")
+            for w in opts.get("passthrough_words", {}) if w.isalpha()]
+    out += [("code", f"{w}1") for w in data.get("addresses", {})]
+    funcs = list(opts.get("functions", {})) + list(data.get("expressions", {}).get("functions",
+                                                                                  {}).values())
+    out += [("function", _function_line(dialect, f)) for f in dict.fromkeys(funcs)]
+    variables = list(data.get("system_variables", {}))
+    for nv in opts.get("numbered_variables", []):
+        variables += [f"#{nv['first']}", f"#{nv.get('last', nv['first'])}"]
+    out += [("variable", _variable_line(dialect, v)) for v in dict.fromkeys(variables)]
+    if dialect == "sinumerik":
+        cycles = tomllib.loads((RULES / "cycles.toml").read_text())
+        for section in ("cycle", "pattern", "milling", "swivel", "unmodelled"):
+            out += [("code", f"{c['name']}()") for c in cycles.get(section, [])]
+    return list(dict.fromkeys(out))
 
 
 def _line_statements(program: n.Program, line: int) -> list:
@@ -175,36 +224,126 @@ def _line_statements(program: n.Program, line: int) -> list:
     return out
 
 
-def _silently_unmodelled(dialect: str, construct: str) -> str | None:
-    text = f"G0 X0 Y0 Z0\n{construct}\nM30\n"
+def _run_line(dialect: str, line: str):
+    text = f"G0 X0 Y0 Z0 {_SET_UP[dialect]}\n{line}\nM30\n"
     ld = pipeline.load_source(from_text(text, "all.nc"), "all.nc", dialect)
+    recs = list(pipeline.toolpath_of(ld)) if ld.program is not None else []
+    return ld, recs
+
+
+def _silently_unmodelled(dialect: str, kind: str, construct: str) -> str | None:
+    ld, recs = _run_line(dialect, construct)
     if ld.program is None:
         return None
-    list(pipeline.toolpath_of(ld))
     said = [d for d in ld.diagnostics if d.line == 2 and d.severity in ("warning", "error")]
+    if said:
+        return None
+    if kind == "variable":
+        moved = [r for r in recs if r.line == 2 and r.kind == "linear"]
+        unknown = [d for d in ld.diagnostics if d.line == 2 and d.rule == "NC107"]
+        if not unknown and not (moved and math.isfinite(moved[0].end["X"])):
+            return f"{construct}: read no value and said nothing"
+        return None
     stmts = _line_statements(ld.program, 2)
     unmodelled = [s for s in stmts if isinstance(s, n.Passthrough)
                   and not no_motion_effect(s.reason)]
     unmodelled += [s for s in stmts if isinstance(s, n.ModeChange)
                    and (s.group, s.value) in UNMODELLED_MODES]
-    if unmodelled and not said:
+    # a ModeChange outside the neutral vocabulary is a mode the interpreter cannot know
+    unmodelled += [s for s in stmts if isinstance(s, n.ModeChange)
+                   and s.group not in MODAL_GROUPS]
+    unmodelled += [s for s in stmts if isinstance(s, n.ModeChange) and MODAL_GROUPS.get(s.group)
+                   and s.value not in MODAL_GROUPS[s.group]]
+    if unmodelled:
         return f"{construct}: {unmodelled} with no warning"
-    if not stmts and not said and not any(d.line == 2 for d in ld.diagnostics):
+    if not stmts and not any(d.line == 2 for d in ld.diagnostics):
         if construct[0] in "GM" or construct.isalpha():
             # a one-shot modifier of axis words (G53, ATRANS): it must act on them
-            return _silently_unmodelled(dialect, construct + " X1") if " " not in construct else \
-                f"{construct}: parsed to nothing and said nothing"
-        return f"{construct}: parsed to nothing and said nothing"
+            if " " not in construct:
+                return _silently_unmodelled(dialect, kind, construct + " X1")
+        if construct[0] not in "NO":        # block number, program number
+            return f"{construct}: parsed to nothing and said nothing"
     return None
 
 
+def _dialect_tables():
+    return [(t, d) for t, d in _tables() if d["dialect"] in base.names()]
+
+
 @pytest.mark.parametrize("table", [t for t, _ in _tables()])
-def test_no_code_or_function_of_any_table_is_silently_unmodelled(table):
+def test_no_entry_of_any_table_is_silently_unmodelled(table):
     data = dict(_tables())[table]
     dialect = data["dialect"]
     if dialect not in base.names():
         pytest.skip(f"no front end for {dialect} yet")
-    constructs = _constructs(data)
-    assert len(constructs) > 20
-    bad = [msg for c in constructs if (msg := _silently_unmodelled(dialect, c))]
+    constructs = _constructs(dialect, data)
+    kinds = {k for k, _ in constructs}
+    assert len(constructs) > 50 and "code" in kinds
+    bad = [msg for k, c in constructs if (msg := _silently_unmodelled(dialect, k, c))]
     assert bad == [], "\n".join(bad)
+
+
+def _warned_only(dialect: str, construct: str) -> bool:
+    """Said at its line by warnings only, and nothing said elsewhere (it changes no other line)."""
+    ld, _ = _run_line(dialect, construct)
+    at = [d for d in ld.diagnostics if d.line == 2]
+    return (ld.program is not None and any(d.severity == "warning" for d in at)
+            and all(d.severity != "error" and d.rule != "NC205" for d in at)
+            and all(d.line == 2 or d.severity == "info" for d in ld.diagnostics))
+
+
+@pytest.mark.parametrize("table", [t for t, d in _dialect_tables()])
+def test_every_warned_entry_is_said_by_lint_toolpath_and_check(tmp_path, table):
+    data = dict(_tables())[table]
+    dialect = data["dialect"]
+    warned = [c for k, c in _constructs(dialect, data) if k == "code" and _warned_only(dialect, c)]
+    assert len(warned) > 10
+    # one program: each construct on a line of its own, a plain move between them
+    lines = [f"G0 X0 Y0 Z0 {_SET_UP[dialect]}"]
+    where = {}
+    for c in warned:
+        where[len(lines) + 1] = c
+        lines += [c, "G1 X1 Y1"]
+    src = tmp_path / ("all" + {"sinumerik": ".mpf", "fagor": ".pim"}.get(dialect, ".nc"))
+    src.write_text("\n".join(lines + ["M30", ""]))
+    for command in ("lint", "toolpath", "check"):
+        argv = [sys.executable, "-m", "nctrans", command, str(src), "--from", dialect,
+                "--fail-on", "warning"]
+        if command == "toolpath":
+            argv += ["--summary"]
+        out = subprocess.run(argv, capture_output=True, text=True, timeout=300)
+        said = out.stdout + out.stderr
+        assert out.returncode == 1, (command, said[-2000:])
+        missing = [f"{line}: {c}" for line, c in where.items()
+                   if not re.search(rf":{line}:\d+: warning", said)]
+        assert missing == [], f"{command} --from {dialect} says nothing at: {missing}"
+
+
+def test_a_frame_read_as_an_axis_word_is_a_type_error_not_a_crash():
+    # $P_PFRAME is a FRAME: as X= it was a TypeError out of the interpreter
+    recs, diags = run("G0 X0\nG1 X=$P_PFRAME F100\nG1 X2\nM30\n")
+    (d,) = [d for d in diags if d.rule == "NC104"]
+    assert d.line == 2 and d.severity == "error" and "frame" in d.message
+    assert all(r.line != 2 for r in moves(recs))
+
+
+def test_fagor_direct_compensation_start_is_said():
+    # G138 sends the tool straight to the perpendicular of the next path (no corner, seed
+    # L10965-10981); the interpreter models G139, the default: G138 must be named at its line
+    recs, diags = run("G0 X0 Y0\nG138\nG1 X1 F100\nM30\n", "fagor")
+    assert {d.rule for d in diags if d.line == 2 and d.severity == "warning"} >= {"NC415"}
+    assert "G138" in " ".join(d.message for d in diags if d.line == 2)
+    recs, diags = run("G0 X0 Y0\nG139\nG1 X1 F100\nM30\n", "fagor")
+    assert [d for d in diags if d.severity != "info"] == []
+
+
+def test_check_names_what_it_did_not_model(tmp_path):
+    src = tmp_path / "p.mpf"
+    src.write_text("G0 X0 Y0\nTRAORI\nG1 X1 F100\nM30\n")
+    argv = [sys.executable, "-m", "nctrans", "check", str(src), "--from", "sinumerik"]
+    out = subprocess.run(argv + ["--fail-on", "error"], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0 and ":2:1: warning[NC220]" in out.stdout and "TRAORI" in out.stdout
+    out = subprocess.run(argv + ["--fail-on", "warning"], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 1

@@ -29,6 +29,9 @@ class WordsMixin:
             return None
         if isinstance(v, str):
             raise EvalError("NC104", f"string used as {what}")
+        if not isinstance(v, (int, float)):      # a FRAME or an AXIS value ($P_PFRAME as X=)
+            raise EvalError("NC104", f"{type(v).__name__.removesuffix('Value').lower()} value "
+                            f"used as {what}")
         v = float(v)
         if v - v != 0.0:                 # infinity or NaN: never let it reach a record
             raise EvalError("NC108", f"{what} is {v} (out of range)")
