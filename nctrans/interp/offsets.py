@@ -55,9 +55,25 @@ class OffsetsMixin:
         return {a: v + tot.get(a, 0.0) for a, v in w.items()}
 
     def _work_offset(self, name: str) -> dict[str, float]:
-        if name.upper() == "G53":
+        """The shift of work coordinate system `name`: its own offset plus the external work
+        offset (ISO EXOFS: G10 L2 P0, #5201..), which moves every work system alike
+        (seed sinumerik-iso-milling L1177, $P_EXTFRAME below $P_UIFR); none under G53."""
+        up = name.upper()
+        if up == "G53":
             return {}
-        return self.machine.work_offset(name)
+        own = self.machine.work_offset(up)
+        ext = self.machine.work_offset("EXT") if up != "EXT" else {}
+        if not ext:
+            return own
+        return {a: own.get(a, 0.0) + ext.get(a, 0.0) for a in {**own, **ext}}
+
+    def _work_offset_changed(self, name: str) -> None:
+        """Re-apply the active work offset after offset `name` was written (the external one
+        moves whichever system is active)."""
+        active = (self.st.work_offset or "").upper()
+        if active and active != "G53" and (active == name or name == "EXT"):
+            self.off.set_work(self._work_offset(active))
+            self._resync()
 
     def _apply_length(self) -> None:
         st = self.st
@@ -121,9 +137,7 @@ class OffsetsMixin:
                 v *= self.st.scale if a in LINEAR_AXES else 1.0
                 cur[a] = cur.get(a, 0.0) + v if inc else v
             m.offsets[name] = cur
-            if self.st.work_offset and self.st.work_offset.upper() == name:
-                self.off.set_work(self._work_offset(name))
-                self._resync()
+            self._work_offset_changed(name)
         elif s.kind.startswith("tool_"):
             v = vals.get("VALUE", 0.0) * self.st.scale
             store = m.length_offsets if "length" in s.kind else m.radius_offsets

@@ -111,9 +111,7 @@ def _writer(interp, e: dict, offset: int, wear: dict) -> Callable[[Any], None] |
             value = _value(name, v) * (st.scale if a in "XYZ" else 1.0)
             m = _machine(interp)
             m.offsets[which] = {**m.offsets.get(which, {}), a: value}
-            if st.work_offset and st.work_offset.upper() == which:
-                interp.off.set_work(interp._work_offset(which))
-                interp._resync()
+            interp._work_offset_changed(which)
         return work_offset
     kind = {"tool_length": "length", "tool_radius": "radius"}.get(src) or e.get("wear_of")
     if kind not in ("length", "radius"):

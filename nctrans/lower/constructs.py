@@ -281,6 +281,10 @@ def _static_checks(program: n.Program, segments: list[Segment]) -> None:
             seg.why_not = "a jump from elsewhere lands inside it"
         elif not _jumps(inside) <= _labels(inside):
             seg.why_not = "it jumps out of itself"
+        elif any(type(x) is n.DataSetting for b in blocks(inside) for x in b.body):
+            # G10 writes offsets the later blocks run with: its plain motion is nothing, and the
+            # rest would run with the target's old offsets (was silently wrong)
+            seg.why_not = "it writes offset data (G10) that the rest of the program runs with"
         else:
             read: set = set()
             _vars(rest, read)

@@ -398,6 +398,16 @@ class Lowering:
 
     def _own_rot(self, b: _Blk) -> None:
         vals = b.vals
+        if any(k in vals for k in "IJK"):
+            # G68 with a vector is the 3D rotation (seed L1483-1511: pivot at the workpiece zero,
+            # R always absolute, two G68 in series); not modelled, so kept and reported at its
+            # line, never turned silently in the plane
+            text = "G68" + "".join(_word_text(k, v) for k, v in vals.items())
+            b.out.append((B_NONMODAL, self._pass(
+                text, "G68 with an I/J/K vector (3D rotation) is not modelled: the moves after "
+                "it are analysed without the rotation")))
+            vals.clear()
+            return
         center = self.axis_values(vals)
         self._drop_axes(b)
         angle = self.num("A", vals.pop("R")) if "R" in vals else None
