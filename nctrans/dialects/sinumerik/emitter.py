@@ -1192,11 +1192,10 @@ def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
     from nctrans.dialects.sinumerik.frontend import parse
     if not text.strip() or "\n" in text or ";" in text:
         return False
-    from nctrans.interp.unmodelled import no_motion_effect
     res = parse(text, "<passthrough>")
     # text Sinumerik reads only as an unknown function (ISO G68 with a vector) is not Sinumerik
     return not res.diagnostics and all(
-        (not isinstance(s, ir.Passthrough) or no_motion_effect(s.reason))
+        (not isinstance(s, ir.Passthrough) or s.reason not in ("syntax error", "unknown function"))
         and (moves_allowed or not isinstance(s, ir.Motion))
         for b in res.program.body if isinstance(b, ir.Block) for s in b.body)
 
