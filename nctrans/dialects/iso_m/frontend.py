@@ -996,6 +996,9 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     meta: dict = program.meta
     meta.update({"program_number": None, "percent": False, "defaults": low.program_defaults(low.table),
                  "options": dict(opts)})
+    if "profiles" in opts and not meta.get("profile"):
+        from nctrans.dialects.iso_m.profiles import detect
+        meta["profile"] = detect(text, opts)
     name = None
     subprograms: dict[str, Subprogram] = program.subprograms
     cur = main

@@ -40,6 +40,7 @@ from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import macro_procs, modal_numbers
 from nctrans.rules import load_table, system_meaning, system_spelling
+from nctrans.dialects.iso_m.profiles import is_common
 
 DIALECT = "sinumerik"
 _NUM_OK = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?$|'[HB][0-9A-F]+'$|TRUE$|FALSE$",
@@ -256,6 +257,11 @@ class Emitter:
             return f"{v.key}{idx}"
         if v.space == "num" and v.key in self.local_names and not v.indices:
             return self.local_names[v.key]
+        if v.space == "num" and is_common(v.key, self.p.meta) and not v.indices:
+            self.info("profile-common", f"common variables of the {self.p.meta.get('profile')} profile "
+                      f"#{v.key}.. written as R parameters of the same numbers (MD 28050 "
+                      "MM_NUM_R_PARAM must cover them)")
+            return f"R{v.key}"
         if v.space == "num" and isinstance(v.key, int) and v.key >= 1000 and not v.indices:
             return self.system_var(v, target)
         if v.space == "num":

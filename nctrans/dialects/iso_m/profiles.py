@@ -1,0 +1,36 @@
+"""Control profiles of the ISO milling family (rules/iso-m.toml [options.profiles]): which control
+of the family a program was written for changes what some numbered variables are (Haas
+#10000-#10999 are plain common variables; on a Fanuc 30i the same numbers are tool offsets).
+The profile is named by the user (`convert --profile`) or detected from the header comments."""
+from __future__ import annotations
+
+import re
+from typing import Optional
+
+# header comments are looked for in this much of the text: detection stays flat in program size
+_HEADER_CHARS = 4000
+_COMMENT = re.compile(r"\(([^()\n]*)\)")
+
+
+def detect(text: str, options: dict) -> Optional[str]:
+    """The profile whose `detect` pattern a header comment matches, or None."""
+    profiles = options.get("profiles") or {}
+    comments = _COMMENT.findall(text[:_HEADER_CHARS])
+    for name, p in profiles.items():
+        for pattern in p.get("detect", ()):
+            rx = re.compile(pattern, re.IGNORECASE)
+            if any(rx.search(c) for c in comments):
+                return name
+    return None
+
+
+def common_ranges(meta: Optional[dict]) -> list[tuple[int, int]]:
+    """The number ranges the program's profile makes plain common variables (none without one)."""
+    meta = meta or {}
+    name = meta.get("profile")
+    profile = ((meta.get("options") or {}).get("profiles") or {}).get(name) if name else None
+    return [(int(a), int(b)) for a, b in (profile or {}).get("common_variables", ())]
+
+
+def is_common(number, meta: Optional[dict]) -> bool:
+    return isinstance(number, int) and any(a <= number <= b for a, b in common_ranges(meta))
