@@ -13,6 +13,7 @@ from hypothesis import given, settings, strategies as st
 
 import nctrans
 import rs274 as harness
+from nctrans import api
 from nctrans.interp import interpret
 
 
@@ -91,7 +92,8 @@ def _convert(src: str, tmp_path):
     return nctrans.transpile(path, read="iso-m", write="sinumerik")
 
 
-@pytest.mark.parametrize("g10", ["G10 L2 P1 X100 Y50", "G10 L2 P0 X7 Y-3", "#5201=7."])
+@pytest.mark.parametrize("g10", ["G10 L2 P1 X100 Y50", "G10 L2 P0 X7 Y-3", "#5201=7.",
+                                 "G91 G10 L2 P0 X7 Y-3 G90"])
 def test_offset_data_is_never_dropped_by_a_conversion(g10, tmp_path):
     # G10 L2 P1 was "lowered to plain motion" alone: nothing, and the G54 move after it ran
     # without the offset in the Sinumerik output (equiv: X110 Y60 vs X10 Y10)
@@ -105,7 +107,8 @@ def test_offset_data_is_never_dropped_by_a_conversion(g10, tmp_path):
     b = [tuple(round(r.end[k], 6) for k in "XY") for r in nctrans.toolpath(conv.text, dialect="sinumerik")
          if r.kind in ("rapid", "linear")]
     assert a == b
-    shift = {"G10 L2 P1 X100 Y50": (100, 50), "G10 L2 P0 X7 Y-3": (7, -3), "#5201=7.": (7, 0)}[g10]
+    shift = {"G10 L2 P1 X100 Y50": (100, 50), "G10 L2 P0 X7 Y-3": (7, -3), "#5201=7.": (7, 0),
+             "G91 G10 L2 P0 X7 Y-3 G90": (7, -3)}[g10]
     assert a[0] == (10 + shift[0], 10 + shift[1])       # hand-computed
 
 
@@ -132,3 +135,30 @@ def test_g68_in_the_plane_still_rotates():
     moves = [m for m in _moves("G21 G90 G17\nG0 X0 Y0\nG68 X0 Y0 R90\nG1 X10 F100\nG69\nM30\n")
              if m.kind == "linear"]
     assert (round(moves[0].end["X"], 6), round(moves[0].end["Y"], 6)) == (0.0, 10.0)
+
+
+@settings(max_examples=15, deadline=None)
+@given(x=st.integers(-5000, 5000).map(lambda v: v / 100), y=st.integers(-5000, 5000).map(lambda v: v / 100),
+       by_var=st.booleans(), work=st.sampled_from(["G54", "G55", "G57"]))
+def test_external_offset_is_kept_as_the_sinumerik_external_frame(x, y, by_var, work, tmp_path_factory):
+    ext = f"#5201={x}\n#5202={y}" if by_var else f"G10 L2 P0 X{x} Y{y}"
+    # (a G10 L2 P1..6 would make the whole conversion plain motion: $P_UIFR is not written yet)
+    src = f"G21 G90 G17\n{work} G0 X1 Y1\n{ext}\nG1 X10 Y2 F100\nG55 X-10 Y5\nM30\n"
+    conv = _convert(src, tmp_path_factory.mktemp("ext"))
+    assert conv.text is not None
+    assert "$P_EXTFRAME[X,TR]=" in conv.text and "flattened" not in conv.text
+    assert api.equiv(src, conv.text, read_a="iso-m", read_b="sinumerik")
+    last = [r for r in nctrans.toolpath(conv.text, dialect="sinumerik") if r.kind == "linear"][-1]
+    assert (round(last.end["X"], 6), round(last.end["Y"], 6)) == (round(-10 + x, 6), round(5 + y, 6))
+    assert [round(m.end["X"], 6) for m in [r for r in nctrans.toolpath(src, dialect="iso-m")
+                                            if r.kind == "linear"]] == [round(10 + x, 6), round(-10 + x, 6)]
+
+
+def test_sinumerik_external_frame_components_other_than_tr_are_reported():
+    from nctrans.dialects import base
+    program = base.get("sinumerik").parse("G54 G0 X0\n$P_EXTFRAME[X,TR]=5\nG0 X10\n"
+                                          "$P_EXTFRAME[Z,RT]=30\nG0 X0\nM30\n", "e.mpf").program
+    diags: list = []
+    moves = [r for r in interpret(program, diagnostics=diags) if r.kind == "rapid"]
+    assert [m.end["X"] for m in moves] == [0.0, 15.0, 5.0]
+    assert any(d.rule == "NC107" and d.line == 4 for d in diags)

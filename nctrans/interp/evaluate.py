@@ -339,6 +339,9 @@ class Evaluator:
         # numbered system variables whose write changes machine data (ISO #2001 tool offsets,
         # #5221 work offsets): number -> writer (nctrans.interp.sysvars registers them)
         self.system_setters: dict[int, Callable[[Any], None]] = {}
+        # frame variables whose components a program writes (Sinumerik $P_EXTFRAME[X,TR]=v):
+        # name -> writer(indices as written, value) (nctrans.interp.settable_frames)
+        self.frame_component_setters: dict[str, Callable[[list, Any], None]] = {}
         self.unknown_used = False     # set when UNKNOWN was read; the interpreter reports it
 
     # ---------------------------------------------------------------- compiler
@@ -914,6 +917,9 @@ class Evaluator:
             return lambda v: self.scope.args.__setitem__(key, v)
         if space == "system":
             name = str(var.key).upper()
+            component = self.frame_component_setters.get(name)
+            if component is not None and var.indices:
+                return lambda v, ix=var.indices: component(ix, v)
 
             def set_sys(v):        # writable system data: kept so later reads see the value
                 setter = self._system_setter(name)

@@ -56,12 +56,11 @@ class OffsetsMixin:
 
     def _work_offset(self, name: str) -> dict[str, float]:
         """The shift of work coordinate system `name`: its own offset plus the external work
-        offset (ISO EXOFS: G10 L2 P0, #5201..), which moves every work system alike
-        (seed sinumerik-iso-milling L1177, $P_EXTFRAME below $P_UIFR); none under G53."""
+        offset (ISO EXOFS: G10 L2 P0, #5201..; Sinumerik $P_EXTFRAME), which moves every work
+        system alike (seed sinumerik-iso-milling L1177, $P_EXTFRAME below $P_UIFR). "G53" is no
+        settable offset (Sinumerik G500): the external one stays, as a system frame does."""
         up = name.upper()
-        if up == "G53":
-            return {}
-        own = self.machine.work_offset(up)
+        own = self.machine.work_offset(up) if up != "G53" else {}
         ext = self.machine.work_offset("EXT") if up != "EXT" else {}
         if not ext:
             return own
@@ -71,7 +70,7 @@ class OffsetsMixin:
         """Re-apply the active work offset after offset `name` was written (the external one
         moves whichever system is active)."""
         active = (self.st.work_offset or "").upper()
-        if active and active != "G53" and (active == name or name == "EXT"):
+        if active and (active == name or name == "EXT"):
             self.off.set_work(self._work_offset(active))
             self._resync()
 

@@ -41,6 +41,7 @@ from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import macro_procs, modal_numbers
 from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
+from nctrans.interp.settable_frames import EXTERNAL as EXTERNAL_FRAME
 
 DIALECT = "sinumerik"
 _NUM_OK = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?$|'[HB][0-9A-F]+'$|TRUE$|FALSE$",
@@ -262,6 +263,11 @@ class Emitter:
                       f"#{v.key}.. written as R parameters of the same numbers (MD 28050 "
                       "MM_NUM_R_PARAM must cover them)")
             return f"R{v.key}"
+        if (v.space == "num" and target and isinstance(v.key, int) and 5201 <= v.key <= 5206
+                and not v.indices and self.st.distance != "incremental"):
+            self.info("extframe", "ISO external work offset (G10 L2 P0, #5201..) written as the "
+                                  "external zero offset frame $P_EXTFRAME")
+            return f"{EXTERNAL_FRAME}[{'XYZABC'[v.key - 5201]},TR]"
         if v.space == "num" and isinstance(v.key, int) and v.key >= 1000 and not v.indices:
             return self.system_var(v, target)
         if v.space == "num":
@@ -519,6 +525,8 @@ class Emitter:
                 self.refuse(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
                             f"({s.scope.replace('_', ' ')} limits differ between controls)")
                 out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
+        elif isinstance(s, ir.DataSetting) and self.external_offset(s, out):
+            pass
         elif isinstance(s, ir.Passthrough):
             if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
                 out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
@@ -536,6 +544,21 @@ class Emitter:
                 out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
         else:
             self.refuse(f"{type(s).__name__} cannot be written in Sinumerik")
+
+    def external_offset(self, s: ir.DataSetting, out: "_Line") -> bool:
+        """ISO G10 L2 P0 (absolute) as the external zero offset frame it writes, one axis
+        translation each (`$P_EXTFRAME[X,TR]=7`, seed sinumerik-iso-milling L1330-1332); False
+        for every other data setting (refused by the caller)."""
+        if (s.kind != "work_offset" or s.extended or not isinstance(s.index, ir.Num)
+                or s.index.value != 0 or self.st.distance == "incremental"
+                or not s.values or any(a.upper() not in "XYZABC" for a in s.values)):
+            return False
+        self.info("extframe", "ISO external work offset (G10 L2 P0, #5201..) written as the "
+                              "external zero offset frame $P_EXTFRAME")
+        for a, e in s.values.items():
+            out.alone(f"{EXTERNAL_FRAME}[{a.upper()},TR]={self.expr(e)}")
+        self.st.known = {}
+        return True
 
     def motion(self, m: ir.Motion, out: "_Line") -> None:
         st = self.st
