@@ -214,8 +214,11 @@ class Conversion:
 def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, write: str = DEFAULT_DIALECT, *,
               flatten: bool = False, strict: bool = False, machine: MachineLike = None,
               search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
-              error_level: ErrorLevel = ErrorLevel.IGNORE, out: Any = None) -> Conversion:
+              error_level: ErrorLevel = ErrorLevel.IGNORE, out: Any = None,
+              profile: Optional[str] = None) -> Conversion:
     """Convert a program from dialect `read` (detected when None) to dialect `write`.
+    `profile`: the control of the source dialect's family (rules `[options.profiles]`, ISO
+    milling: "haas"), instead of the one its header comments name.
 
     Constructs the target cannot express are lowered (NC401 infos, listed in `.lowered`) or the
     conversion is refused (`.text` is None, NC402 errors say why). `flatten` writes plain motion
@@ -229,6 +232,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     _check_dialect(write)
     with _search_path(search_path):
         ld = _load(text, read, file=file, stream=out is not None)
+        _set_profile(ld, profile)
         with _api_errors():
             target = pipeline.get_dialect(write)
         if ld.streamed is not None:
@@ -242,6 +246,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                 return streamed
             out.reset()                  # convert the whole program: parse it whole
             ld = pipeline.load_source(ld.source, ld.path, ld.dialect)
+            _set_profile(ld, profile)
         diags = ld.diagnostics
         out_text: Optional[str] = None
         if ld.program is not None and not any(d.severity == "error" for d in diags):
@@ -294,6 +299,18 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
         out.write(out_text)
         out_text = ""
     return Conversion(out_text, diags, ld.dialect or "", write)
+
+
+def _set_profile(ld: pipeline.Loaded, profile: Optional[str]) -> None:
+    """Select the source's control profile by name (NCError naming the known ones otherwise)."""
+    if profile is None or ld.program is None:
+        return
+    from nctrans.rules import load_table
+    known = sorted((load_table(ld.dialect).options.get("profiles") or {}) if ld.dialect else ())
+    if profile not in known:
+        raise NCError(f"profile {profile!r} is not one of {ld.dialect or 'the source'}'s: "
+                      f"{', '.join(known) or 'it has none'}")
+    ld.program.meta["profile"] = profile
 
 
 def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any,

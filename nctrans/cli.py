@@ -208,7 +208,7 @@ def cmd_convert(args) -> int:
             try:
                 conv = api.transpile(_cli_source(s), read=args.from_, write=target.name,
                                      flatten=args.flatten, strict=args.strict, machine=machine,
-                                     out=sink)
+                                     out=sink, profile=args.profile)
             except (api.NCError, pipeline.PipelineError) as e:
                 _err(str(e))
                 status = EXIT_USAGE
@@ -560,6 +560,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--strict", action="store_true", help="turn every lowering (NC401) into an error")
     p.add_argument("--flatten", action="store_true", help="emit plain motion only (no macros, loops, calls, cycles)")
     p.add_argument("--machine", metavar="MACHINE.toml", help="machine for --flatten (offsets, tools)")
+    p.add_argument("--profile", metavar="NAME", help="control of the source's family (iso-m: haas); "
+                   "detected from the header comments when omitted")
     _add_search_path(p)
     p.set_defaults(func=cmd_convert)
 

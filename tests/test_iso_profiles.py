@@ -60,3 +60,33 @@ def test_haas_conversion_is_equiv(v, tmp_path_factory):
     # hand-computed: the last move ends at X = 2v (inch -> mm)
     last = [r for r in nctrans.toolpath(conv.text, dialect="sinumerik") if r.kind == "linear"][-1]
     assert abs(last.end["X"] - 2 * v * 25.4) < 1e-6
+
+
+PLAIN = "%\nO1\n(MINI MILL)\nG20 G90 G54\n#10100=.5\nG0 X#10100\nM30\n%\n"
+
+
+def test_the_user_selects_the_profile_on_the_command_line(tmp_path, capsys):
+    from nctrans import cli
+    src = tmp_path / "p.nc"
+    src.write_text(PLAIN)
+    assert cli.main(["convert", str(src), "--to", "sinumerik", "-o", str(tmp_path / "p.mpf"),
+                     "--profile", "haas"]) == 0
+    out = (tmp_path / "p.mpf").read_text()
+    assert "R10100=.5" in out and "G0 X=R10100" in out
+
+
+def test_an_unknown_profile_is_a_usage_error(tmp_path, capsys):
+    from nctrans import cli
+    src = tmp_path / "p.nc"
+    src.write_text(PLAIN)
+    assert cli.main(["convert", str(src), "--to", "sinumerik", "-o", str(tmp_path / "p.mpf"),
+                     "--profile", "fanuc-30i"]) == 2
+    assert "profile 'fanuc-30i' is not one of iso-m's: haas" in capsys.readouterr().err
+    assert not (tmp_path / "p.mpf").exists()
+
+
+def test_api_profile_overrides_detection(tmp_path):
+    path = tmp_path / "p.nc"
+    path.write_text(PLAIN)
+    conv = nctrans.transpile(path, read="iso-m", write="sinumerik", profile="haas")
+    assert conv.text is not None and "R10100=.5" in conv.text
