@@ -162,3 +162,15 @@ def test_sinumerik_external_frame_components_other_than_tr_are_reported():
     moves = [r for r in interpret(program, diagnostics=diags) if r.kind == "rapid"]
     assert [m.end["X"] for m in moves] == [0.0, 15.0, 5.0]
     assert any(d.rule == "NC107" and d.line == 4 for d in diags)
+
+
+def test_external_frame_round_trips_iso_sinumerik_iso(tmp_path):
+    src = "G21 G90 G17\nG10 L2 P0 X7 Y-3\nG54 G0 X10 Y10\n#5201=4.\nG0 X1\nG55 X2\nM30\n"
+    sin = _convert(src, tmp_path).text
+    path = tmp_path / "p.mpf"
+    path.write_text(sin)
+    back = nctrans.transpile(path, read="sinumerik", write="iso-m").text
+    assert "#5201=7" in back and "#5202=-3" in back and "#5201=4" in back
+    assert api.equiv(src, back, read_a="iso-m", read_b="iso-m")
+    # hand-computed ends: G54 + (7, -3); then X 1 + 4; G55 X 2 + 4
+    assert _ends(back) == [(17.0, 7.0, 0.0), (5.0, 7.0, 0.0), (6.0, 7.0, 0.0)]

@@ -647,7 +647,12 @@ class IsoEmitter(IsoSpelling, Emitter):
     def assign(self, s: n.Assign) -> str:
         try:
             if s.target.space == "system":
-                raise NotExpressible(f"writing the system variable {s.target.key}")
+                number = _external_offset_number(s.target)
+                if number is None:
+                    raise NotExpressible(f"writing the system variable {s.target.key}")
+                self.lowered("Sinumerik external zero offset $P_EXTFRAME[X,TR] written as the "
+                             "external work offset #5201..")
+                return f"#{number}={self.expr(s.value)}"
             return f"{self.val(s.target)}={self.expr(s.value)}"
         except NotExpressible as err:
             self.refuse(str(err))
@@ -1544,3 +1549,15 @@ def emit_program(program: n.Program, emitter: type[IsoEmitter] = IsoEmitter):
     em = emitter(program)
     text = em.run()
     return EmitResult(text, em.diags)
+
+
+def _external_offset_number(target: n.Var):
+    """ISO's external work offset number (#5201 + axis) of a Sinumerik `$P_EXTFRAME[X,TR]`
+    target (nctrans.interp.settable_frames models both as one offset), or None."""
+    from nctrans.interp.settable_frames import EXTERNAL
+    ix = target.indices or []
+    if (str(target.key).upper() != EXTERNAL or len(ix) != 2
+            or not all(type(i) is n.Var and i.space == "name" and not i.indices for i in ix)
+            or str(ix[1].key).upper() != "TR" or str(ix[0].key).upper() not in ("X", "Y", "Z", "A", "B", "C")):
+        return None
+    return 5201 + "XYZABC".index(str(ix[0].key).upper())
