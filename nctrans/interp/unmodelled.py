@@ -41,6 +41,11 @@ def not_analysed_rules() -> frozenset[str]:
     return frozenset(r.code for r in catalogue.load().rule if not r.code.startswith("NC3")
                      and (r.name.endswith(NOT_ANALYSED_SUFFIXES) or r.name in NOT_ANALYSED_NAMES))
 
+
+# reasons of coordinate-system changes the interpreter leaves out (ISO G68 with an I/J/K vector):
+# the moves after them are analysed in the old system, so no conversion keeps their text
+FRAME_NOT_MODELLED = "coordinate system change not modelled"
+
 # reasons whose construct the front end has already reported as an error (NC002/NC007)
 REPORTED_AS_ERROR = frozenset(("syntax error", "invalid number"))
 

@@ -397,6 +397,7 @@ class Lowering:
         b.out.append((B_NONMODAL, DataSetting(kind[0], _ex(p), values, kind[1])))
 
     def _own_rot(self, b: _Blk) -> None:
+        from nctrans.interp.unmodelled import FRAME_NOT_MODELLED
         vals = b.vals
         if any(k in vals for k in "IJK"):
             # G68 with a vector is the 3D rotation (seed L1483-1511: pivot at the workpiece zero,
@@ -404,8 +405,8 @@ class Lowering:
             # line, never turned silently in the plane
             text = "G68" + "".join(_word_text(k, v) for k, v in vals.items())
             b.out.append((B_NONMODAL, self._pass(
-                text, "G68 with an I/J/K vector (3D rotation) is not modelled: the moves after "
-                "it are analysed without the rotation")))
+                text, f"{FRAME_NOT_MODELLED}: G68 with an I/J/K vector (3D rotation); the moves "
+                "after it are analysed without the rotation")))
             vals.clear()
             return
         center = self.axis_values(vals)

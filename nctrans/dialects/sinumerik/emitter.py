@@ -42,6 +42,7 @@ from nctrans.lower import macro_procs, modal_numbers
 from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp.settable_frames import EXTERNAL as EXTERNAL_FRAME
+from nctrans.interp.unmodelled import FRAME_NOT_MODELLED
 
 DIALECT = "sinumerik"
 _NUM_OK = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?$|'[HB][0-9A-F]+'$|TRUE$|FALSE$",
@@ -535,6 +536,11 @@ class Emitter:
                 self.diags.append(at_span("NC403", "warning", f"kept from {s.dialect}: {s.text} "
                                           f"({s.reason}) as {s.address}=<value>", self.span))
                 out.words.append(f"{s.address}={self.expr(s.value)}")
+            elif s.reason.startswith(FRAME_NOT_MODELLED):
+                # a coordinate-system change the analysis leaves out: kept, the target would run
+                # its own meaning of the text, unproven
+                self.refuse(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
+                out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
             elif _reads_as_sinumerik(s.text, moves_allowed=s.reason != "directive"):
                 self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
                                           f"{s.text} ({s.reason})", self.span))
@@ -1222,9 +1228,8 @@ def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
     if not text.strip() or "\n" in text or ";" in text:
         return False
     res = parse(text, "<passthrough>")
-    # text Sinumerik reads only as an unknown function (ISO G68 with a vector) is not Sinumerik
     return not res.diagnostics and all(
-        (not isinstance(s, ir.Passthrough) or s.reason not in ("syntax error", "unknown function"))
+        (not isinstance(s, ir.Passthrough) or s.reason != "syntax error")
         and (moves_allowed or not isinstance(s, ir.Motion))
         for b in res.program.body if isinstance(b, ir.Block) for s in b.body)
 
