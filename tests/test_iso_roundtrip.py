@@ -10,8 +10,8 @@ from hypothesis import given, settings, strategies as st
 
 from nctrans.dialects.iso_m import emit, parse
 from nctrans.ir import nodes as n
+from conftest import CORPUS
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
 ISO_FILES = sorted((CORPUS / "iso-mill").glob("*"))
 
 

@@ -12,11 +12,11 @@ from nctrans.dialects.sinumerik.emitter import emit
 from nctrans.dialects.sinumerik.frontend import parse
 from nctrans.ir import nodes as ir
 from nctrans.source import read_source
+from conftest import CORPUS
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 OWN = sorted((REPO / "corpus" / "sinumerik").glob("*"))
-REAL = sorted((SHARED / "corpus" / "sinumerik").glob("*"))
+REAL = sorted((CORPUS / "sinumerik").glob("*"))
 
 
 def norm(x):
@@ -283,7 +283,7 @@ def test_roundtrip_generated_programs(text):
 
 # --------------------------------------------------------------------------- ISO programs to Sinumerik
 
-ISO_FILES = sorted((SHARED / "corpus" / "iso-mill").glob("*")) + sorted((SHARED / "corpus" / "linuxcnc").glob("*"))
+ISO_FILES = sorted((CORPUS / "iso-mill").glob("*")) + sorted((CORPUS / "linuxcnc").glob("*"))
 # programs with no refused construct whose toolpath must not change (the others use cycles or macro
 # system variables the emitter refuses, or rely on MCALL firing on a G0 block without motion)
 SAME_TOOLPATH = ["brianhooper-fusion-1001.nc", "camotics-scorpion.nc", "kiely-haas-stepblock-steps.nc",
