@@ -20,10 +20,9 @@ from nctrans.dialects import base
 from nctrans.dialects.base import Dialect, EmitResult, ParseResult
 from nctrans.diagnostics import Diagnostic
 from nctrans.ir import nodes as n
+from conftest import CORPUS
 
 ROOT = Path(__file__).resolve().parents[1]
-SHARED = ROOT.parent / "shared"
-CORPUS = SHARED / "corpus"
 NCTRANS = [sys.executable, "-m", "nctrans"]
 TIMEOUT = 120
 

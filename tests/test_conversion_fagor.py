@@ -21,28 +21,17 @@ from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.machine import default_mill
-from test_conversion_iso_sinumerik import (ISO_MILL, _errors, _policy, _read, originals,  # noqa: F401
+from roundtrip import ConversionRoundTrip, convert_policy
+from test_conversion_iso_sinumerik import (ISO_MILL, _errors, originals,  # noqa: F401
                                            zero_table)
 
 REPO = Path(__file__).resolve().parents[1]
 FAGOR = sorted((REPO / "corpus" / "fagor").glob("*.nc"))
 
 
-class FagorRoundTrip:
-    def __init__(self, path: Path):
-        self.source = get("iso-m").parse(_read(path), path.name).program
-        f = _policy(self.source, "fagor")
-        self.fagor_text, self.fagor_diags = f.text or "", f.diagnostics
-        back = get("fagor").parse(self.fagor_text, path.name + ".nc")
-        self.parse_diags = back.diagnostics
-        self.intermediate = back.program
-        iso = _policy(back.program, "iso-m")
-        self.iso_text, self.iso_diags = iso.text or "", iso.diagnostics
-
-
 @lru_cache(maxsize=None)
-def fagor_round_trip(path: Path) -> FagorRoundTrip:
-    return FagorRoundTrip(path)
+def fagor_round_trip(path: Path) -> ConversionRoundTrip:
+    return ConversionRoundTrip(path, "fagor")
 
 
 # Known: since its G73/G81 cycles are lowered alone (not the whole program), the Fagor text keeps
@@ -61,13 +50,13 @@ def test_iso_fagor_iso_round_trip_keeps_rs274_moves(path, originals, rs274_cache
     if not ref.completed:
         pytest.skip(f"rs274 stops on the original: {ref.message.splitlines()[0] if ref.message else '?'}")
     rt = fagor_round_trip(path)
-    refused = _errors(rt.fagor_diags) + _errors(rt.parse_diags) + _errors(rt.iso_diags)
+    refused = _errors(rt.via_diags) + _errors(rt.parse_diags) + _errors(rt.back_diags)
     assert not refused, "\n".join(d.format_text() for d in refused[:5])
     syntax = [d for d in rt.parse_diags if d.rule.startswith("NC0")]
     assert not syntax, "the Fagor text nctrans wrote does not parse:\n" + "\n".join(
         d.format_text() for d in syntax[:5])
     out = rs274_cache / f"conv-fagor-rt--{path.name}.ngc"
-    out.write_text(rt.iso_text, encoding="utf-8")
+    out.write_text(rt.back_text, encoding="utf-8")
     run = h.run_rs274(out, zero_table, out.with_suffix(".out"))
     assert run.completed, f"rs274 stops on the round trip: {run.message}"
     got = [h.Motion(m.kind, m.start, m.end, m.center, m.direction, m.plane, m.turns, m.where())
@@ -100,7 +89,7 @@ def _fagor(path: Path):
 @pytest.mark.parametrize("path", [pytest.param(p, id=p.name) for p in FAGOR])
 def test_fagor_converts_equivalently_or_refuses_by_line(path, target):
     program, records = _fagor(path)
-    conv = _policy(program, target)
+    conv = convert_policy(program, target)
     if conv.text is None:
         errors = _errors(conv.diagnostics)
         assert errors, "refused without an error"
@@ -123,6 +112,6 @@ def test_every_conformance_program_converts_to_both_targets():
     for path in FAGOR:
         program, _ = _fagor(path)
         for target in ("iso-m", "sinumerik"):
-            if _policy(program, target).text is None:
+            if convert_policy(program, target).text is None:
                 refused.append((path.name, target))
     assert all(name.startswith(("10-", "13-")) for name, _ in refused), refused

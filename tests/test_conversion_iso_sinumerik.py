@@ -29,7 +29,7 @@ import pytest
 import rs274 as h
 from conftest import CORPUS
 from nctrans import equivalence as equiv, pipeline
-from nctrans import source as _source
+from roundtrip import ConversionRoundTrip, convert_policy, read
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.ir import nodes as n
@@ -61,8 +61,6 @@ def _split(records):
     return [p for r in records for p in (_split_turns(r) if r.kind == "arc" and r.turns else [r])]
 
 
-def _read(path: Path) -> str:
-    return _source.decode(path.read_bytes(), path.name).text
 
 
 def _errors(diags) -> list:
@@ -86,28 +84,9 @@ def originals(rs274, rs274_cache, zero_table):
 
 # ------------------------------------------------------------------ a) iso-m -> sinumerik -> iso-m
 
-def _policy(program, target: str):
-    """`nctrans convert` on one program: structural, or lowered to plain motion where the target
-    cannot say it (nctrans.convert)."""
-    return convert(program, get(target),
-                   flatten_with=lambda diags: flatten(program, default_mill(), diagnostics=diags))
-
-
-class RoundTrip:
-    def __init__(self, path: Path):
-        self.source = get("iso-m").parse(_read(path), path.name).program
-        s = _policy(self.source, "sinumerik")
-        self.sinumerik_text, self.sinumerik_diags = s.text or "", s.diagnostics
-        back = get("sinumerik").parse(self.sinumerik_text, path.name + ".mpf")
-        self.parse_diags = back.diagnostics
-        self.intermediate = back.program
-        iso = _policy(back.program, "iso-m")
-        self.iso_text, self.iso_diags = iso.text or "", iso.diagnostics
-
-
 @lru_cache(maxsize=None)
-def round_trip(path: Path) -> RoundTrip:
-    return RoundTrip(path)
+def round_trip(path: Path) -> ConversionRoundTrip:
+    return ConversionRoundTrip(path, "sinumerik", via_suffix=".mpf")
 
 
 def _marks(name: str, known: dict) -> list:
@@ -129,10 +108,10 @@ def test_iso_sinumerik_iso_round_trip_keeps_rs274_moves(path, originals, rs274_c
     if not ref.completed:
         pytest.skip(f"rs274 stops on the original: {ref.message.splitlines()[0] if ref.message else '?'}")
     rt = round_trip(path)
-    refused = _errors(rt.sinumerik_diags) + _errors(rt.parse_diags) + _errors(rt.iso_diags)
+    refused = _errors(rt.via_diags) + _errors(rt.parse_diags) + _errors(rt.back_diags)
     assert not refused, "\n".join(d.format_text() for d in refused[:5])
     out = rs274_cache / f"conv-rt--{path.name}.ngc"
-    out.write_text(rt.iso_text, encoding="utf-8")
+    out.write_text(rt.back_text, encoding="utf-8")
     run = h.run_rs274(out, zero_table, out.with_suffix(".out"))
     assert run.completed, f"rs274 stops on the round trip: {run.message}"
     got = [h.Motion(m.kind, m.start, m.end, m.center, m.direction, m.plane, m.turns, m.where())
@@ -161,7 +140,7 @@ def test_iso_sinumerik_refusals_name_their_line(path, originals):
     if not originals[path.name].completed:
         pytest.skip("rs274 stops on the original")
     rt = round_trip(path)
-    for d in _errors(rt.sinumerik_diags) + _errors(rt.iso_diags):
+    for d in _errors(rt.via_diags) + _errors(rt.back_diags):
         assert d.rule.startswith("NC4") and d.line >= 1, d.format_text()
 
 
@@ -170,7 +149,7 @@ def test_iso_sinumerik_refusals_name_their_line(path, originals):
 class SinumerikCase:
     def __init__(self, path: Path):
         self.path = path
-        res = get("sinumerik").parse(_read(path), path.name)
+        res = get("sinumerik").parse(read(path), path.name)
         self.program = res.program
         self.parse_diags = res.diagnostics
         self.diags: list = []
@@ -299,7 +278,7 @@ def test_summary_counts(originals):
     """Prints how many corpus programs have each property (the numbers the issue asks for)."""
     done = [p for p in ISO_MILL if originals[p.name].completed]
     print(f"\n(a) iso-mill programs rs274 completes: {len(done)}; round trip refused at some stage: "
-          + str(sum(1 for p in done if _errors(round_trip(p).sinumerik_diags) or _errors(round_trip(p).iso_diags))))
+          + str(sum(1 for p in done if _errors(round_trip(p).via_diags) or _errors(round_trip(p).back_diags))))
     for label, paths in (("(b) corpus/sinumerik", SINUMERIK), ("(c) conformance", CONFORMANCE)):
         cases = [sinumerik_case(p) for p in paths]
         ok = [c for c in cases if c.resolved]

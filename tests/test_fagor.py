@@ -20,6 +20,7 @@ from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from nctrans.machine import Axis, Machine, Tool, default_mill
+from roundtrip import assert_toolpath_round_trip
 
 REPO = Path(__file__).resolve().parents[1]
 CORPUS = REPO / "corpus" / "fagor"
@@ -244,16 +245,7 @@ def test_construct_survives_emit_and_parse(block, end):
 
 
 def _assert_fagor_round_trip(text: str, machine=None):
-    res = _parse(text)
-    a = list(interpret(res.program, machine or default_mill(), diagnostics=[]))
-    out = get("fagor").emit(res.program)
-    assert not [d for d in out.diagnostics if d.severity == "error"], out.diagnostics
-    back = _parse(out.text, "back.nc")
-    bad = [d for d in back.diagnostics if d.severity == "error" or d.rule.startswith("NC0")]
-    assert not bad, out.text + "\n".join(d.format_text() for d in bad)
-    b = list(interpret(back.program, machine or default_mill(), diagnostics=[]))
-    diff = equiv.compare(a, b)
-    assert diff is None, out.text + diff.format()
+    assert_toolpath_round_trip("fagor", text, machine)
 
 
 @pytest.mark.parametrize("name", sorted(ENDS))

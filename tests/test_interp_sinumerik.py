@@ -13,8 +13,8 @@ from hypothesis import strategies as hs
 from nctrans import pipeline
 from nctrans.dialects.sinumerik.frontend import parse
 from nctrans.interp import interpret
+from conftest import CORPUS
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
 def run(text: str, preload=()):
@@ -326,7 +326,7 @@ def test_pipeline_preloads_def_files_of_the_source_directory(tmp_path):
 
 
 def test_gud_file_of_the_real_corpus_runs_its_rep_initialisers():
-    ld = pipeline.load(str(SHARED / "corpus/sinumerik/nadj-fb422-PGUD.DEF"), "sinumerik")
+    ld = pipeline.load(str(CORPUS / "sinumerik" / "nadj-fb422-PGUD.DEF"), "sinumerik")
     diags = pipeline.lint(ld)
     assert [d.format_text() for d in diags if d.rule == "NC104"] == []
     # what is left are names from Siemens definition modules not in the corpus (_N_SMAC_DEF

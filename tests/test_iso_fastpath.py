@@ -11,8 +11,8 @@ from nctrans.dialects.iso_m.fastpath import fast_words
 from nctrans.dialects.iso_m.frontend import Lowering
 from nctrans.dialects.iso_m.prelex import clean, strip_comments
 from nctrans.dialects.iso_m.words import lark_words
+from conftest import CORPUS
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
 
 digits = st.text(alphabet="0123456789", min_size=1, max_size=6)
 number = st.one_of(

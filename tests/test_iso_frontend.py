@@ -10,8 +10,8 @@ from hypothesis import given, settings, strategies as st
 from nctrans.dialects.iso_m import parse
 from nctrans.ir import nodes as n
 from nctrans.rules import load_table
+from conftest import CORPUS
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
 ISO_FILES = sorted((CORPUS / "iso-mill").glob("*"))
 LINUXCNC_FILES = sorted((CORPUS / "linuxcnc").glob("*"))
 

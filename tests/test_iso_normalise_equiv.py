@@ -13,8 +13,9 @@ from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from test_iso_roundtrip import iso_program
+from conftest import CORPUS
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus" / "iso-mill"
+ISO_MILL = CORPUS / "iso-mill"
 ISO = get("iso-m")
 LIMIT = 3000   # records: generated WHILE loops may not end; both sides stop at the same place
 
@@ -43,6 +44,6 @@ def test_generated_program_equals_its_normalised_form(text):
     _assert_normalised_equivalent(text, "gen.nc")
 
 
-@pytest.mark.parametrize("path", sorted(CORPUS.glob("*")), ids=lambda p: p.name)
+@pytest.mark.parametrize("path", sorted(ISO_MILL.glob("*")), ids=lambda p: p.name)
 def test_corpus_program_equals_its_normalised_form(path):
     _assert_normalised_equivalent(path.read_bytes().decode("cp1252", errors="replace"), path.name)

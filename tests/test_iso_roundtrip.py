@@ -2,7 +2,6 @@
 programs and on every iso-mill corpus file; plus the emitter's normal form and its NC40x reports."""
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import pytest
@@ -10,45 +9,14 @@ from hypothesis import given, settings, strategies as st
 
 from nctrans.dialects.iso_m import emit, parse
 from nctrans.ir import nodes as n
+from conftest import CORPUS
+from roundtrip import assert_ir_round_trip
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
 ISO_FILES = sorted((CORPUS / "iso-mill").glob("*"))
 
 
-def norm(obj):
-    """IR as plain data without spans and spellings (Num.text, ModeChange.code)."""
-    if dataclasses.is_dataclass(obj):
-        out = {"node": type(obj).__name__}
-        for f in dataclasses.fields(obj):
-            if f.name == "span" or (type(obj) is n.Num and f.name == "text") \
-                    or (type(obj) is n.ModeChange and f.name == "code"):
-                continue
-            out[f.name] = norm(getattr(obj, f.name))
-        return out
-    if isinstance(obj, dict):
-        return {k: norm(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [norm(v) for v in obj]
-    return obj
-
-
-def program_data(text: str) -> dict:
-    data = norm(parse(text, "t.nc").program)
-    data["meta"].pop("percent", None)
-    return data
-
-
 def assert_round_trip(text: str) -> str:
-    first = parse(text, "t.nc").program
-    out = emit(first)
-    assert [d for d in out.diagnostics if d.rule == "NC402"] == []
-    again = parse(out.text, "t.nc")
-    assert [d.format_text() for d in again.diagnostics if d.rule.startswith("NC0")] == []
-    a, b = norm(first), norm(again.program)
-    a["meta"].pop("percent", None)
-    b["meta"].pop("percent", None)
-    assert a == b, out.text
-    return out.text
+    return assert_ir_round_trip("iso-m", text, "t.nc", meta_ignored=("percent",), refusals=False)
 
 
 # --------------------------------------------------------------------- generator of ISO programs

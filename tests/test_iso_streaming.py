@@ -13,8 +13,9 @@ from nctrans import pipeline, source
 from nctrans.machine import Machine
 from nctrans.dialects.base import StreamedBody
 from nctrans.dialects.iso_m.frontend import parse_program, parse_stream
+from conftest import CORPUS
 
-ISO_MILL = Path(__file__).resolve().parents[1].parent / "shared" / "corpus" / "iso-mill"
+ISO_MILL = CORPUS / "iso-mill"
 PROGRAMS = sorted(ISO_MILL.iterdir()) if ISO_MILL.is_dir() else []
 
 

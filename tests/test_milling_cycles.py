@@ -138,10 +138,43 @@ def test_impossible_calls_stop_like_the_control(call, words):
     assert len(said) == 1 and words in said[0].message and "moves nothing" in said[0].message
 
 
-def test_mcall_of_a_pocket_is_reported_not_run():
-    recs, diags = _run("MCALL POCKET2(10, 0, 2, -5, , 15, 50, 50, 100, 300)\nG0 X80\nMCALL")
-    assert [r.line for r in recs if r.line >= 4] == [5]
-    assert [d.rule for d in diags if d.line == 4] == ["NC224"]
+def test_mcall_runs_the_cycle_after_each_positioning_block_with_its_values_of_the_mcall():
+    # the LONGHOLE of test_longhole_by_hand, called modally with its depth in R1. Arguments are
+    # passed once (seed 2.7): R1=-1 after the MCALL changes nothing, every call cuts to -5.
+    # Line 7 (G0 X80) moves to (80, 50, 20), then the cycle as by hand (it starts at Z 20);
+    # line 8 moves to (90, 10) at the RTP 10 the cycle ended at, then the cycle again (from Z 10);
+    # MCALL alone (line 9) ends it: line 10 is a plain rapid.
+    body = ("R1=-5\nMCALL LONGHOLE(10, 0, 2, R1, , 1, 20, 0, 0, 30, 90, 0, 100, 300, 2)\n"
+            "R1=-1\nG0 X80\nX90 Y10\nMCALL\nG0 X0\n")
+    recs, diags = _run(body)
+    z1, z2 = -5 / 3, -10 / 3
+    cuts = [("rapid", (0, 23, 2)),
+            ("linear", (0, 23, z1), 100), ("linear", (0, 37, z1), 300),
+            ("linear", (0, 37, z2), 100), ("linear", (0, 23, z2), 300),
+            ("linear", (0, 23, -5), 100), ("linear", (0, 37, -5), 300),
+            ("rapid", (0, 37, 10))]
+    _check(_ends(recs, 7), [("rapid", (80, 50, 20)), ("rapid", (0, 23, 20))] + cuts)
+    _check(_ends(recs, 8), [("rapid", (90, 10, 10)), ("rapid", (0, 23, 10))] + cuts)
+    _check(_ends(recs, 10), [("rapid", (0, 37, 10))])       # where the last cycle ended
+    assert [r.line for r in recs if r.line in (5, 6, 9)] == []
+    assert [d for d in diags if d.severity != "info"] == []
+
+
+def test_mcall_of_a_milling_cycle_runs_at_each_hole_of_a_pattern():
+    # HOLES1 positions two holes on a line from (20, 0) at 0 degrees, 30 apart: (20, 0), (50, 0).
+    # The modal POCKET2 (radius 15, centre (50, 50), depth -5 in one cut: MID 0) runs after each.
+    body = ("MCALL POCKET2(10, 0, 2, -5, , 15, 50, 50, 100, 300)\n"
+            "HOLES1(20, 0, 0, 0, 30, 2)\nMCALL\n")
+    recs, diags = _run(body)
+    line5 = [r for r in recs if r.line == 5]
+    positions = [(round(r.end["X"], 6), round(r.end["Y"], 6)) for r in line5
+                 if r.kind == "rapid" and round(r.end["Y"], 6) == 0.0]
+    assert positions == [(20.0, 0.0), (50.0, 0.0)]
+    plunges = [r for r in line5 if r.kind == "linear" and round(r.end["Z"], 6) == -5.0
+               and r.feed == 100]
+    assert len(plunges) == 2 and all((round(r.end["X"], 6), round(r.end["Y"], 6)) == (50.0, 50.0)
+                                     for r in plunges)
+    assert [d for d in diags if d.severity != "info"] == []
 
 
 # ---------------------------------------------------------------------------------------------

@@ -12,11 +12,11 @@ from nctrans.dialects.sinumerik.frontend import parse
 from nctrans.interp import interpret
 from nctrans.ir import nodes as ir
 from nctrans.source import read_source
+from conftest import CORPUS
 
 REPO = Path(__file__).resolve().parents[1]
 OWN_DIR = REPO / "corpus" / "sinumerik"
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
-REAL = sorted((SHARED / "corpus" / "sinumerik").glob("*"))
+REAL = sorted((CORPUS / "sinumerik").glob("*"))
 OWN = sorted(OWN_DIR.glob("*"))
 
 

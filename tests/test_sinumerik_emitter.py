@@ -2,7 +2,6 @@
 lowerings of IR that comes from other dialects (R parameters, MCALL cycles, G65, passthrough)."""
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import pytest
@@ -12,43 +11,21 @@ from nctrans.dialects.sinumerik.emitter import emit
 from nctrans.dialects.sinumerik.frontend import parse
 from nctrans.ir import nodes as ir
 from nctrans.source import read_source
+from conftest import CORPUS
+from roundtrip import assert_ir_round_trip, ir_round_trip
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 OWN = sorted((REPO / "corpus" / "sinumerik").glob("*"))
-REAL = sorted((SHARED / "corpus" / "sinumerik").glob("*"))
-
-
-def norm(x):
-    """IR as comparable data, without spans, number spellings and code spellings."""
-    if isinstance(x, ir.Span):
-        return None
-    if isinstance(x, ir.Num):
-        return ("Num", round(x.value, 9))
-    if dataclasses.is_dataclass(x):
-        return (type(x).__name__,) + tuple(
-            (f.name, norm(getattr(x, f.name))) for f in dataclasses.fields(x) if f.name not in ("span", "code"))
-    if isinstance(x, (list, tuple)):
-        return tuple(norm(i) for i in x)
-    if isinstance(x, dict):
-        return tuple(sorted((k, norm(v)) for k, v in x.items() if k != "defaults"))
-    return x
+REAL = sorted((CORPUS / "sinumerik").glob("*"))
 
 
 def roundtrip(text: str, file: str = "t.mpf"):
-    first = parse(text, file)
-    out = emit(first.program)
-    second = parse(out.text, file)
-    return first, out, second
+    return ir_round_trip("sinumerik", text, file)
 
 
 def assert_roundtrip(text: str, file: str = "t.mpf") -> str:
-    first, out, second = roundtrip(text, file)
-    assert not [d for d in second.diagnostics if d.rule.startswith("NC0")], (out.text, second.diagnostics)
-    assert norm(second.program.body) == norm(first.program.body), out.text
-    assert norm(second.program.subprograms) == norm(first.program.subprograms), out.text
-    assert norm(second.program.meta) == norm(first.program.meta)
-    return out.text
+    # numbers without their source spelling are written to 12 significant digits
+    return assert_ir_round_trip("sinumerik", text, file, digits=9, meta_ignored=("defaults",))
 
 
 @pytest.mark.parametrize("path", OWN, ids=lambda p: p.name)
@@ -283,7 +260,7 @@ def test_roundtrip_generated_programs(text):
 
 # --------------------------------------------------------------------------- ISO programs to Sinumerik
 
-ISO_FILES = sorted((SHARED / "corpus" / "iso-mill").glob("*")) + sorted((SHARED / "corpus" / "linuxcnc").glob("*"))
+ISO_FILES = sorted((CORPUS / "iso-mill").glob("*")) + sorted((CORPUS / "linuxcnc").glob("*"))
 # programs with no refused construct whose toolpath must not change (the others use cycles or macro
 # system variables the emitter refuses, or rely on MCALL firing on a G0 block without motion)
 SAME_TOOLPATH = ["brianhooper-fusion-1001.nc", "camotics-scorpion.nc", "kiely-haas-stepblock-steps.nc",

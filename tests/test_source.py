@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from nctrans.source import SourceError, decode, from_text, read_source
+from conftest import CORPUS
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
 def rules(src):
@@ -101,7 +101,7 @@ def test_reading_never_modifies_the_file(tmp_path):
 
 
 def test_every_corpus_program_reads_as_text_without_diagnostics():
-    files = [p for p in (SHARED / "corpus").rglob("*") if p.is_file() and p.suffix != ".tsv"]
+    files = [p for p in CORPUS.rglob("*") if p.is_file() and p.suffix != ".tsv"]
     assert len(files) > 50
     for p in files:
         src = read_source(p)

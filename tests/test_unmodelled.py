@@ -347,3 +347,18 @@ def test_check_names_what_it_did_not_model(tmp_path):
     out = subprocess.run(argv + ["--fail-on", "warning"], capture_output=True, text=True,
                          timeout=120)
     assert out.returncode == 1
+
+
+def test_an_unknown_g_code_moves_nothing_until_the_next_motion_code():
+    # LinuxCNC NURBS: G5.2 and its control points were unknown to the table, and the points after
+    # it ran as G1 moves (warned only for their P words). Lines 3-5 move nothing now; G1 X1 (line
+    # 6) starts from where line 2 left the tool: (0, 0, 0) -> (1, 0, 0).
+    text = "G0 X0 Y0 Z1\nG1 Z0 F300\nG5.2 X3 Y-1 P2\nX5 Y-11 P1\nG5.3\nG1 X1\nM30\n"
+    recs, diags = run(text, "iso-m")
+    assert [(r.line, xy(r)) for r in moves(recs)] == [(1, (0.0, 0.0)), (2, (0.0, 0.0)),
+                                                     (6, (1.0, 0.0))]
+    assert sorted({d.line for d in nc220(diags)}) == [3, 4, 5]
+    # Sinumerik: G123 is no G function; its X1 does not move the tool
+    recs, diags = run("G0 X0\nG123 X1\nG1 X2 F100\nM30\n")
+    assert [(r.line, xy(r)) for r in moves(recs)] == [(1, (0.0, 0.0)), (3, (2.0, 0.0))]
+    assert [d.line for d in nc220(diags)] == [2]

@@ -204,7 +204,7 @@ class CycleCallsMixin:
             hole[a1], hole[a2] = p1 * sc, p2 * sc
             self._move("rapid", hole)        # the pattern's positioning block, even when there
             if self.modal_cycle is not None:
-                self._run_cycle_call(self.modal_cycle)
+                self._run_modal_cycle()
 
     def _h_pattern_position(self, d) -> None:
         """One position of a hole pattern under a modal subprogram call: a rapid in the plane."""
@@ -213,6 +213,14 @@ class CycleCallsMixin:
         hole[a1], hole[a2] = p1, p2
         self.moved = True
         self._move("rapid", hole)            # a positioning block, even when already there
+
+    def _run_modal_cycle(self) -> None:
+        """The modally called cycle (MCALL CYCLE81.., MCALL POCKET1..) at the current position."""
+        s = self.modal_cycle
+        if s.kind == "milling":
+            run_milling_cycle(self, s)
+        else:
+            self._run_cycle_call(s)
 
     def _run_cycle_call(self, s: n.CycleCall, hole: Optional[dict] = None) -> None:
         st = self.st

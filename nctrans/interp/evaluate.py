@@ -342,6 +342,9 @@ class Evaluator:
         # frame variables whose components a program writes (Sinumerik $P_EXTFRAME[X,TR]=v):
         # name -> writer(indices as written, value) (nctrans.interp.settable_frames)
         self.frame_component_setters: dict[str, Callable[[list, Any], None]] = {}
+        # number ranges (first, last) a write refuses / a write leaves unknown (sysvars registers)
+        self.read_only_numbers: tuple[tuple[int, int], ...] = ()
+        self.running_numbers: tuple[tuple[int, int], ...] = ()
         self.unknown_used = False     # set when UNKNOWN was read; the interpreter reports it
 
     # ---------------------------------------------------------------- compiler
@@ -692,6 +695,14 @@ class Evaluator:
             self.scope.num[k] = value
         elif k in self.system_setters:
             self.system_setters[k](value)       # the machine data itself: later moves use it
+        elif k >= 1000 and any(a <= k <= b for a, b in self.read_only_numbers):
+            # kept as a plain variable, a later read would give the written value instead of
+            # the position or modal state: the control refuses the write with an alarm
+            raise EvalError("NC228", f"#{k} is a read-only system variable: the control refuses "
+                            "the write with an alarm (write-protected variable); the analysis "
+                            "goes on without it")
+        elif k >= 1000 and any(a <= k <= b for a, b in self.running_numbers):
+            self.num_globals.pop(k, None)       # a timer: set, it runs on; reads stay unknown
         else:
             self.num_globals[k] = value
 

@@ -35,6 +35,8 @@ Modelling choices [NC] where the manual leaves the path to the control (or the s
   most MIDA (0.8 x diameter when 0) apart, starting and ending FDP beyond the face;
 - thread milling (CYCLE90) climbs one pitch per turn from DP to RFP, entered from the centre
   (internal) or from outside (external) by a straight feed.
+MCALL of a milling cycle calls it after every following block that moves in the plane, with the
+values its arguments had at the MCALL (`select_modal`).
 The lathe's thread cutting cycle CYCLE97 is planned here as well (`thread_turn_steps`, its facts
 and choices in its docstring). Finishing spindle speed SSF has no effect on the path and is not
 modelled. Calls that ask for what
@@ -717,6 +719,29 @@ def call_values(interp, cyc, s) -> dict[str, float]:
     return out
 
 
+def select_modal(interp, s) -> None:
+    """MCALL of a milling cycle: the control calls it after every following block that moves in
+    the plane until MCALL alone (or another MCALL) ends it (seed, advanced manual 2.7: "the
+    subprogram is automatically called and executed after every block with path motion";
+    "parameters are only passed once with an MCALL"). The arguments are evaluated here, once;
+    each call gets the same values, so a pocket given by its centre CPA/CPO (PA/PO) is machined
+    there each time, as the cycle's own code would be [seed]. The call runs after a block that
+    moves in the plane, as the built-in drilling cycles do under MCALL [NC]."""
+    from dataclasses import replace
+
+    from nctrans.interp.evaluate import UNKNOWN
+    from nctrans.ir import nodes as n
+    values = {}
+    for k, e in s.params.items():
+        try:
+            v = interp.ev.compile(e)()
+        except Exception:           # evaluated again (and reported) where the cycle runs
+            v = None
+        values[k] = n.Num(float(v)) if isinstance(v, (int, float)) and v is not UNKNOWN else e
+    interp.modal_call = None         # one modal call at a time: this one replaces a PROC's
+    interp.modal_cycle = replace(s, params=values, modal=False)
+
+
 def run_milling_cycle(interp, s) -> None:
     """Plan the milling cycle call `s` and play its moves through the interpreter (see module doc)."""
     cyc = milling_cycle(s.name)
@@ -724,8 +749,7 @@ def run_milling_cycle(interp, s) -> None:
         interp.diag("NC103", "warning", f"milling cycle {s.name} is not known")
         return
     if s.modal:
-        interp.diag("NC224", "warning", f"MCALL {cyc.name}: a modal call of a milling cycle is not "
-                    "modelled; the call is ignored and the following positions do not run it")
+        select_modal(interp, s)
         return
     if cyc.shape == "thread_turn":
         _run_thread_turn(interp, cyc, s)

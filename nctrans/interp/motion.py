@@ -138,7 +138,7 @@ class MotionMixin:
         if self.modal_cycle is not None and st.cycle == "off" and not machine:
             self._motion_plain(vals, d)
             if any(a in PLANE_AXES[st.plane][:2] for a, _, _ in vals):
-                self._run_cycle_call(self.modal_cycle)
+                self._run_modal_cycle()
             return
         if st.cycle != "off" and not machine:
             self._cycle_hole(vals)

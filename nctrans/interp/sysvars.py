@@ -30,9 +30,21 @@ def entries(dialect: str) -> list[dict]:
         return []
 
 
+def _ranges(dialect: str, key: str) -> tuple[tuple[int, int], ...]:
+    try:
+        from nctrans.rules import load_table
+        spans = load_table(dialect).options.get(key, ())
+    except Exception:            # no table for this dialect
+        return ()
+    return tuple((int(a), int(b)) for a, b in spans)
+
+
 def register(interp, dialect: str) -> None:
-    """Publish every mapped number in `interp.ev.system` (callables read at evaluation time)."""
+    """Publish every mapped number in `interp.ev.system` (callables read at evaluation time), and
+    the read-only and running (timer) numbers the evaluator's writes check."""
     system = interp.ev.system
+    interp.ev.read_only_numbers = _ranges(dialect, "read_only_numbers")
+    interp.ev.running_numbers = _ranges(dialect, "running_numbers")
     _register_indexed(interp, dialect)
     setters = interp.ev.system_setters
     wear: dict[tuple[str, int], float] = {}          # (kind, offset number) -> wear written
@@ -146,6 +158,13 @@ def _reader(interp, e: dict, offset: int, wear: dict) -> Callable[[], Any] | Non
                 return 54.1
             return float(got) if got is not None else UNKNOWN
         return modal
+    if src == "extended_offset":
+        def extended_offset():          # G54.1 P<n> (Haas G154 P<n>) -> n; G54..G59 -> 0
+            v = st.groups.get("work_offset")
+            if isinstance(v, str) and v.startswith("G54.1P"):
+                return float(v[len("G54.1P"):])
+            return 0.0 if v is not None else UNKNOWN
+        return extended_offset
     if src == "word":
         word = e["word"]
         attr = {"feed": "feed", "speed": "spindle_speed", "tool": "tool_selected",

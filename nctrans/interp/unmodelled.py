@@ -10,8 +10,9 @@ Two kinds of Passthrough are exempt, both decided by data, not code:
 - nothing else: an unknown M function is reported like any other word.
 An unmodelled code that takes over the block's motion (a thread, a tapping or a soft-approach G
 code: `[options.unmodelled_motion] codes` of the rules table, plus every code of motion group 1 the table
-marks "passthrough") makes the block's axis words and the following blocks' until the next
-modelled motion code move nothing, with NC220 naming the code.
+marks "passthrough"; and any G code the table does not know, UNKNOWN_G_REASONS) makes the
+block's axis words and the following blocks' until the next modelled motion code move nothing,
+with NC220 naming the code.
 """
 from __future__ import annotations
 
@@ -87,7 +88,21 @@ def motion_codes(dialect: str) -> frozenset[str]:
     return frozenset(out)
 
 
+_G_CODE = re.compile(r"^G\d")
+# reasons of a G code no table knows (or one given by an expression): it may be a motion code
+# (LinuxCNC G5.2 NURBS, Haas G12/G47), so it is taken as one: its axis words, and those of the
+# blocks after it, move nothing until the next modelled motion code. (Before, the control points
+# after a G5.2 ran as G1 moves, warned only for their P word.) The control itself stops at a G
+# code it does not know.
+UNKNOWN_G_REASONS = ("unknown code", "unknown function", "unknown G code", "computed G code")
+
+
 def takes_motion(s: n.Passthrough) -> Optional[str]:
-    """The code when this unmodelled construct is a motion code (see motion_codes), else None."""
+    """The code when this unmodelled construct is a motion code (see motion_codes), or a G code
+    the dialect's table does not know; else None."""
     word = leading_word(s.text)
-    return word if word in motion_codes(s.dialect) else None
+    if word in motion_codes(s.dialect):
+        return word
+    if s.reason.startswith(UNKNOWN_G_REASONS) and _G_CODE.match(word):
+        return word
+    return None

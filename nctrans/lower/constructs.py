@@ -36,6 +36,11 @@ from nctrans.ir.walk import blocks, walk
 
 from nctrans.convert import CONSTRUCT_NOTE as NOTE, HELD_LIMIT_NOTE
 
+# run diagnostics inside a segment after which its plain motion would lack what the source does:
+# the --flatten ones plus NC220 (a construct the interpreter does not model: its plain motion would
+# silently leave it out, G16 polar mode written as Cartesian moves)
+SEGMENT_UNMODELLED = UNMODELLED_RULES + ("NC220",)
+
 class _AllRefused(Exception):
     """Raised from the run's hook once every segment is refused: the rest of the run is moot."""
 
@@ -190,16 +195,33 @@ def _local(space: str, key, program: n.Program) -> bool:
     return False
 
 
+def _label_key(x) -> str:
+    """A label as a jump finds it: upper case (Sinumerik "Mark1:" .. GOTOB MARK1), a block number
+    without leading zeros (ISO N0010 .. GOTO 10)."""
+    t = str(x).upper()
+    return str(int(t)) if t.isdigit() else t
+
+
 def _labels(nodes: list) -> set[str]:
-    return {x for b in blocks(nodes) for x in (b.label, b.number) if x is not None}
+    return {_label_key(x) for b in blocks(nodes) for x in (b.label, b.number) if x is not None}
 
 
 def _jumps(nodes: list) -> set[str]:
+    """Every label a jump, return, repetition or contour reference of `nodes` names (upper case)."""
+    return {_label_key(t) for t in _jump_targets(nodes)}
+
+
+def _jump_targets(nodes: list) -> set[str]:
     out: set[str] = set()
     for node in walk(nodes):
         if type(node) is n.Block:
             out.update(str(s.target) for s in node.body if type(s) is n.Goto)
             out.update(str(s.to_label) for s in node.body if type(s) is n.Return and s.to_label)
+            # a section repetition (REPEAT start end, REPEATB) runs its labels' blocks again: a
+            # label it names inside a lowered stretch would be gone from the output
+            for s in node.body:
+                if type(s) is n.SectionRepeat:
+                    out.update(str(x) for x in (s.start, s.end) if x)
             # a turning cycle's contour (G71 P.. Q..): the blocks it reads and runs past
             out.update(str(int(v.value)) for s in node.body if type(s) is n.CycleCall
                        for k, v in s.params.items() if k in ("start", "end") and type(v) is n.Num)
@@ -277,8 +299,14 @@ def _static_checks(program: n.Program, segments: list[Segment]) -> None:
     for seg in segments:
         inside = body[seg.first:seg.last + 1]
         rest = body[:seg.first] + body[seg.last + 1:]
-        if _jumps(rest + [x for s in subs for x in s]) & _labels(inside):
-            seg.why_not = "a jump from elsewhere lands inside it"
+        landing = _jumps(rest + [x for s in subs for x in s]) & _labels(inside)
+        if landing:
+            # its plain motion has no labels: the jump would find none
+            lab = sorted(landing)[0]
+            line = next(b.span.line for b in blocks(inside)
+                        if lab in (_label_key(b.label), _label_key(b.number)))
+            seg.why_not = (f"a jump or repetition from elsewhere lands on its label {lab} "
+                           f"(line {line}), which plain motion does not keep")
         elif not _jumps(inside) <= _labels(inside):
             seg.why_not = "it jumps out of itself"
         elif any(type(x) is n.DataSetting for b in blocks(inside) for x in b.body):
@@ -480,7 +508,7 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
                 if state["frame"] and seg.why_not is None:
                     seg.why_not = "a programmable frame, G92 or local offset is active where it ends"
                 for d in interp_diags[seg.diag_mark:]:
-                    if d.rule in UNMODELLED_RULES or (d.rule == "NC205" and d.severity == "error"):
+                    if d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error"):
                         seg.why_not = seg.why_not or d.message
                 current[0] = None
             return
@@ -507,7 +535,7 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
     for seg in segments:
         if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
             for d in interp_diags[seg.diag_mark:]:
-                if d.rule in UNMODELLED_RULES or (d.rule == "NC205" and d.severity == "error"):
+                if d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error"):
                     seg.why_not = seg.why_not or d.message
 
 

@@ -15,8 +15,8 @@ from hypothesis import given, strategies as st
 
 from nctrans.dialects.base import get, names
 from nctrans.interp import interpret
+from conftest import CORPUS
 
-CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
 RULE = re.compile(r"^NC\d{3}$")
 
 

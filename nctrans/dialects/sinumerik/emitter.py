@@ -1,4 +1,7 @@
-"""IR -> idiomatic Sinumerik 840D text.
+"""IR -> idiomatic Sinumerik 840D text, on the emitter base (nctrans.dialects.emit): statements
+dispatched to `w_<NodeType>` methods, G/M codes from rules/sinumerik.toml (code_for), expressions
+printed from its [expressions] table (nctrans.dialects.sinumerik.spelling); what cannot be written
+raises NotExpressible and is refused (NC402) at its statement's line, never written as a placeholder.
 
 What the output looks like (spec section 11.5): `DEF` blocks at the top of the program / PROC,
 `;` comments, `CR=` where the IR has a radius, structured control flow kept (IF/ELSE/ENDIF,
@@ -27,14 +30,15 @@ Lowerings for IR from other dialects (each reported as NC401 info, or NC402 when
 """
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import Any, Optional
 
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.dialects.base import EmitResult
-from nctrans.dialects.sinumerik.lexer import number_value
+from nctrans.dialects.emit import Emitter, NotExpressible, rewrites
+from nctrans.dialects.sinumerik.spelling import SinumerikSpelling
+from nctrans.dialects.sinumerik.spelling import format_number as _fmt
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
@@ -45,21 +49,15 @@ from nctrans.interp.settable_frames import EXTERNAL as EXTERNAL_FRAME
 from nctrans.interp.unmodelled import FRAME_NOT_MODELLED
 
 DIALECT = "sinumerik"
-_NUM_OK = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:EX[+-]?\d+)?$|'[HB][0-9A-F]+'$|TRUE$|FALSE$",
-                     re.IGNORECASE)
-_PREC = {"==": 1, "!=": 1, "<": 1, ">": 1, "<=": 1, ">=": 1, "concat": 2, "or": 3, "xor": 4,
-         "and": 5, "bor": 6, "bxor": 7, "band": 8, "+": 9, "-": 9, "*": 10, "/": 10, "div": 10,
-         "mod": 10}
-_OPS = {"==": "==", "!=": "<>", "<": "<", ">": ">", "<=": "<=", ">=": ">=", "concat": "<<",
-        "or": " OR ", "xor": " XOR ", "and": " AND ", "bor": " B_OR ", "bxor": " B_XOR ",
-        "band": " B_AND ", "+": "+", "-": "-", "*": "*", "/": "/", "div": " DIV ", "mod": " MOD "}
 _DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
 # address letters whose value may be an expression written `M=R501` (seed "Indirect programming":
 # every address takes a variable except N, G and L)
 _COMPUTED_WORDS = frozenset("MH")
-_AMBIGUOUS = re.compile(r"^[A-Za-z](?:\d\w*)?$")
+# statements after which the programmed position is no longer a known constant
+_FORGETS = (ir.SubCall, ir.HomeReturn, ir.SetPosition, ir.ResetSetPosition, ir.FrameOp, ir.CycleCall,
+            ir.ModeSelect)
 
 
 def _named(kind: str) -> bool:
@@ -69,19 +67,10 @@ def _named(kind: str) -> bool:
     return mapping is not None and bool(mapping.named) and mapping.exact
 
 
-def _fmt(v: float) -> str:
-    if v == int(v) and abs(v) < 1e15:
-        return str(int(v))
-    s = format(v, ".12g")
-    if "e" in s:
-        mant, ex = s.split("e")
-        return f"{mant}EX{int(ex)}"
-    return s
-
-
 @dataclass
 class _State:
-    """Modal facts the emitter needs while walking blocks in source order."""
+    """Modal facts the emitter needs while walking blocks in source order (the programmed
+    position is the base's `pos`)."""
     motion: str = "linear"
     plane: str = "XY"
     distance: str = "absolute"
@@ -93,24 +82,27 @@ class _State:
     cycle_active: bool = False
     cycle_call: str = ""                    # the active cycle call text, for holes at the current position
     cycle_init: Optional[float] = None      # ISO initial level when known statically
-    known: dict = field(default_factory=dict)   # axis -> last programmed value when constant
     feed: Optional[ir.Expr] = None          # modal F, S and feed mode (a tapping cycle's pitch)
     speed: Optional[ir.Expr] = None
     feed_mode: str = "per_min"
     units: str = "mm"
 
 
-class Emitter:
+class SinumerikEmitter(SinumerikSpelling, Emitter):
+    """IR -> Sinumerik text on the emitter base: statements in `w_<NodeType>` methods, codes from
+    rules/sinumerik.toml (code_for), expressions from its [expressions] table; a statement that
+    cannot be written raises NotExpressible and is refused (NC402) at its line."""
+    dialect = DIALECT
+    table_name = DIALECT
+    target_text = "Sinumerik"
+    lowered_for = ""
+
     def __init__(self, program: ir.Program):
+        super().__init__(program)
         self.p = program
-        self.t = load_table(DIALECT)
-        self.diags: list[Diagnostic] = []
-        self.notes: set[str] = set()
+        self.t = self.table
         self.lines: list[str] = []
         self.st = _State()
-        self.fn = {v: k for k, v in self.t.options.get("functions", {}).items()}
-        self.axes = set(self.t.options.get("axes", []))
-        self.span: Optional[ir.Span] = None
         self.pending = None
         self.targets = walk.program_jump_targets(program)
         # G65 macros written as PROCs with named parameters (nctrans.lower.macro_procs), and while
@@ -121,66 +113,26 @@ class Emitter:
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
-        if key not in self.notes:
-            self.notes.add(key)
-            self.diags.append(at_span("NC401", "info", msg, self.span))
+        """NC401, once per kind of lowering."""
+        self.lowered(msg, once=key)
 
-    def refuse(self, msg: str) -> None:
-        self.diags.append(at_span("NC402", "error", msg, self.span))
+    def lowered(self, what: str, once: Any = None) -> None:
+        Emitter.lowered(self, what, once)
+
+    def refuse_because(self, msg: str) -> None:
+        """NC402 with a message of its own (why, and what to do instead) at the current line."""
+        self.diags.append(at_span("NC402", "error", msg, self._where()))
 
     # ---------------------------------------------------------------- expressions
-    def num(self, n: ir.Num) -> str:
-        if n.text == "":               # an omitted call argument f(1,,3) (frontend.OMITTED)
-            return ""
-        if n.text and _NUM_OK.match(n.text):
-            try:
-                if math.isclose(number_value(n.text.lstrip("+")), n.value, rel_tol=1e-12, abs_tol=1e-12):
-                    return n.text.lstrip("+")
-            except ValueError:
-                pass
-        return _fmt(n.value)
+    def term(self, e: Any) -> tuple[str, int]:
+        if e is None:                  # an argument left out
+            return "", self.syntax.atom
+        return super().term(e)
 
-    def expr(self, e, prec: int = 0) -> str:
-        if e is None:
-            return ""
-        if isinstance(e, ir.Num):
-            s = self.num(e)
-            return f"({s})" if prec > 0 and s.startswith("-") else s
-        if isinstance(e, ir.Str):
-            if '"' in e.value:
-                self.refuse(f"string with a double quote cannot be written in Sinumerik: {e.value!r}")
-            return '"' + e.value.replace('"', "'") + '"'
-        if isinstance(e, ir.Var):
-            return self.var(e)
-        if isinstance(e, ir.Unary):
-            inner = self.expr(e.operand, 11)
-            op = {"-": "-", "+": "+", "not": "NOT ", "bnot": "B_NOT "}[e.op]
-            s = op + inner
-            return f"({s})" if prec > 0 else s
-        if isinstance(e, ir.Binary):
-            if self.vacancy and e.op in ("==", "!="):
-                test = self.vacancy_test(e)
-                if test is not None:
-                    return f"({test})" if prec > 0 else test
-            if e.op == "pow":
-                return self.func(ir.Func("pow", [e.left, e.right]))
-            p = _PREC.get(e.op)
-            if p is None:
-                self.refuse(f"operator {e.op!r} has no Sinumerik equivalent")
-                p = 9
-            if e.op == "concat" and isinstance(e.left, ir.Str) and e.left.value == "":
-                s = "<<" + self.expr(e.right, p + 1)
-            else:
-                left = self.expr(e.left, p if p > 1 else 99)
-                right = self.expr(e.right, (p + 1) if p > 1 else 99)
-                s = left + _OPS.get(e.op, e.op) + right
-            if p == 1 and prec > 0:
-                return f"({s})"
-            return f"({s})" if p < prec else s
-        if isinstance(e, ir.Func):
-            return self.func(e)
-        self.refuse(f"expression {type(e).__name__} cannot be written")
-        return "0"
+    @rewrites(ir.Binary, "==", "!=")
+    def _vacancy_or_compare(self, e: ir.Binary) -> tuple[str, int]:
+        test = self.vacancy_test(e) if self.vacancy else None
+        return (test, 0) if test is not None else self.binary(e)
 
     def vacancy_test(self, e: ir.Binary) -> Optional[str]:
         """An ISO comparison that can see a vacant argument, inside a PROC: `#k EQ #0` asks whether
@@ -210,54 +162,16 @@ class Emitter:
             return f"NOT {given}" if e.op == "==" else given
         if type(right) is ir.Var:
             return None                  # both sides may be vacant: macro_procs kept such calls whole
-        cmp = self.expr(left, 99) + _OPS[e.op] + self.expr(right, 99)
+        atom = self.syntax.atom
+        cmp = self.expr(left, atom) + self.syntax.binary[e.op].text + self.expr(right, atom)
         return f"{given} AND ({cmp})" if e.op == "==" else f"NOT {given} OR ({cmp})"
 
-    def arg(self, e) -> str:
-        """An element of an argument or index list: a name such as X or C1 stands bare there."""
-        if isinstance(e, ir.Var) and e.space == "name" and not e.indices:
-            return str(e.key)
-        return self.expr(e)
-
-    def args(self, args) -> str:
-        return ", ".join(self.arg(a) for a in args).replace(", ,", ",,")
-
-    def func(self, f: ir.Func) -> str:
-        name, a = f.name, f.args
-        if name == "frame_chain":
-            return ":".join(self.expr(x) for x in a)
-        if name == "LIST":
-            return "(" + ",".join(self.arg(x) for x in a) + ")"
-        if name == "pow":
-            if len(a) == 2 and isinstance(a[1], ir.Num) and a[1].value == 2:
-                return f"POT({self.expr(a[0])})"
-            self.info("pow", "general power lowered to EXP(LN(a)*b) (valid for a > 0)")
-            return f"EXP(LN({self.expr(a[0])})*{self.expr(a[1], 10)})"
-        if name == "atan" and len(a) in (1, 2):
-            return f"ATAN2({self.expr(a[0])}, {self.expr(a[1]) if len(a) == 2 else '1'})"
-        if name == "fix":
-            self.info("fix", "FIX lowered to TRUNC (rounds toward zero)")
-            return f"TRUNC({self.expr(a[0])})"
-        if name == "fup":
-            x = self.expr(a[0], 11)
-            self.info("fup", "FUP lowered to TRUNC arithmetic")
-            return f"(TRUNC({x})+({x}>TRUNC({x}))-({x}<TRUNC({x})))"
-        if name in self.fn:
-            return f"{self.fn[name]}({self.args(a)})"
-        if name.islower():
-            self.refuse(f"function {name!r} has no Sinumerik equivalent")
-            return f"{name.upper()}({self.args(a)})"
-        return f"{name}({self.args(a)})"
-
-    def var(self, v: ir.Var, target: bool = False) -> str:
-        idx = "[" + ", ".join(self.arg(i) for i in v.indices) + "]" if v.indices else ""
-        if v.space == "R":
-            return f"R{v.key}" if v.key is not None else f"R{idx}"
-        if v.space == "name" and not idx and not target and _AMBIGUOUS.match(str(v.key)):
-            return f"({v.key})"        # C or R1R2 alone would read back as address words
-        if v.space in ("name", "system"):
-            return f"{v.key}{idx}"
-        if v.space == "num" and v.key in self.local_names and not v.indices:
+    def foreign_var(self, v: ir.Var, target: bool, idx: str) -> str:
+        """ISO macro variables: a G65 macro's locals by name, system variables (#1000 and up) by
+        meaning, the rest as R parameters."""
+        if v.space != "num":
+            raise NotExpressible(f"the variable {v.space}:{v.key}")
+        if v.key in self.local_names and not v.indices:
             return self.local_names[v.key]
         if v.space == "num" and is_common(v.key, self.p.meta) and not v.indices:
             self.info("profile-common", f"common variables of the {self.p.meta.get('profile')} profile "
@@ -269,18 +183,14 @@ class Emitter:
             self.info("extframe", "ISO external work offset (G10 L2 P0, #5201..) written as the "
                                   "external zero offset frame $P_EXTFRAME")
             return f"{EXTERNAL_FRAME}[{'XYZABC'[v.key - 5201]},TR]"
-        if v.space == "num" and isinstance(v.key, int) and v.key >= 1000 and not v.indices:
+        if isinstance(v.key, int) and v.key >= 1000 and not v.indices:
             return self.system_var(v, target)
-        if v.space == "num":
-            self.info("num", "ISO macro variables #n written as R parameters Rn")
-            if v.key is None:
-                return f"R{idx}"
-            if not isinstance(v.key, int) or v.key < 1 or v.key > 999:
-                self.refuse(f"macro variable #{v.key} has no R parameter equivalent")
-                return "R0"
-            return f"R{v.key}"
-        self.refuse(f"variable {v.space}:{v.key} has no Sinumerik equivalent")
-        return f"_{v.key}"
+        self.info("num", "ISO macro variables #n written as R parameters Rn")
+        if v.key is None:
+            return f"R{idx}"
+        if not isinstance(v.key, int) or v.key < 1 or v.key > 999:
+            raise NotExpressible(f"the macro variable #{v.key} (no R parameter is its equivalent)")
+        return f"R{v.key}"
 
     def system_var(self, v: ir.Var, target: bool) -> str:
         """An ISO system variable (#1000 and up) as the Sinumerik variable of the same neutral
@@ -293,11 +203,9 @@ class Emitter:
         if found is None:
             meaning = system_meaning(v.key)
             what = meaning.replace('_', ' ') if meaning else self.numbered_meaning(v.key)
-            self.refuse(f"system variable #{v.key}" + (f" ({what})" if what else "")
-                        + " has no Sinumerik equivalent")
-            return "R0"
+            raise NotExpressible(f"the system variable #{v.key}" + (f" ({what})" if what else ""))
         if target:
-            self.refuse(f"writing the system variable #{v.key}")
+            raise NotExpressible(f"writing the system variable #{v.key}")
         name, axis = found
         self.info("sysvar", "ISO system variables written as the Sinumerik variables of the same meaning")
         return f"{name}[{axis}]" if axis else name
@@ -340,7 +248,7 @@ class Emitter:
     # ---------------------------------------------------------------- words
     def word(self, addr: str, e: ir.Expr) -> str:
         if len(addr) == 1 and isinstance(e, ir.Num):
-            text = self.num(e)
+            text = self.number(e)
             if text[:1].isdigit() or text[:1] in "-+.":
                 return addr + text
         return f"{addr}={self.expr(e)}"
@@ -362,194 +270,235 @@ class Emitter:
         r = self.t.code_for(m.group, m.value)
         return r.code if r else None
 
+
     # ---------------------------------------------------------------- statements
     def statement(self, s, out: "_Line") -> None:
+        """Write one statement into `out`; what cannot be written raises NotExpressible (the block
+        refuses it, NC402) and leaves `out` as it was."""
+        if isinstance(s, _FORGETS) or (isinstance(s, ir.ModeChange) and s.group in ("units", "work_offset")):
+            self.pos = {}
+        words, done, extra = len(out.words), len(out.done), len(out.comment_extra)
+        try:
+            self.dispatch("w_", s, out)
+        except NotExpressible:
+            del out.words[words:], out.done[done:], out.comment_extra[extra:]
+            raise
+
+    def describe(self, node: Any) -> str:
+        return f"{type(node).__name__} statements"
+
+    def w_ModeChange(self, s: ir.ModeChange, out: "_Line") -> None:
         st = self.st
-        if isinstance(s, (ir.SubCall, ir.HomeReturn, ir.SetPosition, ir.ResetSetPosition, ir.FrameOp,
-                          ir.CycleCall)) or (isinstance(s, ir.ModeChange) and s.group in (
-                              "units", "work_offset")):
-            st.known = {}
-        if isinstance(s, ir.ModeChange):
-            g = s.group
-            if g == "motion":
-                st.motion = s.value
-            elif g == "plane":
-                st.plane = s.value
-            elif g == "distance":
-                st.distance = s.value
-            elif g == "feed_mode":
-                st.feed_mode = s.value
-            elif g == "units":
-                st.units = s.value
-                if not out.join and any(w.startswith("F") for w in out.words):
-                    # an F the source reads before its units switch (ISO order): Sinumerik reads
-                    # the whole block in the new units, so the F goes in a block of its own first
-                    out.done.append(" ".join(out.words))
-                    out.words = []
-            if g == "cycle":
-                if s.value == "off":
-                    if st.cycle_active:
-                        out.alone("MCALL")
-                        back = self.t.code_for("motion", st.motion)
-                        if back is not None and st.motion != "rapid":
-                            out.alone(back.code)     # positioning blocks were written with G0
-                    st.cycle, st.cycle_active, st.cycle_params = "off", False, {}
-                    st.cycle_init = None
-                else:
-                    st.cycle, st.cycle_pending = s.value, True
-                    mapping = mapping_table().for_modal(s.value)
-                    if mapping is None or not mapping.named:
-                        why = f" ({mapping.none})" if mapping is not None and mapping.none else ""
-                        self.refuse(f"canned cycle {s.code or s.value} has no Sinumerik standard cycle"
-                                    f"{why}: convert with --flatten to expand it into motion")
-                    elif not mapping.exact:
-                        self.refuse(f"canned cycle {s.code or s.value} has no exact Sinumerik standard "
-                                    f"cycle ({mapping.differs}): convert with --flatten to expand it "
-                                    "into motion")
-                return
-            if g == "cycle_retract":
-                st.cycle_retract, st.cycle_pending = s.value, True
-                return
-            if g == "arc_distance":
-                st.arc_abs = s.value == "absolute"
-                self.info("arc_distance", "absolute arc centres written as I=AC(...)")
-                return
-            if g == "tool_length":
-                self.info("tool_length", "tool length compensation is part of the D cutting edge in "
-                                         "Sinumerik: G43/G44/G49 dropped")
-                return
-            code = self.code_of(s)
-            if code is None:
-                self.refuse(f"{s.code or s.group + '=' + s.value} has no Sinumerik equivalent")
-                return
-            out.words.append(code)
-        elif isinstance(s, ir.Motion):
-            self.motion(s, out)
-        elif isinstance(s, ir.Feed):
-            out.words.append(self.word("F", s.value))
-            if st.cycle_active and st.feed != s.value and self.cycle_takes("feed", "pitch"):
-                st.cycle_pending = True         # the cycle call carries the feed: call it anew
-            st.feed = s.value
-        elif isinstance(s, ir.SpindleSpeed):
-            if s.spindle == 1:
-                if st.cycle_active and st.speed != s.value and self.cycle_takes("pitch"):
-                    st.cycle_pending = True
-                st.speed = s.value
-            out.words.append(self.word("S", s.value) if s.spindle == 1 else
-                             f"S{s.spindle}={self.expr(s.value)}")
-        elif isinstance(s, ir.SpindleLimit):
-            out.words.append(f"LIMS={self.expr(s.value)}")
-        elif isinstance(s, ir.ToolSelect):
-            out.words.append(self.word("T", s.tool))
-        elif isinstance(s, ir.ToolChange):
-            out.words.append("M6")
-        elif isinstance(s, ir.OffsetSelect):
-            if s.kind == "radius":
-                out.words.append(self.word("D", s.index))
-            else:
-                self.info("H", "length offset H dropped: Sinumerik takes the length from the D edge")
-        elif isinstance(s, ir.Dwell):
-            if s.revolutions is None and s.seconds is None:
-                out.alone("G4")
-            elif s.revolutions is not None:
-                out.alone("G4 " + self.word("S", s.revolutions))
-            else:
-                out.alone("G4 " + self.word("F", s.seconds if s.seconds is not None else ir.Num(0.0)))
-        elif isinstance(s, ir.FrameOp):
-            self.frame(s, out)
-        elif isinstance(s, ir.SetPosition):
-            self.info("G92", "G92 written as ATRANS by the programmed position minus the new value")
-            ws = [f"{a}=$P_EP[{a}]-({self.expr(v.value)})" for a, v in s.target.items()]
-            out.alone("ATRANS " + " ".join(ws))
-        elif isinstance(s, ir.ResetSetPosition):
-            self.info("G92.1", "G92.1 written as TRANS (clears the whole programmable frame)")
-            out.alone("TRANS")
-        elif isinstance(s, ir.HomeReturn):
-            self.home(s, out)
-        elif isinstance(s, ir.CycleParams):
-            st.cycle_params.update(s.values)
-            st.cycle_pending = True
-        elif isinstance(s, ir.CycleCall):
-            self.cycle_call(s, out)
-        elif isinstance(s, ir.SubCall):
-            self.subcall(s, out)
-        elif isinstance(s, ir.ModalCallOff):
-            out.words.append("MCALL")
-        elif isinstance(s, ir.Return):
-            if s.to_label:
-                self.info("M99P", "M99 P written as RET(\"N..\") (SW 6.4 parameterised return)")
-                out.alone(f'RET("N{s.to_label}")')
-            else:
-                out.words.append("RET" if out.only else "M17")
-        elif isinstance(s, ir.ProgramEnd):
-            if s.kind == "restart":
-                self.refuse("program restart (M99) in the middle of a main program has no Sinumerik "
-                            "equivalent")
-            out.words.append("M30" if s.kind == "end_rewind" else "M2")
-        elif isinstance(s, ir.Stop):
-            out.words.append("M1" if s.optional else "M0")
-        elif isinstance(s, ir.Assign):
-            out.words.append(f"{self.var(s.target, target=True)}={self.expr(s.value)}")
-        elif isinstance(s, ir.VarDecl):
-            out.alone(self.vardecl([s]))
-        elif isinstance(s, ir.Goto):
-            tgt = "N" + s.target if s.target.isascii() and s.target.isdigit() else s.target
-            kw = _GOTO.get(s.direction, "GOTO")
-            if s.cond is not None:
-                out.alone(f"IF {self.expr(s.cond)} {kw} {tgt}")
-            else:
-                out.words.append(f"{kw} {tgt}")
-        elif isinstance(s, ir.SectionRepeat):
-            words = ["REPEATB" if s.line_only else "REPEAT", s.start] + ([s.end] if s.end else [])
-            if s.count is not None:
-                words.append(f"P={self.expr(s.count)}")
-            out.alone(" ".join(words))
-        elif isinstance(s, ir.Message):
-            out.words.append(f"MSG({self.expr(s.text)})")
-        elif isinstance(s, ir.Alarm):
-            extra = f", {self.expr(s.text)}" if s.text is not None else ""
-            out.words.append(f"SETAL({self.expr(s.number)}{extra})")
-        elif isinstance(s, ir.PolarPole):
-            code = self.t.code_for("pole", s.relative_to)
-            ws = [self.axis(a, v) for a, v in s.target.items()]
-            if s.polar:
-                ws += [f"{k}={self.expr(s.polar[key])}" for k, key in (("AP", "angle"), ("RP", "radius"))
-                       if key in s.polar]
-            out.alone(" ".join([code.code if code else "G111", *ws]))
-        elif isinstance(s, ir.ModeSelect):
-            st.known = {}                   # the mode is chosen as the program runs
-            out.words.append(f"G[{s.family}]={self.expr(s.index)}")
-        elif isinstance(s, ir.TravelLimit):
-            if s.dialect == DIALECT:
-                out.alone(s.text)
-            else:
-                self.refuse(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
-                            f"({s.scope.replace('_', ' ')} limits differ between controls)")
-                out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
-        elif isinstance(s, ir.DataSetting) and self.external_offset(s, out):
-            pass
-        elif isinstance(s, ir.Passthrough):
-            if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
-                out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
-            elif s.address and s.value is not None and s.address in _COMPUTED_WORDS:
-                # a code word with a computed value (ISO M#501): the same word, Sinumerik syntax
-                self.diags.append(at_span("NC403", "warning", f"kept from {s.dialect}: {s.text} "
-                                          f"({s.reason}) as {s.address}=<value>", self.span))
-                out.words.append(f"{s.address}={self.expr(s.value)}")
-            elif s.reason.startswith(FRAME_NOT_MODELLED):
-                # a coordinate-system change the analysis leaves out: kept, the target would run
-                # its own meaning of the text, unproven
-                self.refuse(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
-                out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
-            elif _reads_as_sinumerik(s.text, moves_allowed=s.reason != "directive"):
-                self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
-                                          f"{s.text} ({s.reason})", self.span))
-                out.words.append(s.text)
-            else:
-                self.refuse(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
-                out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
+        g = s.group
+        if g == "motion":
+            st.motion = s.value
+        elif g == "plane":
+            st.plane = s.value
+        elif g == "distance":
+            st.distance = self.distance = s.value
+        elif g == "feed_mode":
+            st.feed_mode = s.value
+        elif g == "units":
+            st.units = s.value
+            if not out.join and any(w.startswith("F") for w in out.words):
+                # an F the source reads before its units switch (ISO order): Sinumerik reads
+                # the whole block in the new units, so the F goes in a block of its own first
+                out.done.append(" ".join(out.words))
+                out.words = []
+        if g == "cycle":
+            self.cycle_mode(s, out)
+            return
+        if g == "cycle_retract":
+            st.cycle_retract, st.cycle_pending = s.value, True
+            return
+        if g == "arc_distance":
+            st.arc_abs = s.value == "absolute"
+            self.info("arc_distance", "absolute arc centres written as I=AC(...)")
+            return
+        if g == "tool_length":
+            self.info("tool_length", "tool length compensation is part of the D cutting edge in "
+                                     "Sinumerik: G43/G44/G49 dropped")
+            return
+        code = self.code_of(s)
+        if code is None:
+            raise NotExpressible(s.code or f"{s.group}={s.value}")
+        out.words.append(code)
+
+    def cycle_mode(self, s: ir.ModeChange, out: "_Line") -> None:
+        """An ISO canned-cycle mode: G80 ends the MCALL, a drilling code starts one (written at the
+        first positioning block), refused where no standard cycle drills the same."""
+        st = self.st
+        if s.value == "off":
+            if st.cycle_active:
+                out.alone("MCALL")
+                if st.motion != "rapid":
+                    out.alone(self.code_for("motion", st.motion))   # positioning blocks were G0
+            st.cycle, st.cycle_active, st.cycle_params = "off", False, {}
+            st.cycle_init = None
+            return
+        st.cycle, st.cycle_pending = s.value, True
+        mapping = mapping_table().for_modal(s.value)
+        if mapping is None or not mapping.named:
+            why = f" ({mapping.none})" if mapping is not None and mapping.none else ""
+            self.refuse_because(f"canned cycle {s.code or s.value} has no Sinumerik standard cycle"
+                                f"{why}: convert with --flatten to expand it into motion")
+        elif not mapping.exact:
+            self.refuse_because(f"canned cycle {s.code or s.value} has no exact Sinumerik standard "
+                                f"cycle ({mapping.differs}): convert with --flatten to expand it "
+                                "into motion")
+
+    def w_Motion(self, s: ir.Motion, out: "_Line") -> None:
+        self.motion(s, out)
+
+    def w_Feed(self, s: ir.Feed, out: "_Line") -> None:
+        st = self.st
+        out.words.append(self.word("F", s.value))
+        if st.cycle_active and st.feed != s.value and self.cycle_takes("feed", "pitch"):
+            st.cycle_pending = True         # the cycle call carries the feed: call it anew
+        st.feed = s.value
+
+    def w_SpindleSpeed(self, s: ir.SpindleSpeed, out: "_Line") -> None:
+        st = self.st
+        if s.spindle == 1:
+            if st.cycle_active and st.speed != s.value and self.cycle_takes("pitch"):
+                st.cycle_pending = True
+            st.speed = s.value
+        out.words.append(self.word("S", s.value) if s.spindle == 1 else
+                         f"S{s.spindle}={self.expr(s.value)}")
+
+    def w_SpindleLimit(self, s: ir.SpindleLimit, out: "_Line") -> None:
+        out.words.append(f"LIMS={self.expr(s.value)}")
+
+    def w_ToolSelect(self, s: ir.ToolSelect, out: "_Line") -> None:
+        out.words.append(self.word("T", s.tool))
+
+    def w_ToolChange(self, s: ir.ToolChange, out: "_Line") -> None:
+        out.words.append(self.code_for("tool_change"))
+
+    def w_OffsetSelect(self, s: ir.OffsetSelect, out: "_Line") -> None:
+        if s.kind == "radius":
+            out.words.append(self.word("D", s.index))
         else:
-            self.refuse(f"{type(s).__name__} cannot be written in Sinumerik")
+            self.info("H", "length offset H dropped: Sinumerik takes the length from the D edge")
+
+    def w_Dwell(self, s: ir.Dwell, out: "_Line") -> None:
+        dwell = self.code_for("dwell")
+        if s.revolutions is None and s.seconds is None:
+            out.alone(dwell)
+        elif s.revolutions is not None:
+            out.alone(f"{dwell} " + self.word("S", s.revolutions))
+        else:
+            out.alone(f"{dwell} " + self.word("F", s.seconds if s.seconds is not None else ir.Num(0.0)))
+
+    def w_FrameOp(self, s: ir.FrameOp, out: "_Line") -> None:
+        self.frame(s, out)
+
+    def w_SetPosition(self, s: ir.SetPosition, out: "_Line") -> None:
+        self.info("G92", "G92 written as ATRANS by the programmed position minus the new value")
+        ws = [f"{a}=$P_EP[{a}]-({self.expr(v.value)})" for a, v in s.target.items()]
+        out.alone(f"{self.code_for('frame', 'trans_add')} " + " ".join(ws))
+
+    def w_ResetSetPosition(self, s: ir.ResetSetPosition, out: "_Line") -> None:
+        self.info("G92.1", "G92.1 written as TRANS (clears the whole programmable frame)")
+        out.alone(self.code_for("frame", "trans"))
+
+    def w_HomeReturn(self, s: ir.HomeReturn, out: "_Line") -> None:
+        self.home(s, out)
+
+    def w_CycleParams(self, s: ir.CycleParams, out: "_Line") -> None:
+        self.st.cycle_params.update(s.values)
+        self.st.cycle_pending = True
+
+    def w_CycleCall(self, s: ir.CycleCall, out: "_Line") -> None:
+        self.cycle_call(s, out)
+
+    def w_SubCall(self, s: ir.SubCall, out: "_Line") -> None:
+        self.subcall(s, out)
+
+    def w_ModalCallOff(self, s: ir.ModalCallOff, out: "_Line") -> None:
+        out.words.append("MCALL")
+
+    def w_Return(self, s: ir.Return, out: "_Line") -> None:
+        if s.to_label:
+            self.info("M99P", "M99 P written as RET(\"N..\") (SW 6.4 parameterised return)")
+            out.alone(f'RET("N{s.to_label}")')
+        else:
+            out.words.append("RET" if out.only else self.code_for("return"))
+
+    def w_ProgramEnd(self, s: ir.ProgramEnd, out: "_Line") -> None:
+        if s.kind == "restart":
+            raise NotExpressible("a program restart (M99) in the middle of a main program")
+        out.words.append(self.code_for("end", "end_rewind" if s.kind == "end_rewind" else "end"))
+
+    def w_Stop(self, s: ir.Stop, out: "_Line") -> None:
+        out.words.append(self.code_for("stop", "optional" if s.optional else "program"))
+
+    def w_Assign(self, s: ir.Assign, out: "_Line") -> None:
+        out.words.append(f"{self.var(s.target, target=True)}={self.expr(s.value)}")
+
+    def w_VarDecl(self, s: ir.VarDecl, out: "_Line") -> None:
+        out.alone(self.vardecl([s]))
+
+    def w_Goto(self, s: ir.Goto, out: "_Line") -> None:
+        tgt = "N" + s.target if s.target.isascii() and s.target.isdigit() else s.target
+        kw = _GOTO.get(s.direction, "GOTO")
+        if s.cond is not None:
+            out.alone(f"IF {self.expr(s.cond)} {kw} {tgt}")
+        else:
+            out.words.append(f"{kw} {tgt}")
+
+    def w_SectionRepeat(self, s: ir.SectionRepeat, out: "_Line") -> None:
+        words = ["REPEATB" if s.line_only else "REPEAT", s.start] + ([s.end] if s.end else [])
+        if s.count is not None:
+            words.append(f"P={self.expr(s.count)}")
+        out.alone(" ".join(words))
+
+    def w_Message(self, s: ir.Message, out: "_Line") -> None:
+        out.words.append(f"MSG({self.expr(s.text)})")
+
+    def w_Alarm(self, s: ir.Alarm, out: "_Line") -> None:
+        extra = f", {self.expr(s.text)}" if s.text is not None else ""
+        out.words.append(f"SETAL({self.expr(s.number)}{extra})")
+
+    def w_PolarPole(self, s: ir.PolarPole, out: "_Line") -> None:
+        ws = [self.axis(a, v) for a, v in s.target.items()]
+        if s.polar:
+            ws += [f"{k}={self.expr(s.polar[key])}" for k, key in (("AP", "angle"), ("RP", "radius"))
+                   if key in s.polar]
+        out.alone(" ".join([self.code_for("pole", s.relative_to), *ws]))
+
+    def w_ModeSelect(self, s: ir.ModeSelect, out: "_Line") -> None:
+        out.words.append(f"G[{s.family}]={self.expr(s.index)}")    # the mode is chosen as it runs
+
+    def w_TravelLimit(self, s: ir.TravelLimit, out: "_Line") -> None:
+        if s.dialect == DIALECT:
+            out.alone(s.text)
+            return
+        self.refuse_because(f"travel limits {s.text!r} from {s.dialect or 'the source'} "
+                            f"({s.scope.replace('_', ' ')} limits differ between controls)")
+        out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
+
+    def w_Passthrough(self, s: ir.Passthrough, out: "_Line") -> None:
+        if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
+            out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
+        elif s.address and s.value is not None and s.address in _COMPUTED_WORDS:
+            # a code word with a computed value (ISO M#501): the same word, Sinumerik syntax
+            text = f"{s.address}={self.expr(s.value)}"
+            self.diags.append(at_span("NC403", "warning", f"kept from {s.dialect}: {s.text} "
+                                      f"({s.reason}) as {s.address}=<value>", self.span))
+            out.words.append(text)
+        elif s.reason.startswith(FRAME_NOT_MODELLED):
+            # a coordinate-system change the analysis leaves out: the target would run its own
+            # meaning of the text, unproven
+            self.refuse_because(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
+            out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
+        elif _reads_as_sinumerik(s.text, moves_allowed=s.reason != "directive"):
+            self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
+                                      f"{s.text} ({s.reason})", self.span))
+            out.words.append(s.text)
+        else:
+            self.refuse_because(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
+            out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
 
     def external_offset(self, s: ir.DataSetting, out: "_Line") -> bool:
         """ISO G10 L2 P0 (absolute) as the external zero offset frame it writes, one axis
@@ -563,8 +512,12 @@ class Emitter:
                               "external zero offset frame $P_EXTFRAME")
         for a, e in s.values.items():
             out.alone(f"{EXTERNAL_FRAME}[{a.upper()},TR]={self.expr(e)}")
-        self.st.known = {}
+        self.pos = {}
         return True
+
+    def w_DataSetting(self, s: ir.DataSetting, out: "_Line") -> None:
+        if not self.external_offset(s, out):
+            raise NotExpressible(self.describe(s))
 
     def motion(self, m: ir.Motion, out: "_Line") -> None:
         st = self.st
@@ -574,7 +527,7 @@ class Emitter:
         self.track(m)
         ws = []
         if m.machine_coords:
-            ws.append("SUPA")
+            ws.append(self.code_for("machine_coords", "SUPA"))
         for a, v in m.target.items():
             ws.append(self.axis(a, v))
         for a, v in (m.center or {}).items():
@@ -612,33 +565,20 @@ class Emitter:
         in force ($P_F) when the block has none."""
         axes = [a for a in m.target if a in ("X", "Y", "Z")]
         if len(axes) != 1:
-            self.refuse("a thread (G33) whose lead is its F, along more than one axis: Sinumerik "
-                        "needs the lead on one axis (I/J/K)")
-            return ""
+            raise NotExpressible("a thread (G33) whose lead is its F along more than one axis "
+                                 "(Sinumerik needs the lead on one axis: I/J/K)")
         feed = next((w for w in out.words if w.startswith("F")), None)
         value = feed[1:].lstrip("=") if feed else "$P_F"
         return f"{'IJK'['XYZ'.index(axes[0])]}={value}"
 
-    def track(self, m: ir.Motion) -> None:
-        """Last programmed constant position per axis (for the ISO cycle initial level)."""
-        known = self.st.known
-        for a, av in m.target.items():
-            v = av.value
-            inc = av.mode == "inc" or (av.mode is None and self.st.distance == "incremental")
-            if m.machine_coords or not isinstance(v, ir.Num):
-                known[a] = None
-            elif inc:
-                known[a] = known[a] + v.value if known.get(a) is not None else None
-            else:
-                known[a] = v.value
-
     def frame(self, f: ir.FrameOp, out: "_Line") -> None:
-        a = "A" if f.additive else ""
+        trans, trans_add = self.code_for("frame", "trans"), self.code_for("frame", "trans_add")
+        add = "_add" if f.additive else ""
         if f.op == "all" or (f.clear and not f.values):
             if f.op not in ("all",):
                 self.info("frame_clear", "cancelling one frame component clears the whole "
                                          "programmable frame in Sinumerik (TRANS)")
-            out.alone("TRANS")
+            out.alone(trans)
             return
         if f.local:
             self.info("G52", "G52 local offset written as TRANS (replaces the programmable frame)")
@@ -646,20 +586,19 @@ class Emitter:
         if f.center:
             self.info("pivot", "frame pivot written as ATRANS to the pivot, the frame, ATRANS back")
             c = {k: self.expr(v.value) for k, v in f.center.items()}
-            pre.append("ATRANS " + " ".join(f"{k}={v}" for k, v in c.items()))
-            post.append("ATRANS " + " ".join(f"{k}=-({v})" for k, v in c.items()))
-            a = "A"
-        op = {"trans": "TRANS", "rot": "ROT", "scale": "SCALE", "mirror": "MIRROR"}.get(f.op)
-        if op is None:
-            self.refuse(f"frame operation {f.op!r} cannot be written")
-            return
+            pre.append(f"{trans_add} " + " ".join(f"{k}={v}" for k, v in c.items()))
+            post.append(f"{trans_add} " + " ".join(f"{k}=-({v})" for k, v in c.items()))
+            add = "_add"
+        if f.op not in ("trans", "rot", "scale", "mirror"):
+            raise NotExpressible(f"the frame operation {f.op!r}")
+        op = self.code_for("frame", f.op + add)
         if f.op == "rot" and f.angle is not None:
             words = " ".join(self.word(k, v) for k, v in f.values.items())
-            body = f"{a}ROT {words} RPL={self.expr(f.angle)}".replace("  ", " ")
+            body = f"{op} {words} RPL={self.expr(f.angle)}".replace("  ", " ")
         elif f.op == "mirror":
-            body = f"{a}MIRROR " + " ".join(f"{k}0" for k in f.values)
+            body = f"{op} " + " ".join(f"{k}0" for k in f.values)
         else:
-            body = f"{a}{op} " + " ".join(self.word(k, v) for k, v in f.values.items())
+            body = f"{op} " + " ".join(self.word(k, v) for k, v in f.values.items())
         for line in pre + [body.strip()] + post:
             out.alone(line)
 
@@ -671,13 +610,12 @@ class Emitter:
                      for v in h.via.values())
         if h.via and not direct:
             self.info("G28", "reference point return written as G0 to the intermediate point, then G74/G75")
-            out.alone("G0 " + " ".join(self.axis(a, v) for a, v in h.via.items()))
+            out.alone(f"{self.code_for('motion', 'rapid')} " + " ".join(self.axis(a, v) for a, v in h.via.items()))
         axes = " ".join(f"{a}1=0" for a in (h.via or {"X": 0, "Y": 0, "Z": 0}))
-        out.alone(f"G74 {axes}" if h.ref == 1 else f"G75 FP={h.ref - 1} {axes}")
+        out.alone(f"{self.code_for('home', 'ref')} {axes}" if h.ref == 1 else
+                  f"{self.code_for('home', 'fixed')} FP={h.ref - 1} {axes}")
         if h.via and not direct and self.st.motion != "rapid":
-            r = self.t.code_for("motion", self.st.motion)
-            if r:
-                out.alone(r.code)
+            out.alone(self.code_for("motion", self.st.motion))
 
     def cycle_call(self, c: ir.CycleCall, out: "_Line") -> None:
         from nctrans.interp.cycles import cycle_table
@@ -692,8 +630,7 @@ class Emitter:
             name = {"holes_line": "HOLES1", "holes_circle": "HOLES2", "holes_grid": "CYCLE801",
                     "swivel_plane": "CYCLE800"}.get(c.kind)
         if name is None:
-            self.refuse(f"cycle kind {c.kind!r} has no Sinumerik standard cycle")
-            return
+            raise NotExpressible(f"the cycle kind {c.kind!r} (no Sinumerik standard cycle)")
         keys = [t.neutral(p) for p in entries[name]]
         vals = [c.params.get(k) for k in keys]
         while vals and vals[-1] is None:
@@ -713,10 +650,9 @@ class Emitter:
             r = p.get("r_plane")
             z = p.get("bottom")
             if r is None or z is None:
-                self.refuse("canned cycle without R level or depth")
-                return
+                raise NotExpressible("a canned cycle without R level or depth")
             if not st.cycle_active:
-                st.cycle_init = st.known.get(ax)
+                st.cycle_init = self.pos.get(ax)
             absolute = st.distance == "absolute"
             if "absolute" in p and isinstance(p["absolute"], ir.Num):
                 absolute = bool(p["absolute"].value)
@@ -727,7 +663,7 @@ class Emitter:
                 dv = z.value if absolute else rv + z.value
                 rtv = rv if st.cycle_retract == "r_plane" else zi
                 rfp, dp, rtp = _fmt(rv), _fmt(dv), _fmt(rtv)
-                st.known[ax] = rtv
+                self.pos[ax] = rtv
             else:
                 # otherwise the programmed position when the MCALL block is read
                 init = _fmt(zi) if zi is not None else f"$P_EP[{ax}]"
@@ -737,7 +673,7 @@ class Emitter:
                     rfp = f"{init}+{self.expr(r, 9)}"
                     dp = f"{init}+{self.expr(r, 9)}+{self.expr(z, 9)}"
                 rtp = rfp if st.cycle_retract == "r_plane" else init
-                st.known[ax] = None
+                self.pos.pop(ax, None)
             mapping = mapping_table().for_modal(st.cycle)
             given = {"RTP": rtp, "RFP": rfp, "SDIS": "0", "DP": dp}
             for param, source in mapping.args.items():
@@ -754,7 +690,7 @@ class Emitter:
             st.cycle_call = f"{mapping.named}({text})"
             out.alone("MCALL " + st.cycle_call)
             st.cycle_pending, st.cycle_active = False, True
-        words = ["G0"] + [self.axis(a, v) for a, v in pos.items()]
+        words = [self.code_for("motion", "rapid")] + [self.axis(a, v) for a, v in pos.items()]
         if not pos:
             # ISO drills at the current position when the block moves nothing in the plane; an
             # MCALL only fires on a block that moves, so call the cycle once, here
@@ -781,14 +717,13 @@ class Emitter:
             return _fmt(peck_clearance(st.units == "mm"))
         if source == "feed":
             if st.feed is None:
-                self.refuse("canned cycle without a feed rate")
-                return None
+                raise NotExpressible("a canned cycle without a feed rate")
             return self.expr(st.feed)
         if source == "pitch":
             sign = "-" if st.cycle == "tap_left" else ""
             if st.feed is None or (st.feed_mode != "per_rev" and st.speed is None):
-                self.refuse("tapping cycle without a feed rate and spindle speed: its pitch is unknown")
-                return None
+                raise NotExpressible("a tapping cycle without a feed rate and spindle speed (its pitch "
+                                     "is unknown)")
             if st.feed_mode == "per_rev":
                 lead = st.feed
             elif isinstance(st.feed, ir.Num) and isinstance(st.speed, ir.Num) and st.speed.value:
@@ -806,7 +741,7 @@ class Emitter:
         if m and self.p.dialect != DIALECT:
             return "L" + m.group(1)
         if self.p.dialect != DIALECT and not _NAME_OK.match(name):
-            self.refuse(f"program name {name!r} is not a Sinumerik name")
+            self.refuse_because(f"program name {name!r} is not a Sinumerik name")
             fixed = re.sub(r"\W", "_", name)[:31]
             return fixed if re.match(r"[A-Za-z_]", fixed) else "_" + fixed[:30]
         return name
@@ -821,8 +756,8 @@ class Emitter:
     def subcall(self, c: ir.SubCall, out: "_Line") -> None:
         if not c.name and "P" in c.named_args and self.p.dialect != DIALECT:
             # ISO M98 P#144: Sinumerik would say CALL "L" << R144, which nctrans does not analyse
-            self.refuse(f"the called program's number is computed (P={self.expr(c.named_args['P'])}): "
-                        "a Sinumerik indirect CALL is not analysed, so the conversion could not be proven")
+            self.refuse_because(f"the called program's number is computed (P={self.expr(c.named_args['P'])}): "
+                                "a Sinumerik indirect CALL is not analysed, so the conversion could not be proven")
             return
         name = self.subname(c.name)
         if self.p.dialect != DIALECT and c.name and not self._defined(c.name):
@@ -843,7 +778,7 @@ class Emitter:
                     pre.append(f"{self.var(var)}={self.expr(c.named_args[letter])}")
             pre.extend(self.fresh_locals(c))
         elif c.named_args:
-            self.refuse(f"named call arguments of {c.name} have no binding to write")
+            self.refuse_because(f"named call arguments of {c.name} have no binding to write")
         if c.kind == "call" and not c.args:
             text = f'CALL "{name}"'
         elif c.kind in ("isocall", "extcall") and not c.args:
@@ -880,7 +815,7 @@ class Emitter:
         passed = {v.key for v in c.bindings.values() if isinstance(v.key, int)}
         clear, shows = use.left_out(passed)
         if shows:
-            self.refuse(f"the call of {c.name} leaves out #{', #'.join(map(str, shows))}, which the "
+            self.refuse_because(f"the call of {c.name} leaves out #{', #'.join(map(str, shows))}, which the "
                         "macro reads while vacant (a word dropped or an EQ/NE test): a Sinumerik "
                         "R parameter would hold the value of before")
         return [f"R{k}=0" for k in clear]
@@ -892,7 +827,7 @@ class Emitter:
         for letter, var in c.bindings.items():
             pos = proc.position(var.key) if letter in c.named_args else None
             if pos is None:
-                self.refuse(f"argument {letter} of {c.name} has no parameter of its PROC")
+                self.refuse_because(f"argument {letter} of {c.name} has no parameter of its PROC")
                 continue
             at[pos] = self.expr(c.named_args[letter])
         return ", ".join(at.get(i, "") for i in range(1, max(at, default=0) + 1))
@@ -926,7 +861,7 @@ class Emitter:
     def block(self, b: ir.Block, ind: str) -> None:
         self.span = b.span
         if (b.label and b.label in self.targets) or (b.number and b.number in self.targets):
-            self.st.known = {}       # a jump target: the position depends on the path taken
+            self.pos = {}            # a jump target: the position depends on the path taken
         decls = [s for s in b.body if isinstance(s, ir.VarDecl)]
         rest = [s for s in b.body if not isinstance(s, ir.VarDecl)]
         line = _Line(only=len(rest) == 1, join=self.p.dialect == DIALECT)
@@ -938,9 +873,15 @@ class Emitter:
             else:
                 groups.append([d])
         for g in groups:
-            line.alone(self.vardecl(g))
+            try:
+                line.alone(self.vardecl(g))
+            except NotExpressible as e:
+                self.refuse(str(e))
         for s in rest:
-            self.statement(s, line)
+            try:
+                self.statement(s, line)
+            except NotExpressible as e:
+                self.refuse(str(e))
         texts = line.finish()
         head = []
         if b.skip is not None:
@@ -1001,33 +942,39 @@ class Emitter:
                 self.block(n, ind)
                 continue
             deco, self.pending = self.pending, None
-            self.st.known = {}       # loops and branches: positions depend on the path taken
-            if isinstance(n, ir.If):
-                self.ctl(ind, f"IF {self.expr(n.cond)}", deco)
-                close = self.body(n.then, ind)
-                if n.orelse:
-                    self.ctl(ind, "ELSE", close)
-                    close = self.body(n.orelse, ind)
-                self.ctl(ind, "ENDIF", close)
-            elif isinstance(n, ir.While):
-                self.ctl(ind, f"WHILE {self.expr(n.cond)}", deco)
-                self.ctl(ind, "ENDWHILE", self.body(n.body, ind))
-            elif isinstance(n, ir.ForLoop):
-                self.for_loop(n, ind, deco)
-            elif isinstance(n, ir.Loop):
-                self.ctl(ind, "LOOP", deco)
-                self.ctl(ind, "ENDLOOP", self.body(n.body, ind))
-            elif isinstance(n, ir.RepeatUntil):
-                self.ctl(ind, "REPEAT", deco)
-                self.ctl(ind, f"UNTIL {self.expr(n.cond)}", self.body(n.body, ind))
-            elif isinstance(n, ir.Case):
-                parts = [f"{self.expr(v)} GOTOF {t}" for v, t in n.branches]
-                if n.default:
-                    parts.append(f"DEFAULT GOTOF {n.default}")
-                self.ctl(ind, f"CASE {self.expr(n.subject)} OF " + " ".join(parts), deco)
-            else:
-                self.refuse(f"{type(n).__name__} cannot be written")
-            self.st.known = {}
+            self.pos = {}            # loops and branches: positions depend on the path taken
+            start, span = len(self.lines), self.span
+            try:
+                if isinstance(n, ir.If):
+                    self.ctl(ind, f"IF {self.expr(n.cond)}", deco)
+                    close = self.body(n.then, ind)
+                    if n.orelse:
+                        self.ctl(ind, "ELSE", close)
+                        close = self.body(n.orelse, ind)
+                    self.ctl(ind, "ENDIF", close)
+                elif isinstance(n, ir.While):
+                    self.ctl(ind, f"WHILE {self.expr(n.cond)}", deco)
+                    self.ctl(ind, "ENDWHILE", self.body(n.body, ind))
+                elif isinstance(n, ir.ForLoop):
+                    self.for_loop(n, ind, deco)
+                elif isinstance(n, ir.Loop):
+                    self.ctl(ind, "LOOP", deco)
+                    self.ctl(ind, "ENDLOOP", self.body(n.body, ind))
+                elif isinstance(n, ir.RepeatUntil):
+                    self.ctl(ind, "REPEAT", deco)
+                    self.ctl(ind, f"UNTIL {self.expr(n.cond)}", self.body(n.body, ind))
+                elif isinstance(n, ir.Case):
+                    parts = [f"{self.expr(v)} GOTOF {t}" for v, t in n.branches]
+                    if n.default:
+                        parts.append(f"DEFAULT GOTOF {n.default}")
+                    self.ctl(ind, f"CASE {self.expr(n.subject)} OF " + " ".join(parts), deco)
+                else:
+                    self.refuse(self.describe(n))
+            except NotExpressible as e:     # the structure is refused whole, at its line
+                del self.lines[start:]
+                self.span = span
+                self.refuse(str(e))
+            self.pos = {}
 
     def ctl(self, ind: str, text: str, deco) -> None:
         """A control-structure line, with the block number / comment of its source line."""
@@ -1101,7 +1048,7 @@ class Emitter:
             self.info("defaults", f"power-on modes of {self.p.dialect} written out: {' '.join(codes)}")
             self.lines.append(" ".join(codes))
 
-    def program(self) -> str:
+    def run(self) -> str:
         self.head()
         self.unit(self.restart_as_loop(self.p.body))
         self.subprograms()
@@ -1179,6 +1126,7 @@ class Emitter:
             if proc is not None and proc.plain_locals:
                 self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
             self.st = _State()
+            self.pos, self.distance = {}, "absolute"
             self.unit(sub.body)
             self.local_names, self.vacancy = {}, {}
 
@@ -1286,7 +1234,7 @@ def emit_stream(program: ir.Program, chunks, write) -> list[Diagnostic]:
     import copy
     shell = copy.copy(program)
     shell.body = []              # the emitter's look-ahead (jump targets) must not drain the stream
-    e = Emitter(shell)
+    e = SinumerikEmitter(shell)
     chunks = iter(chunks)
     first = next(chunks, None)  # a streamed parse fills program.meta (defaults) as it starts
     e.head()
@@ -1302,6 +1250,6 @@ def emit_stream(program: ir.Program, chunks, write) -> list[Diagnostic]:
 
 
 def emit(program: ir.Program) -> EmitResult:
-    e = Emitter(program)
-    text = e.program()
+    e = SinumerikEmitter(program)
+    text = e.run()
     return EmitResult(text, e.diags)

@@ -261,8 +261,20 @@ def _index(t) -> list[ir.Expr]:
     return _args(t) or [omitted()]
 
 
+_FUNCTIONS: list = [None, {}]
+
+
+def _functions() -> dict[str, str]:
+    """Sinumerik function name -> neutral name (rules/sinumerik.toml [expressions.functions], the
+    emitter's spellings read the other way), remembered per table."""
+    t = table()
+    if _FUNCTIONS[0] is not t:
+        _FUNCTIONS[:] = [t, {sp: neutral for neutral, sp in t.expressions.get("functions", {}).items()}]
+    return _FUNCTIONS[1]
+
+
 def func(name: str, args: list) -> ir.Expr:
-    fn = table().options.get("functions", {})
+    fn = _functions()
     if name == "POT" and len(args) == 1:
         return ir.Func("pow", [args[0], ir.Num(2.0, "2")])
     if name in fn:
@@ -1291,8 +1303,8 @@ class _PlainWord:
 
 def _expr_text(e) -> str:
     """Sinumerik spelling of an expression (for metadata that must round-trip)."""
-    from nctrans.dialects.sinumerik.emitter import Emitter
-    return Emitter(ir.Program("", DIALECT, [])).expr(e)
+    from nctrans.dialects.sinumerik.spelling import format_expr
+    return format_expr(e)
 
 
 def _expand(code: str, macros: dict[str, str], most: int) -> Optional[str]:
