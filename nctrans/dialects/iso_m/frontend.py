@@ -1032,16 +1032,18 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
             yield from main
             main.clear()
         if plain_scan is not None and cur is main:
-            end, nlines, nblocks, motion = plain_scan(text, lines.start, sep,
-                                                      plainrun.motion_code(low.motion),
-                                                      low.cycle is None, low.arc_abs, False, max_block)
-            if nblocks >= PLAIN_RUN_MIN:
-                cur.append(plainrun.PlainRun(file, text, lines.start, end, lineno, sep, nblocks,
-                                             plain_line, low.motion, low.cycle, low.arc_abs))
-                lines.skip_to(end, nlines)
-                if motion >= 0:
-                    low.motion = PLAIN_MOTIONS[motion]
-                    low.cycle = None
+            # A run starts here when its first PLAIN_RUN_MIN lines are plain. Where it ends the
+            # kernel finds as it runs it (one pass over the lines), before the body is iterated
+            # on; else extent() finds it with scan().
+            if plain_scan(text, lines.start, sep, plainrun.motion_code(low.motion), low.cycle is None,
+                          low.arc_abs, False, max_block, PLAIN_RUN_MIN)[2] >= PLAIN_RUN_MIN:
+                run = plainrun.PlainRun.open(file, text, lines.start, lineno, sep, plain_line, low.motion,
+                                             low.cycle, low.arc_abs, False, max_block)
+                main_seen = True
+                yield run
+                ends = run.extent()
+                lines.skip_to(ends.pos, ends.line - lineno)
+                low.motion, low.cycle = ends.motion, ends.cycle
                 seen_block = True
                 continue
         # Hot path: a comment-free line of plain axis words (most of CAM output).
