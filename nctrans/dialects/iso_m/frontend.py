@@ -1193,6 +1193,10 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 cur.append(_passthrough_block(raw, span, skip, unknown, low, lineno))
                 comment = None
                 continue
+            for it in structure:
+                if it[0] == "IFTHEN" and comment and any(_is_alarm(a[1]) for a in it[2]):
+                    it[2].append(("comment", comment))      # IF[..]THEN#3000=n (MESSAGE)
+                    comment = None
             if body or number is not None or comment is not None or not structure:
                 for st in body:
                     if type(st) is Alarm and st.text is None and comment:
@@ -1203,7 +1207,10 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
             for it in structure:
                 tag = it[0]
                 if tag == "IFTHEN":
-                    then = [Assign(a[1], a[2]) for a in it[2]]
+                    # #3000=n after THEN raises the alarm as it does alone on a line
+                    message = next((Str(a[1]) for a in it[2] if a[0] == "comment"), None)
+                    then = [Alarm(a[2], message) if _is_alarm(a[1]) else Assign(a[1], a[2])
+                            for a in it[2] if a[0] != "comment"]
                     cur.append(If(span, it[1], [Block(span, then, skip=skip)]))
                 elif tag in ("WHILE", "DO"):
                     node = While(span, it[1], [], it[2]) if tag == "WHILE" else Loop(span, [])
@@ -1260,6 +1267,11 @@ def _unknown_g(low: Lowering, code: str) -> Optional[str]:
         if low.code("G", m.group(1)) is None:
             return "G" + m.group(1)
     return None
+
+
+def _is_alarm(target) -> bool:
+    """An assignment to #3000 (Fanuc macro B: raise alarm n)."""
+    return type(target) is Var and target.space == "num" and target.key == ALARM_VARIABLE
 
 
 def _passthrough_block(raw: str, span: Span, skip, unknown: Optional[str], low: Lowering,
