@@ -201,7 +201,39 @@ def equidistant(start, moves, fal: float, sd: float, sp: float):
             o_moves.append(("arc", e, (m.center["Y"], m.center["X"]), m.direction == "cw"))
         else:
             o_moves.append(("linear", e, None, None))
+    # the filter checks corners locally; a step of the contour smaller than FAL can still bring the
+    # offset closer than FAL: then the allowance is not modelled rather than cut into
+    near = min(_distance(q, _polyline(start, moves)) for q in _polyline(o_start, o_moves, 8))
+    if near < fal - 1e-3 or turning.first_non_monotonic(o_start, o_moves) is not None or \
+            turning.first_non_monotonic((o_start[1], o_start[0]), turning.swapped(o_moves)) is not None:
+        raise unmodelled(f"with FAL {fal:g} larger than a step of the contour: the contour offset by FAL "
+                         "is not modelled there")
     return o_start, o_moves
+
+
+def _polyline(start, moves, n_line: int = 1) -> list:
+    """Points along the moves: arcs finely sampled, lines split in n_line pieces."""
+    pts = [start]
+    cur = start
+    for kind, end, centre, cw in moves:
+        if kind == "arc" and centre is not None:
+            pts.extend(turning.arc_points(cur, end, centre, cw, 256)[1:])
+        else:
+            pts.extend((cur[0] + (end[0] - cur[0]) * k / n_line, cur[1] + (end[1] - cur[1]) * k / n_line)
+                       for k in range(1, n_line + 1))
+        cur = end
+    return pts
+
+
+def _distance(q, pts) -> float:
+    """Distance from q to the polyline through pts."""
+    best = math.inf
+    for a, b in zip(pts, pts[1:]):
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        L = dx * dx + dy * dy
+        t = 0.0 if L == 0 else max(0.0, min(1.0, ((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / L))
+        best = min(best, math.hypot(q[0] - a[0] - t * dx, q[1] - a[1] - t * dy))
+    return best if len(pts) > 1 else math.hypot(q[0] - pts[0][0], q[1] - pts[0][1])
 
 
 def plan(start, moves, p: dict[str, float], face: bool, inside: bool, what: str):
