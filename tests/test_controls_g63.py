@@ -39,3 +39,44 @@ def test_g63_converted_is_its_feed_move_and_equivalent():
         assert api.equiv(TAP, conv.text, read_a="sinumerik", read_b=target)
     back = api.transpile(TAP, "sinumerik", "sinumerik")
     assert back.text.count("G63") == 2 and api.equiv(TAP, back.text, read_a="sinumerik", read_b="sinumerik")
+
+
+# Fagor G63: interpolated (rigid) tapping (seed L8556-8780, spec 9.8): lead = F / S, the spindle
+# turning by the sign of S whatever M3/M4 say, modal until M3/M4/M5/M19.
+FAGOR_TAP = "G17 G90 G00 X0 Y0 Z5\nF750 S500 M3\nG63 Z-10 S500\nZ-12\nG63 Z5 S-500\nM3\nX10\nM30\n"
+
+
+def _fagor(text: str):
+    ld = pipeline.load_source(from_text(text, "t.pim"), "t.pim", "fagor")
+    recs = [(r.line, r.kind, r.end["Z"] if r.end else None, r.feed, r.spindle_dir, r.pitch)
+            for r in pipeline.toolpath_of(ld) if r.kind in ("rapid", "linear", "spindle")]
+    return recs, ld.diagnostics
+
+
+def test_fagor_g63_taps_with_lead_f_over_s_and_reverses_by_the_sign_of_s():
+    recs, diags = _fagor(FAGOR_TAP)
+    assert not [d for d in diags if d.severity in ("warning", "error")]
+    moves = [r for r in recs if r[1] != "spindle"]
+    # F750 / S500 = 1.5 mm a turn; Z-12 under modal G63 taps on; M3 ends G63: X10 is a rapid
+    assert moves == [(1, "rapid", 5.0, None, None, None), (3, "linear", -10.0, 750.0, None, 1.5),
+                     (4, "linear", -12.0, 750.0, None, 1.5), (5, "linear", 5.0, 750.0, None, 1.5),
+                     (7, "rapid", 5.0, None, None, None)]
+    turns = [(r[0], r[4]) for r in recs if r[1] == "spindle"]
+    assert (5, "ccw") in turns and turns[-1] == (6, "cw")
+
+
+def test_fagor_g63_per_revolution_and_without_feed():
+    recs, _ = _fagor("G95 G00 Z5\nF1.25 S400 M3\nG63 Z-10 S400\nM30\n")
+    assert (3, "linear", -10.0, 500.0, None, 1.25) in recs          # F is the lead under G95
+    recs, diags = _fagor("G00 Z5\nS400 M3\nG63 Z-10 S400\nM30\n")
+    assert not [r for r in recs if r[1] == "linear"]
+    assert ("NC206", 3) in [(d.rule, d.line) for d in diags]
+
+
+def test_fagor_g63_round_trips_and_converts_to_iso_and_sinumerik():
+    again = api.transpile(FAGOR_TAP, "fagor", "fagor")
+    assert "G63 Z5 S-500" in again.text and api.equiv(FAGOR_TAP, again.text, read_a="fagor", read_b="fagor")
+    for target in ("iso-m", "sinumerik"):
+        conv = api.transpile(FAGOR_TAP, "fagor", target)
+        assert conv.text is not None and "G33" in conv.text, target
+        assert api.equiv(FAGOR_TAP, conv.text, read_a="fagor", read_b=target)

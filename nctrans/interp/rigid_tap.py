@@ -18,9 +18,16 @@ spindle is not synchronised (the chuck takes up the difference between F and lea
 M3/M4 program it, the retraction being a second G63 block after M4 [GK]. So the analysed path is the
 block's G1 move at F, exactly; only the override, which the toolpath does not model, differs. Under
 G0/G2/G3 the block is not what the seed describes: NC226, and its axis words move nothing.
+
+Fagor G63, interpolated (rigid) tapping (seed L8556-8780, spec 9.8): `G63 Z.. S±n` moves with the
+spindle interpolated, lead = F / S (F per revolution under G95), the spindle turning by the sign of
+S whatever M3/M4 say (the reader writes that direction into the block), modal until M3/M4/M5/M19;
+the retraction is a second G63 with S negative. The records are G331's: linear moves carrying the
+lead as pitch.
 """
 from __future__ import annotations
 
+INTERPOLATED = "tap_interp"         # Fagor G63
 TAP = "tap_rigid"                   # G331
 RETRACT = "tap_rigid_retract"       # G332
 MODES = frozenset((TAP, RETRACT))
@@ -65,3 +72,18 @@ def compensating_chuck(it) -> None:
     it.diag("NC226", "error", f"G63 (tapping with compensating chuck) under {motion or 'no'} motion: "
             "the control taps with G1 (seed: G63 Z.. G1); its axis words, and those of the blocks "
             "after it until the next motion code, move nothing in the analysed toolpath")
+
+
+def interpolated_tap_move(it, vals) -> None:
+    """One Fagor G63 block with axis words: the lead is F / S (F itself per revolution)."""
+    st = it.st
+    target = it._target(vals)
+    if not st.spindle_speed or not st.feed:
+        it.diag("NC206", "error", "G63 without a feed F and a spindle speed S: the lead (F / S) is "
+                "unknown, the move is not made")
+        return
+    lead = st.feed if st.feed_mode == "per_rev" else st.feed / st.spindle_speed
+    if st.spindle_dir not in ("cw", "ccw") or it.spindle_stopped:
+        it._record("spindle", spindle_dir=st.spindle_dir or "cw", spindle=st.spindle_speed)
+        it.spindle_stopped = False
+    it._lead_move(target, lead)
