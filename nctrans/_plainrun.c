@@ -357,7 +357,8 @@ static int plain_in_state(const Block *b, int *motion, int *cycle_off, int arc_a
     return 1;
 }
 
-/* scan(text, pos, sep, motion, cycle_off, arc_abs[, strict[, max_chars]]) -> (end, lines, blocks, motion)
+/* scan(text, pos, sep, motion, cycle_off, arc_abs[, strict[, max_chars[, max_blocks]]])
+ *   -> (end, lines, blocks, motion)
  * The run of plain lines starting at pos, given the front end's static motion mode (a MOTION_*
  * code), whether no canned cycle is active and whether centres are absolute (G90.1): `end` is where the next line starts (len(text) + 1
  * when the run reaches the end of the text), `lines` how many lines it spans, `blocks` how many of
@@ -365,15 +366,16 @@ static int plain_in_state(const Block *b, int *motion, int *cycle_off, int arc_a
  * none). The run never starts with a blank line. strict: see words_separated and parse_block_as
  * (run() needs no flag: it only reads runs scan() gave). max_chars: the longest line the front end
  * reads (limits.MAX_BLOCK_CHARS, as set): a longer one, blank or not, ends the run, so the front
- * end reports it (NC010) where it would without the kernel. */
+ * end reports it (NC010) where it would without the kernel. max_blocks: stop after that many blocks
+ * (the front end asks whether a run starts here; run() finds where it ends). */
 static PyObject *scan(PyObject *self, PyObject *args)
 {
     PyObject *str;
     Py_ssize_t pos;
     int sepc, motion, cycle_off, arc_abs, strict = 0;
-    Py_ssize_t max_chars = PY_SSIZE_T_MAX;
-    if (!PyArg_ParseTuple(args, "UnCipp|pn", &str, &pos, &sepc, &motion, &cycle_off, &arc_abs, &strict,
-                          &max_chars))
+    Py_ssize_t max_chars = PY_SSIZE_T_MAX, max_blocks = PY_SSIZE_T_MAX;
+    if (!PyArg_ParseTuple(args, "UnCipp|pnn", &str, &pos, &sepc, &motion, &cycle_off, &arc_abs, &strict,
+                          &max_chars, &max_blocks))
         return NULL;
     Text t;
     if (get_text(str, &t) < 0)
@@ -387,7 +389,7 @@ static PyObject *scan(PyObject *self, PyObject *args)
     Block b;
     Py_ssize_t p = pos, lines = 0, blocks = 0, blanks = 0;
     int last_g = -1;
-    while (p >= 0 && p <= t.len) {
+    while (p >= 0 && p <= t.len && blocks < max_blocks) {
         Py_ssize_t q = line_end(&t, p, (Py_UCS4)sepc);
         if (q - p > max_chars)
             break;                     /* NC010: the front end reports it */
@@ -664,9 +666,9 @@ static double hyp(double a, double b) { return hypot(a, b); }
 
 /* run(text, pos, end, sep, lineno, axes, prog, tot, mach, scale, incremental, motion, feed,
  *     feed_mode_json, rapid_tail, seq, file_json, max_blocks, write, plane, arc_absolute, inch_tol
- *     [, feed_scale])
+ *     [, feed_scale[, scan_state]])
  *   -> (pos, lineno, blocks, chunk, records, prog, mach, motion, feed, feed_seen, last_from,
- *       last_arc, last_g)
+ *       last_arc, last_g, ended)
  *
  * Runs the plain blocks in text[pos:end) (a run scan() found) from the interpreter's state:
  * axes: the program position's axis letters in order ("XYZ"); prog: that position (program
@@ -677,7 +679,13 @@ static double hyp(double a, double b) { return hypot(a, b); }
  * number; file_json: the file as a JSON string; plane: "XY", "ZX" or "YZ"; arc_absolute: I J K
  * are absolute (G90.1); center_tol: the arc centre tolerance (arcs.CENTER_TOL_*); feed_scale: what
  * an F word is multiplied by (the feed unit -> mm; `scale` when not given, but Sinumerik G70 reads
- * lengths in inch and feeds in mm: 25.4 and 1). Returns where
+ * lengths in inch and feeds in mm: 25.4 and 1). scan_state: None when text[pos:end) is a run
+ * scan() gave; else (motion, cycle_off, arc_abs, strict, max_chars), the front end's static state
+ * where the run starts as scan() takes it, and the run's end is found while it runs (one pass over
+ * the lines instead of scan() then run()): each line is first held to scan()'s checks, and the
+ * first one that fails them (or the end of the text) ends the run: `ended` is then 1 and `pos`,
+ * `lineno` are where the run ends (after its last block: trailing blank lines are not the run's).
+ * Returns where
  * it stopped (the first block it cannot run identically, or `end`), the JSON lines (None unless
  * `write`) and the new state; last_arc is (c1, c2, cw) when the last move was an arc; last_g the
  * MOTION_* code of the last G word in the blocks run (-1: none). */
@@ -689,14 +697,22 @@ static PyObject *run(PyObject *self, PyObject *args)
     double scale, center_tol, feed_scale = NAN;
     const char *fm_json, *tail_json, *file_json, *plane;
     Py_ssize_t fm_len, tail_len, file_len, plane_len;
-    if (!PyArg_ParseTuple(args, "UnnCnUOOOdpiOs#s#ns#nps#pd|d", &str, &pos, &end, &sepc, &lineno,
+    PyObject *scan_obj = Py_None;
+    if (!PyArg_ParseTuple(args, "UnnCnUOOOdpiOs#s#ns#nps#pd|dO", &str, &pos, &end, &sepc, &lineno,
                           &axes_obj, &prog_obj, &tot_obj, &mach_obj, &scale, &incremental, &motion,
                           &feed_obj, &fm_json, &fm_len, &tail_json, &tail_len, &seq, &file_json,
                           &file_len, &max_blocks, &write, &plane, &plane_len, &arc_absolute,
-                          &center_tol, &feed_scale))
+                          &center_tol, &feed_scale, &scan_obj))
         return NULL;
     if (PyTuple_GET_SIZE(args) < 23)
         feed_scale = scale;
+    /* open run (scan_state given): the front end's static state, held as scan() holds it */
+    int open = scan_obj != Py_None, s_motion = 0, s_cycle_off = 1, s_arc_abs = 0, s_strict = 0;
+    Py_ssize_t s_max_chars = PY_SSIZE_T_MAX;
+    if (open && (!PyArg_ParseTuple(scan_obj, "ipppn;run: scan_state is (motion, cycle_off, arc_abs, "
+                                   "strict, max_chars)", &s_motion, &s_cycle_off, &s_arc_abs, &s_strict,
+                                   &s_max_chars)))
+        return NULL;
     Text t;
     if (get_text(str, &t) < 0)
         return NULL;
@@ -704,6 +720,7 @@ static PyObject *run(PyObject *self, PyObject *args)
     if (pos < 0 || end < pos || end > t.len || lineno < 0 || max_blocks < 0
         || motion < MOTION_RAPID || motion > MOTION_OTHER || !(scale > 0.0) || !isfinite(scale)
         || !(feed_scale > 0.0) || !isfinite(feed_scale)
+        || s_motion < MOTION_RAPID || s_motion > MOTION_OTHER
         || !(center_tol >= 0.0) || !isfinite(center_tol)) {
         PyErr_SetString(PyExc_ValueError, "run: pos/end outside the text, or lineno, max_blocks, "
                         "motion, scale, feed_scale or center_tol out of range");
@@ -782,16 +799,33 @@ static PyObject *run(PyObject *self, PyObject *args)
     int start_len = -1, feed_len = -1;
     double feed_spelled = 0.0;          /* the feed feed_json spells (valid when feed_len >= 0) */
     Block b;
+    /* open run: where the last block run ends (the run's end if no block follows), whether the
+     * end was found, and the static state after the block being looked at */
+    Py_ssize_t tail_pos = pos, tail_lineno = lineno;
+    int ended = 0, next_motion = s_motion, next_cycle_off = s_cycle_off;
 
     while (pos < end && blocks < max_blocks) {
         Py_ssize_t q = line_end(&t, pos, (Py_UCS4)sepc);
+        if (open && q - pos > s_max_chars) {
+            ended = 1;                  /* NC010: the front end reports it (as scan()) */
+            break;
+        }
         int n = read_line(&t, pos, q, line);
         if (n == LINE_BLANK) {
             pos = q + 1;
             lineno++;
             continue;
         }
-        if (n < 0 || !parse_block(line, n, &b))
+        if (open) {
+            /* scan()'s checks, in the front end's static state */
+            next_motion = s_motion;
+            next_cycle_off = s_cycle_off;
+            if (n < 0 || (s_strict && !words_separated(&t, pos, q)) || !parse_block_as(line, n, &b, s_strict)
+                || !plain_in_state(&b, &next_motion, &next_cycle_off, s_arc_abs)) {
+                ended = 1;
+                break;
+            }
+        } else if (n < 0 || !parse_block(line, n, &b))
             break;                      /* not a run scan() gave: Python takes over */
         /* Work out the whole block before changing any state, so a block the kernel cannot do
          * identically is left entirely to Python. Order as the interpreter: feed, mode, motion. */
@@ -962,6 +996,16 @@ static PyObject *run(PyObject *self, PyObject *args)
         blocks++;
         pos = q + 1;
         lineno++;
+        s_motion = next_motion;
+        s_cycle_off = next_cycle_off;
+        tail_pos = pos;
+        tail_lineno = lineno;
+    }
+    if (open && pos >= end && blocks < max_blocks)
+        ended = 1;                      /* the text ends: so does the run */
+    if (ended) {
+        pos = tail_pos;                 /* blank lines after the last block are not the run's */
+        lineno = tail_lineno;
     }
     PyObject *chunk = buf_take(&out);
     if (chunk == NULL)
@@ -980,8 +1024,8 @@ static PyObject *run(PyObject *self, PyObject *args)
         Py_DECREF(chunk);
         return NULL;
     }
-    return Py_BuildValue("(nnnNnNNiNiNNi)", pos, lineno, blocks, chunk, records, prog_l, mach_l,
-                         motion, feed_o, feed_seen, from_l, arc_o, last_g);
+    return Py_BuildValue("(nnnNnNNiNiNNii)", pos, lineno, blocks, chunk, records, prog_l, mach_l,
+                         motion, feed_o, feed_seen, from_l, arc_o, last_g, ended);
 fail:
     Py_XDECREF(out.str);
     return NULL;

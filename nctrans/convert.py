@@ -106,10 +106,11 @@ def lower_for(program: Program, target: Dialect, diags: list[Diagnostic]) -> Pro
 
 
 def strict(diags: list[Diagnostic]) -> list[Diagnostic]:
-    """--strict: every lowering (NC401) becomes an error."""
+    """--strict: every lowering (NC401) and every construct refused in place (NC412) becomes an
+    error."""
     out = []
     for d in diags:
-        if d.rule == "NC401" and d.severity != "error":
+        if d.rule in ("NC401", "NC412") and d.severity != "error":
             d = Diagnostic(d.rule, "error", f"{d.message} (refused by --strict)", d.file, d.line,
                            d.column, d.end_line, d.end_column, d.fix)
         out.append(d)

@@ -165,6 +165,13 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
             cls = "rapid" if k == "rapid" else "feed"
             if cls == "feed":
                 feed = (r.feed, r.feed_mode or "per_min")
+                speed = r.spindle if r.spindle is not None else state.get("spindle_speed")
+                if feed[1] == "per_rev" and r.feed is not None \
+                        and isinstance(speed, (int, float)) and speed > 0:
+                    # a feed per revolution is that feed x the move's spindle speed per minute:
+                    # one motion, whichever way a dialect programs it (G95 vs CYCLE84; a constant
+                    # surface speed marked on one side, written out as S words on the other)
+                    feed = (r.feed * speed, "per_min")
                 last = state.get("feed")
                 if last is None or not (_close(last[0], feed[0]) and last[1] == feed[1]):
                     state["feed"] = feed

@@ -14,7 +14,13 @@ would otherwise build) instead of lowering each line. The interpreter then eithe
   identically.
 
 Either way the toolpath and the diagnostics are the same (tests/test_plainrun.py compares the two
-on corpus programs and generated ones). The kernel is optional: without the compiled extension, or
+on corpus programs and generated ones).
+
+A run is "open" when the front end makes it (it knows only that the run starts with plain lines):
+the kernel finds where it ends as it runs it, holding each line to scan()'s checks, so a plain
+line is read once. Whoever needs the end before the kernel has found it (the front end going on
+past the run, an expansion in Python, a conversion) finds it with scan() (`resolve`); the pieces a
+run is split into share one RunEnd, where the end is written once found. The kernel is optional: without the compiled extension, or
 with NCTRANS_NATIVE=0 in the environment, the front end builds no runs at all.
 """
 from __future__ import annotations
@@ -54,32 +60,116 @@ class JsonChunk:
         self.count = count
 
 
+class RunEnd:
+    """Where a run of plain lines ends, once someone has found it: `pos` (where the next line
+    starts; None until found), `line` (its number), and the front end's static motion mode and
+    canned cycle after the run's last block."""
+    __slots__ = ("pos", "line", "motion", "cycle")
+
+    def __init__(self):
+        self.pos: Optional[int] = None
+        self.line = 0
+        self.motion: Optional[str] = None
+        self.cycle: Optional[str] = None
+
+    def found(self, pos: int, line: int, motion: Optional[str], cycle: Optional[str]) -> None:
+        self.pos, self.line, self.motion, self.cycle = pos, line, motion, cycle
+
+
 class PlainRun:
     """Lines text[start:end) of a streamed ISO program: `blocks` plain blocks (blank lines between
     them do not count), the first on line `line`. `lower(code, motion, cycle, arc_abs)` turns a line's
     code (blanks removed) into the Block body the Python fast path would build (Lowering.plain_line), given
     the front end's static motion mode, canned cycle and centre mode (G90.1), which were `motion`,
-    `cycle`, `arc_abs` at `start`."""
-    __slots__ = ("file", "text", "start", "end", "line", "sep", "blocks", "lower", "motion", "cycle",
-                 "arc_abs")
+    `cycle`, `arc_abs` at `start`.
 
-    def __init__(self, file: str, text: str, start: int, end: int, line: int, sep: str, blocks: int,
-                 lower: Callable, motion: Optional[str], cycle: Optional[str], arc_abs: bool):
+    Open (see the module's docstring): `end` and `known_blocks` are None until found (reading
+    `blocks` finds them); `strict` and `max_chars` are the front end's scan() arguments (words
+    separated; the longest line it reads), `ends` the RunEnd the run's pieces share."""
+    __slots__ = ("file", "text", "start", "end", "line", "sep", "known_blocks", "lower", "motion", "cycle",
+                 "arc_abs", "strict", "max_chars", "ends")
+
+    def __init__(self, file: str, text: str, start: int, end: Optional[int], line: int, sep: str,
+                 blocks: Optional[int], lower: Callable, motion: Optional[str], cycle: Optional[str],
+                 arc_abs: bool, strict: bool = False, max_chars: int = 0, ends: Optional[RunEnd] = None):
         self.file = file
         self.text = text
         self.start = start
         self.end = end
         self.line = line
         self.sep = sep
-        self.blocks = blocks
+        self.known_blocks = blocks
         self.lower = lower
         self.motion = motion
         self.cycle = cycle
         self.arc_abs = arc_abs
+        self.strict = strict
+        self.max_chars = max_chars
+        self.ends = ends
+
+    @property
+    def is_open(self) -> bool:
+        """The run's end is not found yet."""
+        return self.known_blocks is None
+
+    @property
+    def blocks(self) -> int:
+        """The blocks in the run (found now with scan() when it is open)."""
+        self.resolve()
+        return self.known_blocks
+
+    @classmethod
+    def open(cls, file: str, text: str, start: int, line: int, sep: str, lower: Callable,
+             motion: Optional[str], cycle: Optional[str], arc_abs: bool, strict: bool,
+             max_chars: int) -> "PlainRun":
+        """A run that starts with plain lines at `start` and whose end is not known yet."""
+        return cls(file, text, start, None, line, sep, None, lower, motion, cycle, arc_abs, strict,
+                   max_chars, RunEnd())
+
+    def piece(self, start: int, line: int, motion: Optional[str], cycle: Optional[str],
+              blocks_run: int) -> "PlainRun":
+        """The rest of this run from `start` (line `line`) after `blocks_run` of its blocks ran,
+        the front end's static state there being `motion`, `cycle`."""
+        left = None if self.known_blocks is None else self.known_blocks - blocks_run
+        return PlainRun(self.file, self.text, start, self.end, line, self.sep, left, self.lower,
+                        motion, cycle, self.arc_abs, self.strict, self.max_chars, self.ends)
+
+    def resolve(self) -> None:
+        """Find this run's end with scan() when nobody has yet (the run is then closed: `end` and
+        `blocks` known). The piece may start on blank lines inside the run (the kernel stopped
+        before them), which scan() never starts on: they are stepped over here first."""
+        if self.known_blocks is not None:
+            return
+        text, sep, pos, line = self.text, self.sep, self.start, self.line
+        while pos <= len(text):
+            nl = text.find(sep, pos)
+            if nl < 0:
+                nl = len(text)
+            if nl - pos > self.max_chars or text[pos:nl].strip(" \r"):
+                break
+            pos, line = nl + 1, line + 1
+        end, lines, blocks, last = (native.scan(text, pos, sep, motion_code(self.motion), self.cycle is None,
+                                                self.arc_abs, self.strict, self.max_chars)
+                                    if pos <= len(text) else (pos, 0, 0, -1))
+        if blocks == 0:         # only blank lines were left: the run ended before them
+            end, line = self.start, self.line
+        else:
+            line += lines
+        self.end, self.known_blocks = end, blocks
+        motion, cycle = (MOTIONS[last], None) if last >= 0 else (self.motion, self.cycle)
+        if self.ends.pos is None:
+            self.ends.found(end, line, motion, cycle)
+
+    def extent(self) -> RunEnd:
+        """Where the whole run ends (found now by scan() if the kernel has not found it running)."""
+        if self.ends.pos is None:
+            self.resolve()
+        return self.ends
 
     def take(self, count: int) -> tuple[list, Optional["PlainRun"]]:
         """The first `count` blocks as IR Blocks, and the rest of the run (None when none is left)."""
         from nctrans.ir.nodes import Block, Span
+        self.resolve()
         text, sep, end, file, lower = self.text, self.sep, self.end, self.file, self.lower
         pos, line = self.start, self.line
         motion, cycle = self.motion, self.cycle
@@ -98,9 +188,7 @@ class PlainRun:
                     motion, cycle = mode, None
                 out.append(Block(Span(file, line, 1, line, len(raw) + 1), body, number))
             pos, line = nl + 1, line + 1
-        left = self.blocks - len(out)
-        rest = (PlainRun(file, text, pos, end, line, sep, left, lower, motion, cycle, self.arc_abs)
-                if left > 0 else None)
+        rest = self.piece(pos, line, motion, cycle, len(out)) if self.blocks > len(out) else None
         return out, rest
 
     def expand(self) -> list:

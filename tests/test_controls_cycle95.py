@@ -83,9 +83,31 @@ def test_contour_subprogram_beside_the_program_and_face_machining(tmp_path):
                    ("rapid", 11, -0.5), ("rapid", 21, -0.5), ("rapid", 21, 1.5)]
 
 
+def test_fal_is_an_allowance_along_the_normal_by_hand():
+    # FAL 0.5 only, roughing, MID 2, _VRT 1. The offset contour: the floor at d 10.5; the 45-degree
+    # taper d = -p moved 0.5 along its normal: d + p = 0.5 sqrt 2 (w); the shoulder at p -14.5.
+    # Concave corners at the intersections: (10.5, w - 10.5) and (w + 14.5, -14.5); top 20;
+    # A = (21, 1); depth 20 - 10.5 = 9.5 in 5 cuts of 1.9.
+    got, diags, _ = _run('CYCLE95("ANF:ENDE", 2, 0, 0, 0.5, 0.3, 0.1, 0.1, 1, , , 1)')
+    assert not [d for d in diags if d.severity != "info"]
+    w = 0.5 * math.sqrt(2)
+    r, f1 = "rapid", 0.3
+    want = [(r, 21, 1, None),
+            (r, 18.1, 1, None), ("linear", 18.1, -14.5, f1), ("linear", 20, -14.5, f1),
+            (r, 21, -13.5, None), (r, 21, 1, None),
+            (r, 16.2, 1, None), ("linear", 16.2, -14.5, f1), ("linear", 18.1, -14.5, f1),
+            (r, 19.1, -13.5, None), (r, 19.1, 1, None),
+            (r, 14.3, 1, None), ("linear", 14.3, w - 14.3, f1), ("linear", w + 14.5, -14.5, f1),
+            ("linear", 16.2, -14.5, f1), (r, 17.2, -13.5, None), (r, 17.2, 1, None),
+            (r, 12.4, 1, None), ("linear", 12.4, w - 12.4, f1), ("linear", 14.3, w - 14.3, f1),
+            (r, 15.3, w - 13.3, None), (r, 15.3, 1, None),
+            (r, 10.5, 1, None), ("linear", 10.5, w - 10.5, f1), ("linear", 12.4, w - 12.4, f1),
+            (r, 13.4, w - 11.4, None), (r, 13.4, 1, None), (r, 21, 1, None)]
+    assert got == [(k, pytest.approx(x, abs=1e-6), pytest.approx(z, abs=1e-6), f) for k, x, z, f in want]
+
+
 @pytest.mark.parametrize("call, contour, rule", [
     ('CYCLE95("ANF:ENDE", 2, 0, 0, 0, 0.3, 0.1, 0.1, 9)', "ANF: G1 X20 Z0\nX30 Z-10\nX26 Z-15\nENDE: X40\n", "NC113"),
-    ('CYCLE95("ANF:ENDE", 2, 0, 0, 0.2, 0.3, 0.1, 0.1, 9)', CONTOUR, "NC113"),
     ('CYCLE95("ANF:ENDE", 2, 0, 0, 0, 0.3, 0.1, 0.1, 9, 1, 5)', CONTOUR, "NC113"),
     ('CYCLE95("ANF:ENDE", 2, 0, 0, 0, 0.3, 0.1, 0.1, 13)', CONTOUR, "NC114"),
     ('CYCLE95("ANF:ENDE", 0, 0, 0, 0, 0.3, 0.1, 0.1, 1)', CONTOUR, "NC114"),
@@ -135,18 +157,22 @@ def _inside_part(pts, q) -> bool:
     return bool(ds) and q[0] < max(ds) - 1e-7
 
 
-@settings(max_examples=80, deadline=None)
-@given(steps_, st.floats(0.3, 6), st.floats(0, 1), st.floats(0, 1),
+@settings(max_examples=60, deadline=None)
+@given(steps_, st.floats(0.3, 6), st.floats(0, 1), st.floats(0, 1), st.one_of(st.just(0.0), st.floats(0.05, 1)),
        st.one_of(st.just(0.0), st.floats(0.1, 2)), st.sampled_from([1, 5, 9]))
-def test_never_below_the_allowance_finishes_on_the_contour_ends_safe(steps, mid, falz, falx, vrt, vari):
+def test_never_below_the_allowance_finishes_on_the_contour_ends_safe(steps, mid, falz, falx, fal, vrt, vari):
     pts = _contour(steps)
     moves = [("linear", q, None, None) for q in pts[1:]]
-    p = dict(MID=mid, FALZ=falz, FALX=falx, VRT=vrt, FF1=0.3, FF3=0.1, VARI=vari)
-    a, out = plan(pts[0], moves, p, face=False, inside=False, what={1: "rough", 5: "finish", 9: "complete"}[vari])
+    p = dict(MID=mid, FALZ=falz, FALX=falx, FAL=fal, VRT=vrt, FF1=0.3, FF3=0.1, VARI=vari)
+    try:
+        a, out = plan(pts[0], moves, p, face=False, inside=False, what={1: "rough", 5: "finish", 9: "complete"}[vari])
+    except MillingError as err:     # a step smaller than FAL: the offset is not modelled (located, NC113)
+        assert fal > 0 and err.rule == "NC113" and "FAL" in err.message
+        return
     v = vrt or 1.0
     assert a[0] >= max(d for d, _ in pts) + falx + v - 1e-9 and a[1] >= pts[0][1] + falz + v - 1e-9
+    assert _distance_to(pts, (a[0] - falx, a[1] - falz)) >= fal + v - 1e-6    # clear of the allowance
     assert out[-1][0] == "rapid" and out[-1][1] == pytest.approx(a)     # ends at the start point
-    shifted = [(d + falx, z + falz) for d, z in pts]
     feed, here, finishing = None, None, []
     for s in out:
         if s[0] == "feed":
@@ -154,8 +180,10 @@ def test_never_below_the_allowance_finishes_on_the_contour_ends_safe(steps, mid,
             continue
         if here is not None and feed == 0.3 and s[0] == "linear":
             for t in (0.0, 0.25, 0.5, 0.75, 1.0):               # roughing: never into contour + allowance
-                q = (here[0] + t * (s[1][0] - here[0]), here[1] + t * (s[1][1] - here[1]))
-                assert _distance_to(shifted, q) < 1e-6 or not _inside_part(shifted, q), (q, s)
+                q = (here[0] + t * (s[1][0] - here[0]) - falx, here[1] + t * (s[1][1] - here[1]) - falz)
+                # the part grown by FAL, shifted by FALX/FALZ: the tool stays out of it
+                dist = _distance_to(pts, q)
+                assert (dist < 1e-6 or not _inside_part(pts, q)) and dist > fal - 1e-6, (q, s)
         if feed == 0.1 and s[0] == "linear":
             finishing.append(s[1])
         here = s[1]
@@ -166,7 +194,11 @@ def test_never_below_the_allowance_finishes_on_the_contour_ends_safe(steps, mid,
     if vari in (1, 9) and max(d for d, _ in pts) > pts[0][0] + 1e-6:
         rough = out[:next((i for i, s in enumerate(out) if s[:2] == ("feed", 0.1)), len(out))]
         cuts = [s[1] for s in rough if s[0] == "linear"]        # the deepest cut reaches the allowance
-        assert min(q[0] for q in cuts) == pytest.approx(pts[0][0] + falx)
+        if not cuts:                                            # the whole step lies in the allowance
+            assert max(d for d, _ in pts) - pts[0][0] <= fal + 1e-6
+            return
+        deepest = min(cuts, key=lambda q: q[0])                 # on the allowance's boundary
+        assert _distance_to(pts, (deepest[0] - falx, deepest[1] - falz)) == pytest.approx(fal, abs=1e-6)
 
 
 def test_any_values_plan_or_refuse():
@@ -175,3 +207,15 @@ def test_any_values_plan_or_refuse():
     for bad in (dict(MID=float("nan")), dict(MID=1e-9), dict(MID=-1.0), dict(VRT=float("inf"))):
         with pytest.raises(MillingError):
             plan(pts[0], moves, dict(dict(MID=1.0, VARI=1), **bad), False, False, "rough")
+
+
+def test_a_contour_section_after_m30_is_not_unreachable(tmp_path, capsys):
+    from nctrans import cli
+    _, _, text = _run('CYCLE95("ANF:ENDE", 2, 0.25, 0.5, 0, 0.3, 0.1, 0.1, 9, , , 1)')
+    src = tmp_path / "p.mpf"
+    src.write_text(text)
+    assert cli.main(["lint", str(src), "--from", "sinumerik", "--fail-on", "warning"]) == 0
+    assert "NC112" not in capsys.readouterr().out
+    src.write_text(text.replace('"ANF:ENDE"', '"ANX:ENDE"'))          # nothing reaches it now
+    cli.main(["lint", str(src), "--from", "sinumerik"])
+    assert "NC112" in capsys.readouterr().out

@@ -88,11 +88,16 @@ def test_conversion_to_iso_writes_synchronised_moves():
     assert "G33" in words and "M4" in words
 
 
-def test_conversion_to_fagor_is_refused_at_its_line():
-    """The Fagor writer has no spindle-synchronised move: refused at the G331 line, never plain feeds."""
+def test_conversion_to_fagor_writes_g63():
+    """Fagor's rigid tapping is G63 (seed L8556-8780: lead = F / S, direction the sign of S, ended
+    by M3/M4): K1.5 at S500 is F750; after M4 the retraction is G63 again with S-500. Never plain
+    feeds (tests/test_controls_g63.py has the reader's side)."""
     out = api.transpile(TAP_PROGRAM, "sinumerik", "fagor")
-    assert out.text is None
-    assert any(d.rule == "NC402" and d.severity == "error" and d.line == 3 for d in out.diagnostics)
+    lines = [ln.split(";")[0].split() for ln in out.text.splitlines()]
+    taps = [ln for ln in lines if "G63" in ln]
+    assert [[w for w in ln if w[0] in "ZFS"] for ln in taps] == [["Z-20", "F750", "S500"], ["Z5", "F750", "S-500"]]
+    assert not any("G01" in ln for ln in lines)
+    assert api.equiv(TAP_PROGRAM, out.text, read_a="sinumerik", read_b="fagor")
 
 
 def test_sinumerik_output_keeps_g331_g332():

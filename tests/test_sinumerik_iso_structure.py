@@ -16,7 +16,7 @@ import nctrans
 from conftest import CORPUS
 from nctrans import api, equivalence, pipeline
 from nctrans.dialects.base import get
-from nctrans.dialects.iso_m.plan import stable_number
+from nctrans.dialects.iso_m.plan import NOT_CONVERTED_ALARM, stable_number
 from nctrans.interp import interpret
 from nctrans.machine import default_mill
 
@@ -64,12 +64,55 @@ def test_undeclared_array_elements_each_get_a_common_variable_named_in_the_table
     assert (moves[0]["X"], moves[0]["Y"], moves[1]["X"]) == (20.0, 40.0, 41.0)
 
 
-def test_undeclared_array_indexed_at_run_time_is_refused_at_its_line():
-    src = "DEF INT I=3\nG0 X0\nG1 X=INI[I] F100\nM30\n"
-    out = get("iso-m").emit(get("sinumerik").parse(src, "a.mpf").program)
-    refused = [d for d in out.diagnostics if d.rule == "NC402"]
-    assert [d.line for d in refused] == [3]
-    assert "INI indexed by an expression" in refused[0].message and "dimensions" in refused[0].message
+def test_undeclared_array_indexed_at_run_time_is_a_block_with_its_indices_checked(tmp_path):
+    # INI is declared by the control (GUD.DEF beside); the program indexes it with a variable
+    (tmp_path / "GUD.DEF").write_text("DEF NCK REAL INI[200]\nM30\n")
+    src = "DEF INT IX=3\nINI[IX]=7\nINI[IX+1]=INI[IX]*2\nG1 X=INI[IX] Y=INI[4] F100\nM30\n"
+    (tmp_path / "USER.MPF").write_text(src)
+    conv = nctrans.transpile(tmp_path / "USER.MPF", read="sinumerik", write="iso-m")
+    assert conv.ok, [d.format_text() for d in conv.diagnostics if d.severity == "error"]
+    lines = conv.text.splitlines()
+    # hand-checked: 1-D, largest constant index 4 -> 100 rows (the cap) from #500 (no R used);
+    # an index is checked in 0..99 as |i - 49.5| <= 49.5 before the line that uses it
+    assert "(VAR INI[100] = #500..#599 ASSUMED)" in lines
+    check = "IF[ABS[[#100]-49.5]GT49.5]THEN#3000=101(INI INDEX OUT OF RANGE)"
+    at = lines.index("#[500+#100]=7")
+    assert lines[at - 1] == check
+    assert lines[-4:-1] == [check, "G1 F100. X#[500+#100] Y#504", "M30"]
+    warn = [d for d in conv.diagnostics if d.rule == "NC410"]
+    assert [(d.line, d.severity) for d in warn] == [(2, "warning")] and "run time" in warn[0].message
+    _reads_back_clean(conv.text)
+    (tmp_path / "user.nc").write_text(conv.text)
+    same = api.equiv(tmp_path / "USER.MPF", tmp_path / "user.nc", read_a="sinumerik", read_b="iso-m")
+    assert same, same.message
+    moves = [r.end for r in nctrans.toolpath(conv.text, dialect="iso-m") if r.kind == "linear"]
+    assert (moves[0]["X"], moves[0]["Y"]) == (7.0, 14.0)
+    # an index past the assumed extent stops the ISO program (the source, with INI[200], runs on)
+    found: list = []
+    beyond = conv.text.replace("#100=3", "#100=150")
+    records = list(interpret(get("iso-m").parse(beyond, "b.nc").program, default_mill(), diagnostics=found))
+    assert not [r for r in records if r.kind == "linear"]
+    assert [d.rule for d in found if d.severity == "error"] == ["NC221"] and "alarm 101" in found[0].message
+
+
+def test_two_dimensional_global_array_rows_share_the_room_left():
+    # second extent max(2 + 1, 8) = 8; 500 free variables / 8 = 62 rows (under the 100-row cap)
+    src = "DEF INT IX=3\nTAB[IX,2]=5\nG1 X=TAB[IX,2] F100\nM30\n"
+    conv = _convert(src)
+    lines = conv.text.splitlines()
+    assert "(VAR TAB[62,8] = #500..#995 ASSUMED)" in lines and "#[500+[#100*8+2]]=5" in lines
+    assert "IF[ABS[[#100]-30.5]GT30.5]THEN#3000=101(TAB INDEX OUT OF RANGE)" in lines
+    _reads_back_clean(conv.text)
+    moves = [r.end["X"] for r in nctrans.toolpath(conv.text, dialect="iso-m") if r.kind == "linear"]
+    assert moves == [5.0]
+
+
+def test_global_array_element_only_shown_in_a_message_is_named_in_the_comment():
+    # a text array of the definition files (KOMENTAR) has no ISO place; a message is a comment
+    src = 'DEF INT IX=2\nMSG("phase-" << KOMENTAR[IX])\nG1 X1 F100\nM30\n'
+    conv = _convert(src)
+    assert "(MSG, phase-<KOMENTAR[#100]>)" in conv.text.splitlines()
+    assert not [d for d in conv.diagnostics if d.rule == "NC410"]      # nothing laid out for it
 
 
 def test_no_room_left_for_undeclared_elements_is_refused_not_wrapped():
@@ -250,8 +293,8 @@ def _library(program):
 PREFIX = 3000
 
 
-def _records(program, folder: Path, dialect: str) -> list:
-    return list(islice(interpret(program, default_mill(), diagnostics=[],
+def _records(program, folder: Path, dialect: str, diagnostics=None) -> list:
+    return list(islice(interpret(program, default_mill(), diagnostics=[] if diagnostics is None else diagnostics,
                                  resolver=pipeline.make_resolver(str(folder), dialect)), PREFIX))
 
 
@@ -303,6 +346,13 @@ def test_corpus_proc_file_runs_as_its_source_through_a_caller(path, tmp_path):
     assert conv.text.splitlines()[1].startswith(f"O{number} ")
     (out / f"O{number}.nc").write_text(conv.text)
     want = _records(get("sinumerik").parse(caller, str(src / "MAIN.MPF")).program, src, "sinumerik")
-    got = _records(get("iso-m").parse(main.text, str(out / "main.nc")).program, out, "iso-m")
+    found: list = []
+    got = _records(get("iso-m").parse(main.text, str(out / "main.nc")).program, out, "iso-m", found)
+    alarms = [d for d in found if d.rule == "NC221" and f"alarm {NOT_CONVERTED_ALARM}:" in d.message]
+    if alarms:
+        # a construct refused in place (NC412): the ISO subprogram stops with the alarm there, and
+        # runs as its source up to it
+        assert any(d.rule == "NC412" for d in conv.diagnostics) and len(got) < len(want)
+        want = want[:len(got)]
     diff = equivalence.compare(want, got)
     assert diff is None, diff.format()

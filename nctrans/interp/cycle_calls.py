@@ -146,7 +146,7 @@ class CycleCallsMixin:
         if s.kind == "swivel_plane":
             self._swivel_plane(s)
             return
-        if s.kind == "milling" and (s.name or "").upper() == "CYCLE95":
+        if s.kind == "milling" and (s.name or "").upper() in ("CYCLE95", "CYCLE72"):
             return ("turning", s)           # reads its contour from the running body (lathe.py)
         if s.kind == "milling":
             return run_milling_cycle(self, s)

@@ -18,7 +18,6 @@ A mixin of Interpreter.
 """
 from __future__ import annotations
 
-from itertools import islice
 from typing import Any, Callable, Iterator, Optional
 
 from nctrans.interp import unmodelled
@@ -32,6 +31,18 @@ from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
 
 STREAM_BATCH = 256          # blocks of a streamed main body compiled at a time
+
+
+def _next_batch(stream: Iterator) -> list:
+    """The next STREAM_BATCH items of a streamed body, or fewer: a batch ends with a PlainRun, so
+    that the run is run before the front end is asked for more and the kernel, not scan(), finds
+    where the run ends (see plainrun)."""
+    batch: list = []
+    for item in stream:
+        batch.append(item)
+        if type(item) is PlainRun or len(batch) >= STREAM_BATCH:
+            break
+    return batch
 
 
 class FlowMixin:
@@ -229,7 +240,7 @@ class FlowMixin:
             while True:
                 if pc >= len(code):
                     if stream is not None and unit is main and not self.stack:
-                        batch = list(islice(stream, STREAM_BATCH))
+                        batch = _next_batch(stream)
                         if batch:
                             code.clear()
                             main.labels.clear()

@@ -171,9 +171,13 @@ class LatheMixin:
     def _turning_control(self, s: n.CycleCall, unit, pc, sidx):
         """Run a turning cycle; returns where the interpreter continues (unit, code, pc, sidx)."""
         resume = (unit, unit.code, pc, sidx)
-        if s.kind == "milling":                 # Sinumerik CYCLE95 (nctrans.interp.stock_removal)
-            from nctrans.interp.stock_removal import run_cycle95
-            run_cycle95(self, s, unit, pc)
+        if s.kind == "milling":                 # Sinumerik cycles along a contour subprogram
+            if s.name.upper() == "CYCLE72":
+                from nctrans.interp.contour_milling import run_cycle72
+                run_cycle72(self, s, unit, pc)
+            else:
+                from nctrans.interp.stock_removal import run_cycle95
+                run_cycle95(self, s, unit, pc)
             return resume
         vals = self._turning_values(s)
         first = (self.turning_first or {}).get(s.kind, {})

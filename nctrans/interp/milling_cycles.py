@@ -709,7 +709,7 @@ def call_values(interp, cyc, s) -> dict[str, float]:
     out: dict[str, float] = {}
     for name in cyc.params:
         e = s.params.get(table.neutral(name))
-        if e is None:
+        if e is None or (name in table.milling_param and table.milling_param[name].unit == "name"):
             continue
         v = interp._value(interp.ev.compile(e), f"{cyc.name} {name}")
         if v is None:

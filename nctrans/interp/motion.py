@@ -169,6 +169,10 @@ class MotionMixin:
             if vals:
                 rigid_tap.rigid_tap_move(self, vals, center, motion)
             return
+        if motion == rigid_tap.INTERPOLATED:
+            if vals:
+                rigid_tap.interpolated_tap_move(self, vals)
+            return
         if motion in ("arc_cw", "arc_ccw"):
             self._arc(vals, center, radius, turns, motion == "arc_cw", aperture)
             return

@@ -69,14 +69,21 @@ class NativeLaneMixin:
         if st.tool is not None:
             tail += f',"tool":{int(st.tool)}'
         write = self.fast_sink == "jsonl"
+        # an open run (its end not found yet): the kernel finds it, holding each line to scan()'s
+        # checks in the front end's static state where the run starts
+        is_open = run.is_open
+        scan_state = ((plainrun.motion_code(run.motion), run.cycle is None, run.arc_abs, run.strict,
+                       run.max_chars) if is_open else None)
         (stop, line, blocks, chunk, records, prog, mach, new_motion, feed, feed_seen,
-         last_from, last_arc, last_g) = self.native.run(
-            run.text, run.start, run.end, run.sep, run.line, axes, list(pos.values()),
+         last_from, last_arc, last_g, ended) = self.native.run(
+            run.text, run.start, len(run.text) if is_open else run.end, run.sep, run.line, axes,
+            list(pos.values()),
             [tot.get(a, 0.0) for a in axes] if tot else None, list(mpos.values()), st.scale,
             st.incremental, motion, st.feed, f',"feed_mode":"{st.feed_mode}"', tail, self._seq,
             _json_str(run.file), budget, write, st.plane, st.arc_absolute,
             arcs.CENTER_TOL_INCH if st.scale != 1.0 else arcs.CENTER_TOL_MM,
-            st.feed_scale)                          # Sinumerik G70: inch lengths, feeds in mm
+            st.feed_scale,                          # Sinumerik G70: inch lengths, feeds in mm
+            scan_state)
         if blocks:
             self.pos = dict(zip(axes, prog))
             self.mpos = dict(zip(axes, mach))
@@ -95,11 +102,13 @@ class NativeLaneMixin:
                     self.out.append(JsonChunk(chunk, records))
                 else:
                     self._seq += records
-        rest = None
-        if blocks < run.blocks:
-            # the front end's static mode where the rest starts: the last G word the kernel ran
-            motion_at, cycle_at = ((plainrun.MOTIONS[last_g], None) if last_g >= 0
-                                   else (run.motion, run.cycle))
-            rest = PlainRun(run.file, run.text, stop, run.end, line, run.sep, run.blocks - blocks,
-                            run.lower, motion_at, cycle_at, run.arc_abs)
-        return blocks, rest
+        # the front end's static mode where the rest starts: the last G word the kernel ran
+        motion_at, cycle_at = ((plainrun.MOTIONS[last_g], None) if last_g >= 0
+                               else (run.motion, run.cycle))
+        if is_open and ended:
+            if run.ends.pos is None:
+                run.ends.found(stop, line, motion_at, cycle_at)
+            return blocks, None
+        if is_open or blocks < run.blocks:
+            return blocks, run.piece(stop, line, motion_at, cycle_at, blocks)
+        return blocks, None

@@ -11,9 +11,23 @@ The toolpath holds them as CYCLE84's tapping does (cycles.tap_steps): linear rec
 pitch, and the spindle direction they need set (and recorded) where it changes: G331 turns it the
 thread's way, G332 the other way, and it stays so until the program says otherwise (M3/M4/M5), as
 a CYCLE84 written with G331/G332 and its SDAC leaves it.
+
+Sinumerik G63, tapping with a compensating chuck (seed L24397: non-modal, group 2, written
+`G63 Z.. G1`): the block's move is a plain feed at F with the feed override held at 100 %; the
+spindle is not synchronised (the chuck takes up the difference between F and lead x S) and turns as
+M3/M4 program it, the retraction being a second G63 block after M4 [GK]. So the analysed path is the
+block's G1 move at F, exactly; only the override, which the toolpath does not model, differs. Under
+G0/G2/G3 the block is not what the seed describes: NC226, and its axis words move nothing.
+
+Fagor G63, interpolated (rigid) tapping (seed L8556-8780, spec 9.8): `G63 Z.. S±n` moves with the
+spindle interpolated, lead = F / S (F per revolution under G95), the spindle turning by the sign of
+S whatever M3/M4 say (the reader writes that direction into the block), modal until M3/M4/M5/M19;
+the retraction is a second G63 with S negative. The records are G331's: linear moves carrying the
+lead as pitch.
 """
 from __future__ import annotations
 
+INTERPOLATED = "tap_interp"         # Fagor G63
 TAP = "tap_rigid"                   # G331
 RETRACT = "tap_rigid_retract"       # G332
 MODES = frozenset((TAP, RETRACT))
@@ -46,3 +60,30 @@ def rigid_tap_move(it, vals, center, motion: str) -> None:
         it.spindle_stopped = False
         it._record("spindle", spindle_dir=turning, spindle=st.spindle_speed)
     it._lead_move(target, abs(lead))
+
+
+def compensating_chuck(it) -> None:
+    """G63 in a Sinumerik block (see the module doc): nothing to change under G1; else NC226."""
+    motion = it.st.motion
+    if motion == "linear":
+        return
+    it.unmodelled_motion = "G63"
+    it._unmodelled_at = it.span
+    it.diag("NC226", "error", f"G63 (tapping with compensating chuck) under {motion or 'no'} motion: "
+            "the control taps with G1 (seed: G63 Z.. G1); its axis words, and those of the blocks "
+            "after it until the next motion code, move nothing in the analysed toolpath")
+
+
+def interpolated_tap_move(it, vals) -> None:
+    """One Fagor G63 block with axis words: the lead is F / S (F itself per revolution)."""
+    st = it.st
+    target = it._target(vals)
+    if not st.spindle_speed or not st.feed:
+        it.diag("NC206", "error", "G63 without a feed F and a spindle speed S: the lead (F / S) is "
+                "unknown, the move is not made")
+        return
+    lead = st.feed if st.feed_mode == "per_rev" else st.feed / st.spindle_speed
+    if st.spindle_dir not in ("cw", "ccw") or it.spindle_stopped:
+        it._record("spindle", spindle_dir=st.spindle_dir or "cw", spindle=st.spindle_speed)
+        it.spindle_stopped = False
+    it._lead_move(target, lead)

@@ -204,6 +204,9 @@ class StatementsMixin:
         self.ev.declare(s)
 
     def _c_passthrough(self, s: n.Passthrough):
+        if s.dialect == "sinumerik" and s.text.upper() == "G63":
+            from nctrans.interp.rigid_tap import compensating_chuck
+            return (compensating_chuck, self)
         if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")) or \
                 s.reason in unmodelled.REPORTED_AS_ERROR:
             return (self._h_known, None)

@@ -21,8 +21,10 @@ Facts [GK] (Siemens 840D/810D turning cycles manual; the seeds do not document C
 - DT is a dwell and DAM a path length for chip breaking while roughing.
 Modelling choices [NC] (the manual leaves them to the control, or nctrans does not model them):
 - the contour must be monotonic in both axes (no undercut): one with undercuts is refused at its
-  line (NC113) and moves nothing; so are FAL (the equidistant allowance), DAM/DT chip breaking,
-  and a contour with fewer than two moves;
+  line (NC113) and moves nothing; so are DAM/DT chip breaking and a contour with fewer than two
+  moves;
+- FAL offsets the contour along its normal (convex corners rounded with radius FAL, as a tool of
+  that radius would run round them); FALX/FALZ then shift it along the axes (the two add up);
 - longitudinal machining steps towards the axis outside, away from it inside; face machining
   steps towards -Z; the passes run from the contour's deep end (the end furthest in the infeed
   direction) towards its other end, whichever way the contour is written;
@@ -38,7 +40,7 @@ import math
 from typing import Optional
 
 from nctrans.interp import turning
-from nctrans.interp.milling_cycles import MAX_PASSES, MillingError
+from nctrans.interp.milling_cycles import MAX_MOVES, MAX_PASSES, MillingError
 
 EPS = 1e-9
 
@@ -150,6 +152,90 @@ def _extreme(start, moves, direction: float, axis: int) -> float:
     return best
 
 
+def _tangent(start, move) -> tuple[float, float]:
+    """Unit direction (d, p) in which `move` leaves `start`."""
+    kind, end, centre, cw = move
+    if kind == "arc" and centre is not None:
+        # in the (p, d) frame an arc runs clockwise when `cw`; its tangent is the radius turned
+        rp, rd = start[1] - centre[1], start[0] - centre[0]
+        tp, td = (rd, -rp) if cw else (-rd, rp)
+    else:
+        tp, td = end[1] - start[1], end[0] - start[0]
+    n = math.hypot(tp, td) or 1.0
+    return td / n, tp / n
+
+
+def equidistant(start, moves, fal: float, sd: float, sp: float):
+    """The contour offset by `fal` along its normal, away from the part (towards -sd): the
+    compensated path of a tool of radius FAL (nctrans.interp.cutter_comp: convex corners get an arc
+    round the corner, concave ones end at the intersection). (start, moves) in (d, p)."""
+    if fal <= EPS:
+        return start, list(moves)
+    from nctrans.interp.cutter_comp import LEFT, RIGHT, CutterCompensator, PlannedMove
+
+    def pt(q):                      # (d, p) -> the plane (X = p, Y = d)
+        return {"X": q[1], "Y": q[0]}
+
+    side = LEFT if sp == -sd else RIGHT     # travelling +sp, the part lies on the sd side
+    comp = CutterCompensator(side, fal, "XY")
+    td, tp = _tangent(start, moves[0])
+    lead = 4 * fal + 1.0                    # an entry move longer than the radius (LinuxCNC's rule)
+    before = (start[0] - lead * td, start[1] - lead * tp)
+    out = comp.push(PlannedMove("linear", pt(before), pt(start)))
+    cur = start
+    for kind, end, centre, cw in moves:
+        if kind == "arc" and centre is not None:
+            out += comp.push(PlannedMove("arc", pt(cur), pt(end), pt(centre), "cw" if cw else "ccw"))
+        else:
+            out += comp.push(PlannedMove("linear", pt(cur), pt(end)))
+        cur = end
+    out += comp.finish()
+    if comp.problems:
+        raise unmodelled(f"with FAL {fal:g} along a contour it cannot follow at that distance "
+                         f"({comp.problems[0][1]}): not modelled")
+    o_start = (out[0].end["Y"], out[0].end["X"])
+    o_moves = []
+    for m in out[1:]:
+        e = (m.end["Y"], m.end["X"])
+        if m.kind == "arc":
+            o_moves.append(("arc", e, (m.center["Y"], m.center["X"]), m.direction == "cw"))
+        else:
+            o_moves.append(("linear", e, None, None))
+    # the filter checks corners locally; a step of the contour smaller than FAL can still bring the
+    # offset closer than FAL: then the allowance is not modelled rather than cut into
+    near = min(_distance(q, _polyline(start, moves)) for q in _polyline(o_start, o_moves, 8))
+    if near < fal - 1e-3 or turning.first_non_monotonic(o_start, o_moves) is not None or \
+            turning.first_non_monotonic((o_start[1], o_start[0]), turning.swapped(o_moves)) is not None:
+        raise unmodelled(f"with FAL {fal:g} larger than a step of the contour: the contour offset by FAL "
+                         "is not modelled there")
+    return o_start, o_moves
+
+
+def _polyline(start, moves, n_line: int = 1) -> list:
+    """Points along the moves: arcs finely sampled, lines split in n_line pieces."""
+    pts = [start]
+    cur = start
+    for kind, end, centre, cw in moves:
+        if kind == "arc" and centre is not None:
+            pts.extend(turning.arc_points(cur, end, centre, cw, 256)[1:])
+        else:
+            pts.extend((cur[0] + (end[0] - cur[0]) * k / n_line, cur[1] + (end[1] - cur[1]) * k / n_line)
+                       for k in range(1, n_line + 1))
+        cur = end
+    return pts
+
+
+def _distance(q, pts) -> float:
+    """Distance from q to the polyline through pts."""
+    best = math.inf
+    for a, b in zip(pts, pts[1:]):
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        L = dx * dx + dy * dy
+        t = 0.0 if L == 0 else max(0.0, min(1.0, ((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / L))
+        best = min(best, math.hypot(q[0] - a[0] - t * dx, q[1] - a[1] - t * dy))
+    return best if len(pts) > 1 else math.hypot(q[0] - pts[0][0], q[1] - pts[0][1])
+
+
 def plan(start, moves, p: dict[str, float], face: bool, inside: bool, what: str):
     """CYCLE95 in (d, p): the contour `start` + `moves` as the subprogram programs it (radius,
     axes already in (d, p) order, allowances not applied). Returns (cycle start point, steps):
@@ -159,9 +245,6 @@ def plan(start, moves, p: dict[str, float], face: bool, inside: bool, what: str)
             raise impossible(f"with {k} not a finite number")
     if len(moves) < 1:
         raise impossible("with a contour of fewer than two points")
-    if abs(p.get("FAL", 0.0)) > EPS:
-        raise unmodelled("with FAL, a finishing allowance along the contour (equidistant): not "
-                         "modelled (FALX/FALZ are)")
     if abs(p.get("DAM", 0.0)) > EPS or abs(p.get("DT", 0.0)) > EPS:
         raise unmodelled("with chip breaking while roughing (DT/DAM): not modelled")
     if turning.first_non_monotonic(start, moves) is not None or \
@@ -179,8 +262,9 @@ def plan(start, moves, p: dict[str, float], face: bool, inside: bool, what: str)
     fal_p = abs(p.get("FALX" if face else "FALZ", 0.0))
     vrt = abs(p.get("VRT", 0.0)) or 1.0
     dd, dp = -sd * fal_d, -sp * fal_p
-    s_start = (start[0] + dd, start[1] + dp)
-    s_moves = turning.shifted(moves, dd, dp)
+    o_start, o_moves = equidistant(start, moves, abs(p.get("FAL", 0.0)), sd, sp)
+    s_start = (o_start[0] + dd, o_start[1] + dp)
+    s_moves = turning.shifted(o_moves, dd, dp)
     top = _extreme(s_start, s_moves, -sd, 0)
     front = _extreme(s_start, s_moves, -sp, 1)
     a = (top - sd * vrt, front - sp * vrt)             # the cycle start point
@@ -208,6 +292,8 @@ def plan(start, moves, p: dict[str, float], face: bool, inside: bool, what: str)
             steps.append(("rapid", (here[0] - sd * vrt, here[1] - sp * vrt), None, None))
             steps.append(("rapid", (here[0] - sd * vrt, a[1]), None, None))
             prev = level
+            if len(steps) > MAX_MOVES:
+                raise impossible(f"with more than {MAX_MOVES} moves (MID too small for the contour)")
         steps.append(("rapid", a, None, None))
     if what in ("finish", "complete"):
         steps.append(("rapid", (start[0], a[1]), None, None))

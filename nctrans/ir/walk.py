@@ -64,8 +64,9 @@ def jump_targets(nodes: Iterable) -> set[str]:
                     out.add(str(s.to_label))
                 elif type(s) is n.SectionRepeat:      # the section runs again from its label
                     out.add(str(s.start))
-                elif type(s) is n.CycleCall and type(s.params.get("npp")) is n.Str:
-                    out.add(s.params["npp"].value.partition(":")[0].strip())   # CYCLE95 "START:END"
+                elif type(s) is n.CycleCall:          # CYCLE95/CYCLE72 contour "START:END"
+                    out.update(v.value.partition(":")[0].strip() for v in s.params.values()
+                               if type(v) is n.Str and ":" in v.value)
         elif t is n.Case:
             out.update(str(label) for _, label in node.branches)
             if node.default is not None:

@@ -115,8 +115,8 @@ def _modal_runs(body: list) -> list[tuple[int, int]]:
 STRETCH_MODES = {
     # Sinumerik G70: lengths in inch, feeds in the basic system (ISO and Fagor inch reads F in inch)
     "units": frozenset(("inch_geometry",)),
-    # Sinumerik G331/G332: every later block with axis words taps or retracts
-    "motion": frozenset(("tap_rigid", "tap_rigid_retract")),
+    # Sinumerik G331/G332, Fagor G63: every later block with axis words taps or retracts
+    "motion": frozenset(("tap_rigid", "tap_rigid_retract", "tap_interp")),
 }
 
 

@@ -187,7 +187,11 @@ class _Walker:
             return
         self.dropped.add(key)
         what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
-        if no_motion_effect(s.reason, self.machine_kind):
+        if s.dialect == "sinumerik" and s.text.upper() == "G63":    # nctrans.interp.rigid_tap
+            self.diags.append(at_span("NC401", "info", "--flatten writes G63 (tapping with a "
+                                      "compensating chuck) as the block's G1 feed move it is; the "
+                                      "feed override hold at 100 % is not written", span))
+        elif no_motion_effect(s.reason, self.machine_kind):
             self.diags.append(at_span("NC401", "info", f"--flatten leaves out {what}: no effect on "
                                       "the motion", span))
         elif _M_FUNCTION.match(s.text):

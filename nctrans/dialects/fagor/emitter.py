@@ -206,6 +206,12 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.radius_index: Any = None
         self.length_on = False
         self.in_sub = False
+        # spindle-synchronised moves ("thread") are written as G63: S and the feed mode they need
+        self.speed: Optional[float] = None            # the last constant S written (rev/min)
+        self.feed_mode = "per_min"
+        self.tap_cancelled = False                    # an M3/M4/M5/M19 ended G63 on the control
+        self.s_negative = False                       # a G63 wrote S negative: positive before M3/M4
+        self.spindle_dir: Optional[str] = None
 
     def lowered(self, what: str, once: Any = None) -> None:
         """Each lowering once per source line."""
@@ -418,7 +424,19 @@ class FagorEmitter(FagorSpelling, Emitter):
         if s.spindle not in (0, 1):
             word("", f"S{s.spindle}={self.expr(s.value)}")
         else:
-            word("S", "S" + val(s.value))
+            self.speed = ir_walk.literal(s.value)
+            self.s_negative = self._tap_block(rest) and self.spindle_dir == "ccw"
+            if self.s_negative:
+                if self.speed is None:
+                    raise NotExpressible("G63 reversed with a computed spindle speed")
+                word("S", "S" + format_number(-abs(self.speed)))
+            else:
+                word("S", "S" + val(s.value))
+
+    def _tap_block(self, rest: list) -> bool:
+        """A Fagor G63 is in force or set later in this block."""
+        return self.motion == "tap_interp" or any(
+            isinstance(x, n.ModeChange) and x.group == "motion" and x.value == "tap_interp" for x in rest)
 
     def w_SpindleLimit(self, s: n.SpindleLimit, word, new_line, rest: list):
         val = self.value
@@ -545,6 +563,17 @@ class FagorEmitter(FagorSpelling, Emitter):
 
     def w_ModeChange(self, s: n.ModeChange, word, new_line, rest: list) -> int:
         g, v = s.group, s.value
+        if g == "spindle":
+            self.spindle_dir = v
+            if s.code == "" and self._tap_block(rest):
+                return 0                             # a Fagor G63's direction: the sign of its S
+            if self.motion == "thread":
+                self.tap_cancelled = True            # Fagor: M3/M4/M5/M19 end G63
+            if self.s_negative and v in ("cw", "ccw") and self.speed is not None:
+                word("S", "S" + format_number(abs(self.speed)))     # negative S only under G63
+                self.s_negative = False
+        if g == "feed_mode":
+            self.feed_mode = v
         if g == "motion":
             if v in ("arc_3point", "arc_tangent"):
                 self.pending_motion = v
@@ -552,7 +581,14 @@ class FagorEmitter(FagorSpelling, Emitter):
             self.pending_motion = None
             if v == self.motion and s.code == "":
                 return 0                 # the front end's restore after a one-shot G08/G09
+            if self.motion == "tap_interp" and v == "rapid" and s.code == "":
+                self.motion = v          # the front end's: M3/M4/M5/M19 ended G63
+                return 0
             self.motion = v
+            if v == "thread":            # spindle-synchronised: G63, its F and S in motion_words
+                self.tap_cancelled = False
+                word("GMOTION", self.code_for("motion", "tap_interp"))
+                return 0
         if g == "distance":
             self.distance = v
         if g == "plane":
@@ -605,10 +641,16 @@ class FagorEmitter(FagorSpelling, Emitter):
             # the first move of a unit: its mode is the power-on default, written out
             self.motion = "rapid"
             word("GMOTION", self.code_for("motion", "rapid"))
+        if self.motion == "thread" and self.tap_cancelled:
+            self.tap_cancelled = False
+            word("GMOTION", self.code_for("motion", "tap_interp"))
         for a, av in s.target.items():
             if av.mode is not None and av.mode != ("abs" if self.distance == "absolute" else "inc"):
                 raise NotExpressible(f"{a} in {av.mode} mode for one word")
             word(a, a + val(av.value))
+        if self.motion == "thread":
+            self._tap_words(s, word)
+            return
         if s.polar:
             if self.distance != "absolute":
                 raise NotExpressible("polar coordinates in incremental mode")
@@ -631,6 +673,21 @@ class FagorEmitter(FagorSpelling, Emitter):
             if s.polar:
                 raise NotExpressible("an arc radius together with polar coordinates")
             word("R", "R" + val(s.radius))
+
+    def _tap_words(self, s: n.Motion, word) -> None:
+        """F and signed S of a spindle-synchronised move written as G63 (seed L8556-8780: lead =
+        F / S, the spindle turning by the sign of S): the lead is the move's I/J/K word."""
+        leads = [ir_walk.literal(av.value) for av in (s.center or {}).values()]
+        lead = next((x for x in leads if x), None)
+        if lead is None or not self.speed or self.feed_mode == "inverse_time":
+            raise NotExpressible("a spindle-synchronised move without a constant lead and spindle speed")
+        self.lowered("tapping and threads written as Fagor G63 (interpolated tapping: lead = F / S, "
+                     "the spindle turning by the sign of S)")
+        feed = abs(lead) if self.feed_mode == "per_rev" else abs(lead) * self.speed
+        word("F", "F" + format_number(round(feed, 6)))
+        negative = self.spindle_dir == "ccw"
+        word("S", "S" + format_number(-self.speed if negative else self.speed))
+        self.s_negative = negative
 
     def _subcall(self, s: n.SubCall, word) -> None:
         if s.args:

@@ -211,6 +211,7 @@ class Lowerer:
         self.file = file
         self.diags: list[Diagnostic] = []
         self.motion = "rapid"            # static modal motion (decides what R means)
+        self.s_negative = False          # the last S was negative: G63 taps counterclockwise
         self.cycle = False               # a Fagor canned cycle is modal
         self.line = 0
         self.col = 1
@@ -441,6 +442,12 @@ class Lowerer:
                 self.note("NC415", "warning", f"M{q_m}{q} addresses another spindle than the first; "
                           "only spindle S/S1 is modelled")
 
+        if motion_g is None and self.motion == "tap_interp" and any(
+                r is not None and r.group == "spindle" for r, _ in w.ms):
+            # M3/M4/M5/M19 cancel G63 (spec 9.8, L8556-8780): back to the power-on motion the
+            # reader assumes at the start of a program
+            motion_g = "rapid"
+            out.append((B_MOTION - 1, ir.ModeChange("motion", "rapid", "")))
         if motion_g is not None:
             self.motion = motion_g
             self.cycle = False
@@ -452,7 +459,20 @@ class Lowerer:
         elif limit and "S" in vals:
             out.append((B_SPEED, ir.SpindleLimit(vals.pop("S"))))
         elif "S" in vals:
-            out.append((B_SPEED, ir.SpindleSpeed(vals.pop("S"))))
+            speed = vals.pop("S")
+            value = ir_walk.literal(speed)
+            if value is not None:
+                self.s_negative = value < 0
+                if self.motion == "tap_interp":
+                    speed = ir.Num(abs(value), format(abs(value), "g"))
+            elif self.motion == "tap_interp":
+                self.note("NC415", "warning", "G63 with a computed S: the sign of S is the spindle "
+                          "direction, read here as the sign of the last constant S")
+            if self.motion == "tap_interp":  # G63: the sign of S turns the spindle, M3/M4 do not
+                out.append((B_SPEED, ir.ModeChange("spindle", "ccw" if self.s_negative else "cw", "")))
+            out.append((B_SPEED, ir.SpindleSpeed(speed)))
+        elif self.motion == "tap_interp":
+            out.append((B_SPEED, ir.ModeChange("spindle", "ccw" if self.s_negative else "cw", "")))
         for name in list(w.numbered):
             if name in ("S1",):
                 out.append((B_SPEED, ir.SpindleSpeed(w.numbered.pop(name))))

@@ -129,6 +129,17 @@ class _Lines(list):
     """Words a statement writes on lines of their own (one list of words per line)."""
 
 
+class NotConvertible(NotExpressible):
+    """A facility of the source control ISO has no counterpart for (text the IR keeps verbatim:
+    synchronized actions, interrupts, cam tables; a system variable with no ISO number). In a
+    subprogram file, which cannot be lowered to plain motion, it is refused at its place only: an
+    alarm stops the ISO control there (NC412) and the rest of the file keeps its structure."""
+
+    def __init__(self, reason: str, construct: str):
+        super().__init__(reason)
+        self.construct = construct
+
+
 class IsoEmitter(IsoSpelling, Emitter):
     """IR -> text for a dialect of the ISO family. dialect: the name of programs (and passthrough
     text) that are already this dialect's own; table: the rules table G/M codes are spelled from.
@@ -159,6 +170,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.sub_numbers: dict[str, int] = {}
         self.arrays: dict[tuple, pl.ArrayPlan] = {}
         self.undeclared: set[str] = set()      # arrays used but not declared (NC410 once each)
+        self.in_place = False                  # a subprogram file: NotConvertible refused in place
         self.strings: dict[int, str] = {}       # string number -> the string argument it stands for
         # (unit, array parameter) -> its dimensions
         self._slot_dims: dict[tuple, list[int]] = {
@@ -166,6 +178,11 @@ class IsoEmitter(IsoSpelling, Emitter):
             for key, sub in program.subprograms.items() for prm in sub.params if prm.dims}
         top_r, dynamic_r = pl.max_r_used(program)
         self.next_array = 900 if dynamic_r else 500 + top_r + 1
+        # undeclared (GUD) arrays indexed at run time: a row-major block each, laid out here
+        self.global_arrays: dict[str, pl.ArrayPlan] = {}
+        self.guards: list[str] = []         # index checks the next line written must run first
+        if program.dialect != self.dialect:
+            self._lay_out_globals(program)
         # plane and three-point mode, for arcs computed from the constant points (self.pos)
         self.plane = "XY"
         self.cip_mode = False
@@ -181,6 +198,49 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.motion_mode: Optional[str] = None
         self.units_mm = True
         self.feed_expr = None
+
+    def _lay_out_globals(self, program: n.Program) -> None:
+        uses = pl.undeclared_arrays(program)
+        declared = sum(math.prod(s.dims) for b in walk.blocks(program.body) for s in b.body
+                       if type(s) is n.VarDecl and s.dims and all(isinstance(d, int) for d in s.dims))
+        declared += sum(math.prod(s.dims) for sub in program.subprograms.values()
+                        for b in walk.blocks(sub.body) for s in b.body
+                        if type(s) is n.VarDecl and s.dims and all(isinstance(d, int) for d in s.dims))
+        reserved = declared + sum(len(u.elements) for u in uses.values() if not u.computed)
+        self.global_arrays = pl.global_layout(uses, self.next_array, reserved)
+        if self.global_arrays:
+            self.next_array = max(a.base + a.size for a in self.global_arrays.values())
+
+    def _global_element(self, key: str, v: n.Var) -> str:
+        """An element of an undeclared array indexed at run time: its place in the array's block
+        (laid out by plan.global_layout), each computed index checked first (alarm when outside)."""
+        arr = self.global_arrays[key]
+        text = self._element(arr, v)
+        for e, dim in zip(v.indices, arr.dims):
+            if constant(e) is None:
+                half = format_number((dim - 1) / 2)
+                guard = (f"IF[ABS[[{self.expr(e)}]-{half}]GT{half}]THEN#3000={pl.ARRAY_INDEX_ALARM}"
+                         f"({key[:20]} INDEX OUT OF RANGE)")
+                if guard not in self.guards:
+                    self.guards.append(guard)
+        if key not in self.undeclared:
+            self.undeclared.add(key)
+            dims = ",".join(map(str, arr.dims))
+            self.diags.append(at_span(
+                "NC410", "warning", f"{v.key} is not declared in the program (a global of the control's "
+                f"definition files) and is indexed at run time: it is laid out row-major as "
+                f"{key}[{dims}] in #{arr.base}..#{arr.base + arr.size - 1} (assumed extents: 1 + the "
+                f"largest constant index, at least {pl.GLOBAL_MIN_EXTENT}, the first dimension sharing "
+                f"out the room left; the table at the top names it); an index outside stops the program "
+                f"with alarm #3000={pl.ARRAY_INDEX_ALARM}, and the values the control kept in the array "
+                "must be loaded there", self._where()))
+        return text
+
+    def _flush_guards(self, prefix: str = "") -> None:
+        """Write the index checks gathered for the line about to be written, before it."""
+        if self.guards:
+            self.out.extend(prefix + g for g in self.guards)
+            self.guards.clear()
 
     def named_var(self, v: n.Var) -> str:
         if v.space == "system":
@@ -198,6 +258,8 @@ class IsoEmitter(IsoSpelling, Emitter):
                 return f"#{local}"
             if plan is not None and key in plan.slots:
                 return self._slot_var(plan, key, v)
+            if v.indices and key in self.global_arrays:
+                return self._global_element(key, v)
             if v.indices:
                 return self._undeclared_element(key, v)
         if v.space == "R" and v.key is None and v.indices and len(v.indices) == 1:
@@ -214,12 +276,12 @@ class IsoEmitter(IsoSpelling, Emitter):
             idx = v.indices[0]
             if len(v.indices) != 1 or type(idx) is not n.Var or idx.space != "name" \
                     or str(idx.key).upper() not in AXES:
-                raise NotExpressible(f"system variable {v.key} with this index")
+                raise NotConvertible(f"system variable {v.key} with this index", f"{v.key}[..]")
             axis = str(idx.key).upper()
         found = system_spelling(self.table_name, str(v.key), axis)
         if found is None or found[1] is not None or not found[0][1:].isdigit():
-            raise NotExpressible(f"system variable {v.key}{f'[{axis}]' if axis else ''} (no ISO "
-                                 "number of the same meaning)")
+            raise NotConvertible(f"system variable {v.key}{f'[{axis}]' if axis else ''} (no ISO "
+                                 "number of the same meaning)", str(v.key))
         self.lowered(f"system variable {v.key}{f'[{axis}]' if axis else ''} written as {found[0]}")
         return found[0]
 
@@ -336,6 +398,7 @@ class IsoEmitter(IsoSpelling, Emitter):
             self.out.append(str(meta["archive_header"]))
         head = self._program_word(p.name, meta.get("program_number"))
         library = self._library_entry()
+        self.in_place = library is not None
         if library is not None:
             # a file that only defines a subprogram (a Sinumerik PROC file) is that subprogram:
             # O<its number>, the body, M99; callers elsewhere call the same number
@@ -388,6 +451,9 @@ class IsoEmitter(IsoSpelling, Emitter):
             where = f" IN {unit}" if unit else ""
             for name, number in plan.locals.items():
                 lines.append(f"(VAR {name}{where} = #{number})")
+        for name, arr in self.global_arrays.items():
+            dims = ",".join(str(d) for d in arr.dims)
+            lines.append(f"(VAR {name}[{dims}] = #{arr.base}..#{arr.base + arr.size - 1} ASSUMED)")
         for (unit, name), arr in self.arrays.items():
             where = f" IN {unit}" if unit else ""
             dims = ",".join(str(d) for d in arr.dims)
@@ -500,6 +566,11 @@ class IsoEmitter(IsoSpelling, Emitter):
                 self.forget()
             try:
                 self.dispatch("s_", node)
+            except NotConvertible as err:
+                if not self.in_place:
+                    self.refuse(str(err))
+                else:
+                    self.out.append(self._refused_in_place(err, type(node).__name__))
             except NotExpressible as err:
                 self.refuse(str(err))
             if structure:
@@ -536,6 +607,13 @@ class IsoEmitter(IsoSpelling, Emitter):
         if b.number is not None:
             prefix += f"N{b.number} "
         lines = self.statements(b.body)
+        if self.guards:
+            # the checks run before the block, after its number (a jump to it runs them too)
+            skip = prefix.split("N")[0]
+            if prefix.strip() != skip.strip():
+                self.out.append(prefix.strip())
+                prefix = skip
+            self._flush_guards(skip)
         comment = b.comment
         if b.label:
             comment = f"LABEL {b.label}" + (f" {comment}" if comment else "")
@@ -563,18 +641,22 @@ class IsoEmitter(IsoSpelling, Emitter):
     def s_If(self, node: n.If) -> None:
         then = node.then
         simple = (not node.orelse and len(then) == 1 and type(then[0]) is n.Block
-                  and then[0].body and all(type(s) is n.Assign for s in then[0].body)
+                  and then[0].body and all(type(s) is n.Assign for s in then[0].body[:-1])
+                  and type(then[0].body[-1]) in (n.Assign, n.Alarm)
                   and then[0].number is None and then[0].comment is None)
         cond = self.cond(node.cond)
         if simple:
             skip = then[0].skip
             prefix = "" if skip is None else ("/" if skip == 0 else f"/{skip}")
-            assigns = "".join(self.assign(s) for s in then[0].body)
+            assigns = "".join(self.assign(s) if type(s) is n.Assign else self.w_Alarm(s)[0][1]
+                              for s in then[0].body)
+            self._flush_guards(prefix)
             self.out.append(f"{prefix}IF[{cond}]THEN{assigns}")
             return
         self.lowered("IF/ELSE block written with IF..GOTO")
         else_label = self.fresh_label()
         end_label = self.fresh_label()
+        self._flush_guards()
         self.out.append(f"IF[[{cond}]EQ0]GOTO{else_label}")
         self.nodes(then)
         self.span = node.span
@@ -590,10 +672,14 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def s_While(self, node: n.While) -> None:
         label = self._loop_label(node.label)
-        self.out.append(f"WHILE[{self.cond(node.cond)}]DO{label}")
+        cond = self.cond(node.cond)
+        checks = list(self.guards)          # run again before each new test of the condition
+        self._flush_guards()
+        self.out.append(f"WHILE[{cond}]DO{label}")
         self.depth += 1
         self.nodes(node.body)
         self.depth -= 1
+        self.out.extend(checks)
         self.out.append(f"END{label}")
 
     def s_Loop(self, node: n.Loop) -> None:
@@ -610,8 +696,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         step = node.step if node.step is not None else n.Num(1.0)
         down = type(step) is n.Num and step.value < 0
         label = self._loop_label(None)
-        self.out.append(f"{var}={self.expr(node.start)}")
-        self.out.append(f"WHILE[{var}{'GE' if down else 'LE'}{self._operand(node.end)}]DO{label}")
+        start = self.expr(node.start)
+        end = self._operand(node.end)
+        self._flush_guards()
+        self.out.append(f"{var}={start}")
+        self.out.append(f"WHILE[{var}{'GE' if down else 'LE'}{end}]DO{label}")
         self.depth += 1
         self.nodes(node.body)
         self.depth -= 1
@@ -624,11 +713,14 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.out.append(f"N{top}")
         self.nodes(node.body)
         self.span = node.span
-        self.out.append(f"IF[[{self.cond(node.cond)}]EQ0]GOTO{top}")
+        cond = self.cond(node.cond)
+        self._flush_guards()
+        self.out.append(f"IF[[{cond}]EQ0]GOTO{top}")
 
     def s_Case(self, node: n.Case) -> None:
         self.lowered("CASE written as IF..GOTO")
         subject = self._operand(node.subject)
+        self._flush_guards()
         for value, label in node.branches:
             self.out.append(f"IF[{subject}EQ{self._operand(value)}]GOTO{self._goto_target(label)}")
         if node.default is not None:
@@ -637,9 +729,25 @@ class IsoEmitter(IsoSpelling, Emitter):
     def _operand(self, e) -> str:
         return self.expr(e, self.syntax.unary["-"].prec)
 
+    def _refused_in_place(self, err: NotConvertible, what: str) -> str:
+        """NC412 and the alarm line that stands for a construct refused at its place."""
+        self.diags.append(at_span(
+            "NC412", "warning", f"{what}: {self.target_text} cannot express {err} (source line "
+            f"{self.span.line if self.span else 1}), and a subprogram file cannot be lowered to plain "
+            f"motion: written as alarm #3000={pl.NOT_CONVERTED_ALARM} at its place, so the control "
+            "stops there until it is ported by hand; the rest keeps its structure", self._where()))
+        self.guards.clear()
+        text = err.construct.replace("(", "[").replace(")", "]")
+        return f"#3000={pl.NOT_CONVERTED_ALARM} ({'NOT CONVERTED: ' + text})"
+
     def cond(self, e) -> str:
         try:
             return self.expr(e)
+        except NotConvertible as err:
+            if self.in_place:
+                raise
+            self.refuse(str(err))
+            return "0EQ1"
         except NotExpressible as err:
             self.refuse(str(err))
             return "0EQ1"
@@ -654,6 +762,11 @@ class IsoEmitter(IsoSpelling, Emitter):
                              "external work offset #5201..")
                 return f"#{number}={self.expr(s.value)}"
             return f"{self.val(s.target)}={self.expr(s.value)}"
+        except NotConvertible as err:
+            if self.in_place:
+                raise
+            self.refuse(str(err))
+            return ""
         except NotExpressible as err:
             self.refuse(str(err))
             return ""
@@ -674,6 +787,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         for s in body:
             try:
                 words = self.dispatch("w_", s)
+            except NotConvertible as err:
+                if not self.in_place:
+                    self.refuse(f"{type(s).__name__}: {err}")
+                    continue
+                words = _Lines([[("#3000", self._refused_in_place(err, type(s).__name__))]])
             except NotExpressible as err:
                 self.refuse(f"{type(s).__name__}: {err}")
                 continue
@@ -749,6 +867,9 @@ class IsoEmitter(IsoSpelling, Emitter):
     def _axes(self, target: dict) -> list:
         words = []
         for k, av in target.items():
+            if k not in AXES or len(k) != 1:
+                # a machine's own axis name (XV, C1): which ISO letter drives it is the machine's
+                raise NotConvertible(f"the axis {k} (ISO axes are the letters {AXES})", f"axis {k}")
             if av.mode not in (None,):
                 raise NotExpressible(f"per-word {av.mode} coordinate on {k}")
             words.append((k, self.addr(k, av.value)))
@@ -1430,7 +1551,16 @@ class IsoEmitter(IsoSpelling, Emitter):
             return self._message_text(e.left) + self._message_text(e.right)
         self.lowered("a value in a message written as the expression that holds it (the comment "
                      "shows no value)")
-        return f"<{self.expr(e)}>"
+        try:
+            return f"<{self.expr(e)}>"
+        except NotExpressible:
+            if type(e) is not n.Var or e.space != "name" or not e.indices:
+                raise
+            # an element of a global array only shown (a text array, never read as a number):
+            # named as the source names it, its indices as ISO expressions
+            self.lowered(f"the message value {e.key}[..] (a global array with no ISO place) named "
+                         "in the comment", once=("message element", str(e.key).upper()))
+            return f"<{e.key}[{','.join(self.expr(i) for i in e.indices)}]>"
 
     def w_Alarm(self, s):
         self.lowered("alarm written as #3000")
@@ -1504,7 +1634,7 @@ class IsoEmitter(IsoSpelling, Emitter):
                 self.lowered(f"{s.dialect} {s.reason} {s.text.strip()!r} kept as a comment (no effect on "
                              "the path)")
                 return [("", self._comment(s.text.strip()))]
-            raise NotExpressible(f"{s.dialect} text {s.text!r}")
+            raise NotConvertible(f"{s.dialect} text {s.text!r}", s.text.strip())
         return [("", s.text)]
 
     def w_DataSetting(self, s: n.DataSetting):

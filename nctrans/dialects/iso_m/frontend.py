@@ -1046,16 +1046,18 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
             yield from main
             main.clear()
         if plain_scan is not None and cur is main:
-            end, nlines, nblocks, motion = plain_scan(text, lines.start, sep,
-                                                      plainrun.motion_code(low.motion),
-                                                      low.cycle is None, low.arc_abs, False, max_block)
-            if nblocks >= PLAIN_RUN_MIN:
-                cur.append(plainrun.PlainRun(file, text, lines.start, end, lineno, sep, nblocks,
-                                             plain_line, low.motion, low.cycle, low.arc_abs))
-                lines.skip_to(end, nlines)
-                if motion >= 0:
-                    low.motion = PLAIN_MOTIONS[motion]
-                    low.cycle = None
+            # A run starts here when its first PLAIN_RUN_MIN lines are plain. Where it ends the
+            # kernel finds as it runs it (one pass over the lines), before the body is iterated
+            # on; else extent() finds it with scan().
+            if plain_scan(text, lines.start, sep, plainrun.motion_code(low.motion), low.cycle is None,
+                          low.arc_abs, False, max_block, PLAIN_RUN_MIN)[2] >= PLAIN_RUN_MIN:
+                run = plainrun.PlainRun.open(file, text, lines.start, lineno, sep, plain_line, low.motion,
+                                             low.cycle, low.arc_abs, False, max_block)
+                main_seen = True
+                yield run
+                ends = run.extent()
+                lines.skip_to(ends.pos, ends.line - lineno)
+                low.motion, low.cycle = ends.motion, ends.cycle
                 seen_block = True
                 continue
         # Hot path: a comment-free line of plain axis words (most of CAM output).
@@ -1205,6 +1207,10 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 cur.append(_passthrough_block(raw, span, skip, unknown, low, lineno))
                 comment = None
                 continue
+            for it in structure:
+                if it[0] == "IFTHEN" and comment and any(_is_alarm(a[1]) for a in it[2]):
+                    it[2].append(("comment", comment))      # IF[..]THEN#3000=n (MESSAGE)
+                    comment = None
             if body or number is not None or comment is not None or not structure:
                 for st in body:
                     if type(st) is Alarm and st.text is None and comment:
@@ -1215,7 +1221,10 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
             for it in structure:
                 tag = it[0]
                 if tag == "IFTHEN":
-                    then = [Assign(a[1], a[2]) for a in it[2]]
+                    # #3000=n after THEN raises the alarm as it does alone on a line
+                    message = next((Str(a[1]) for a in it[2] if a[0] == "comment"), None)
+                    then = [Alarm(a[2], message) if _is_alarm(a[1]) else Assign(a[1], a[2])
+                            for a in it[2] if a[0] != "comment"]
                     cur.append(If(span, it[1], [Block(span, then, skip=skip)]))
                 elif tag in ("WHILE", "DO"):
                     node = While(span, it[1], [], it[2]) if tag == "WHILE" else Loop(span, [])
@@ -1272,6 +1281,11 @@ def _unknown_g(low: Lowering, code: str) -> Optional[str]:
         if low.code("G", m.group(1)) is None:
             return "G" + m.group(1)
     return None
+
+
+def _is_alarm(target) -> bool:
+    """An assignment to #3000 (Fanuc macro B: raise alarm n)."""
+    return type(target) is Var and target.space == "num" and target.key == ALARM_VARIABLE
 
 
 def _passthrough_block(raw: str, span: Span, skip, unknown: Optional[str], low: Lowering,

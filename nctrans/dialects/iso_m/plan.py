@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import Iterator, Optional
 
 from nctrans import calls
 from nctrans.ir import nodes as n
-from nctrans.ir.walk import blocks, walk
+from nctrans.ir.walk import blocks, constant, walk
 
 # G65 Type I letters for PROC parameters in order, and the local each one lands in (spec §1.8.1).
 # I/J/K are left out (their Type II repetition makes the order ambiguous), G L N O P are not arguments.
@@ -95,52 +95,122 @@ def circle_through(p1, p2, p3) -> Optional[tuple[float, float, bool]]:
     return cx, cy, cw
 
 
-def max_r_used(program: n.Program) -> tuple[int, bool]:
-    """Highest constant R number the program uses, and whether any R is indexed by an expression."""
-    top, dynamic = -1, False
+def program_vars(program: n.Program, skip: tuple = ()) -> Iterator[n.Var]:
+    """Every variable reference of the program's expressions (index expressions included), in
+    the main program and its subprograms; statements of the types in `skip` are not read."""
+    stack: list = []
 
     def expr(e):
-        nonlocal top, dynamic
-        if e is None:
-            return
-        if type(e) is n.Var:
-            if e.space == "R":
-                if isinstance(e.key, int):
-                    top = max(top, e.key)
-                else:
-                    dynamic = True
-            for i in e.indices or ():
-                expr(i)
-        elif type(e) is n.Binary:
-            expr(e.left)
-            expr(e.right)
-        elif type(e) is n.Unary:
-            expr(e.operand)
-        elif type(e) is n.Func:
-            for a in e.args:
-                expr(a)
-        elif type(e) is n.AxisValue:
-            expr(e.value)
-        elif isinstance(e, dict):
-            for v in e.values():
-                expr(v)
-        elif isinstance(e, list):
-            for v in e:
-                expr(v)
-        elif hasattr(e, "__slots__") and not isinstance(e, (n.Num, n.Str)):
-            for f in e.__slots__:
-                expr(getattr(e, f, None))
+        stack.append(e)
+        while stack:
+            e = stack.pop()
+            if e is None or isinstance(e, (n.Num, n.Str, str, int, float, bool)):
+                continue
+            t = type(e)
+            if t is n.Var:
+                yield e
+                stack.extend(e.indices or ())
+            elif t is n.Binary:
+                stack.extend((e.left, e.right))
+            elif t is n.Unary:
+                stack.append(e.operand)
+            elif t is n.Func:
+                stack.extend(e.args)
+            elif t is n.AxisValue:
+                stack.append(e.value)
+            elif isinstance(e, dict):
+                stack.extend(e.values())
+            elif isinstance(e, (list, tuple)):
+                stack.extend(e)
+            elif hasattr(e, "__slots__"):
+                stack.extend(getattr(e, f, None) for f in e.__slots__)
 
-    units = [program.body] + [s.body for s in program.subprograms.values()]
-    for body in units:
+    for body in [program.body] + [s.body for s in program.subprograms.values()]:
         for node in walk(body):
             if type(node) is n.Block:
                 for s in node.body:
-                    expr(s)
+                    if not isinstance(s, skip):
+                        yield from expr(s)
             else:
                 for attr in ("cond", "subject", "start", "end", "step", "var"):
-                    expr(getattr(node, attr, None))
+                    yield from expr(getattr(node, attr, None))
+
+
+def max_r_used(program: n.Program) -> tuple[int, bool]:
+    """Highest constant R number the program uses, and whether any R is indexed by an expression."""
+    top, dynamic = -1, False
+    for v in program_vars(program):
+        if v.space == "R":
+            if isinstance(v.key, int):
+                top = max(top, v.key)
+            else:
+                dynamic = True
     return top, dynamic
+
+
+@dataclass
+class GlobalArrayUse:
+    """How a program uses an array it does not declare (a GUD of the control's definition files):
+    per dimension the largest constant index, and whether any index is computed at run time."""
+    highest: list[int]
+    computed: bool = False
+    elements: set = field(default_factory=set)      # the constant index tuples used
+
+
+def undeclared_arrays(program: n.Program) -> dict[str, GlobalArrayUse]:
+    """Arrays the program indexes but declares nowhere (no DEF, no parameter), by upper-case name.
+    Values shown in messages are left out: a message is written as a comment, its values unread."""
+    declared = {p.name.upper() for s in program.subprograms.values() for p in s.params}
+    for b in blocks(program.body):
+        declared.update(s.name.upper() for s in b.body if type(s) is n.VarDecl)
+    for sub in program.subprograms.values():
+        for b in blocks(sub.body):
+            declared.update(s.name.upper() for s in b.body if type(s) is n.VarDecl)
+    uses: dict[str, GlobalArrayUse] = {}
+    for v in program_vars(program, skip=(n.Message,)):
+        if v.space != "name" or not v.indices or str(v.key).upper() in declared:
+            continue
+        use = uses.setdefault(str(v.key).upper(), GlobalArrayUse([-1] * len(v.indices)))
+        if len(use.highest) != len(v.indices):
+            use.computed = True           # used with different ranks: laid out never (refused)
+            continue
+        consts = [constant(e) for e in v.indices]
+        for i, c in enumerate(consts):
+            if c is None or c != int(c) or c < 0:
+                use.computed = True
+            else:
+                use.highest[i] = max(use.highest[i], int(c))
+        if all(c is not None for c in consts):
+            use.elements.add(tuple(consts))
+    return uses
+
+
+# Layout of a global array indexed at run time: each dimension after the first spans 1 + its largest
+# constant index, at least this; the first takes an equal share of the room left (at most
+# GLOBAL_MAX_ROWS rows). Documented in NC410; an index outside raises ARRAY_INDEX_ALARM.
+GLOBAL_MIN_EXTENT = 8
+GLOBAL_MAX_ROWS = 100
+ARRAY_INDEX_ALARM = 101
+NOT_CONVERTED_ALARM = 102
+
+
+def global_layout(uses: dict[str, GlobalArrayUse], first: int, reserved: int) -> dict[str, ArrayPlan]:
+    """Row-major blocks from common variable `first` up for the undeclared arrays indexed at run
+    time, leaving `reserved` variables free for the rest; {} when they do not fit."""
+    computed = {k: u for k, u in sorted(uses.items()) if u.computed}
+    if not computed:
+        return {}
+    tails = {k: [max(h + 1, GLOBAL_MIN_EXTENT) for h in u.highest[1:]] for k, u in computed.items()}
+    row = sum(math.prod(t) for t in tails.values())
+    room = COMMON_END + 1 - first - reserved
+    rows = min(GLOBAL_MAX_ROWS, room // row if row else 0)
+    if rows < max(u.highest[0] + 1 for u in computed.values()) or rows < 1:
+        return {}
+    plans, base = {}, first
+    for k, tail in tails.items():
+        plans[k] = ArrayPlan(base, [rows, *tail])
+        base += plans[k].size
+    return plans
 
 
 def unit_plan(sub: Optional[n.Subprogram], body, fresh_number) -> UnitPlan:

@@ -1047,14 +1047,16 @@ class _FileParse:
                 continue
             if scan is not None and len(units) == 1 and not unit.stack and unit.proc is None \
                     and iso_lines is None and section is None and not macros:
-                run_end, nlines, nblocks, last = scan(text, start, "\n", plainrun.motion_code(motion),
-                                                      True, False, True, max_block)
-                if nblocks >= PLAIN_RUN_MIN:
-                    main.append(plainrun.PlainRun(file, text, start, run_end, n, "\n", nblocks, plain_line,
-                                                  motion, None, False))
-                    pos, n = run_end, n + nlines - 1
-                    if last >= 0:
-                        motion = plainrun.MOTIONS[last]
+                # a run starts here when its first PLAIN_RUN_MIN lines are plain; where it ends
+                # the kernel finds as it runs it (one pass), else extent() with scan()
+                if scan(text, start, "\n", plainrun.motion_code(motion), True, False, True, max_block,
+                        PLAIN_RUN_MIN)[2] >= PLAIN_RUN_MIN:
+                    run = plainrun.PlainRun.open(file, text, start, n, "\n", plain_line, motion, None, False,
+                                                 True, max_block)
+                    yield run
+                    ends = run.extent()
+                    pos, n = ends.pos, ends.line - 1
+                    motion = ends.motion
                     seen_code = True
                     continue
             if not raw.strip():
