@@ -196,6 +196,7 @@ def stream_chunks(body, size: int = STREAM_CHUNK):
             while run is not None:
                 blocks, run = run.take(size - len(batch))
                 batch.extend(blocks)
+                del blocks          # not held while the next batch is taken
                 if len(batch) >= size:
                     yield batch
                     batch = []
