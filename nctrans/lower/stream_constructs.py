@@ -333,14 +333,15 @@ def convert_constructs_stream(reparse: Callable[[], Optional[n.Program]], target
         return Conversion("", others + notes)
     reset()
     return _whole_stream(reparse, target, write, reset, machine, resolver,
-                         [_whole_note(d, target) for d in remaining], others + notes + remaining)
+                         [_whole_note(d, target) for d in remaining], others + notes, remaining)
 
 
 def _whole_stream(reparse, target, write, reset, machine, resolver, whole_notes: list[Diagnostic],
-                  refusal: list[Diagnostic]) -> Optional[Conversion]:
+                  before: list[Diagnostic], remaining: list[Diagnostic]) -> Optional[Conversion]:
     """convert()'s last resort, streamed: the whole program lowered to plain motion, written as it
-    runs (stopping at the first thing that makes it incomplete); `refusal` when that fails too."""
-    from nctrans.convert import convert_flat_stream
+    runs (stopping at the first thing that makes it incomplete); when that fails too, refused with
+    `before` and the `remaining` refusals."""
+    from nctrans.convert import convert_flat_stream, whole_failure
     from nctrans.lower.flatten import flatten_blocks, flattened_meta
     program = reparse()
     if program is None:
@@ -356,5 +357,5 @@ def _whole_stream(reparse, target, write, reset, machine, resolver, whole_notes:
         return None
     if done.text is None:
         reset()
-        return Conversion(None, refusal)
+        return Conversion(None, before + whole_failure(remaining, done.diagnostics))
     return Conversion(done.text, [*whole_notes, *done.diagnostics], flattened=True)
