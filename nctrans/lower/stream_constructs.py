@@ -278,6 +278,11 @@ class _StreamedLowering:
             notes.extend(lowered_notes(seg, target_name, first, last))
         return notes, remaining
 
+    def refused_lines(self) -> list[tuple[int, int]]:
+        """(first, last) source lines of each segment that cannot be lowered on its own."""
+        return [(scan.first_line, scan.last_line) for seg, scan in zip(self.segments, self.scans)
+                if seg.why_not is not None and scan.first_line is not None]
+
     def close(self) -> None:
         self.records.close()
 
@@ -327,8 +332,12 @@ def convert_constructs_stream(reparse: Callable[[], Optional[n.Program]], target
         return None
     notes, remaining = lowering.outcome(target.name)
     if again is not None:
+        # a refused segment was written as plain motion all the same (its verdict came at its
+        # end): what the target refuses in that motion is moot, convert emits the segment as it was
+        moot = lowering.refused_lines()
         kept = {(d.file, d.line) for d in remaining}
-        remaining += [d for d in again if _is_refusal(d) and (d.file, d.line) not in kept]
+        remaining += [d for d in again if _is_refusal(d) and (d.file, d.line) not in kept
+                      and not any(a <= d.line <= b for a, b in moot)]
     if not remaining:
         return Conversion("", others + notes)
     reset()
