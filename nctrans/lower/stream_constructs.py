@@ -77,8 +77,13 @@ class _Survey:
     outside: list[Diagnostic]               # refusals at no node of the main body
 
 
+# Statements that name other blocks (jumps, calls, section repetitions): the streaming emitters
+# refuse them, so a program holding one was never surveyed; checked all the same.
+_NAMING = (n.Goto, n.SubCall, n.Return, n.SectionRepeat)
+
+
 def _straight(node) -> n.Block:
-    if type(node) is not n.Block or node.label:
+    if type(node) is not n.Block or node.label or any(type(s) in _NAMING for s in node.body):
         raise _NotStraight(f"{type(node).__name__} at line {node.span.line}")
     return node
 
