@@ -35,12 +35,15 @@ bench: $(STAMP)
 	$(BIN)/python bench/bench_structure.py
 
 # FUZZ_SECONDS: coverage-guided (atheris) time per front end; crashes are kept as regression cases
-# under tests/data/fuzz-crashes (run by tests/test_fuzz_crashes.py in `make test`).
+# under tests/data/fuzz-crashes (run by tests/test_fuzz_crashes.py in `make test`). FUZZ_EXAMPLES:
+# examples of each long property run (tests/fuzz) after it. Exit 1 when a crash was kept.
 FUZZ_SECONDS ?= 120
+FUZZ_EXAMPLES ?= 20000
 fuzz: $(STAMP)
 	$(BIN)/pip install --quiet -e '.[fuzz]'
-	$(BIN)/python fuzz/fuzz_frontends.py $(FUZZ_SECONDS)
-	NCTRANS_FUZZ_PROFILE_SET=1 $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 tests/fuzz --hypothesis-profile=fuzz
+	status=0; $(BIN)/python fuzz/fuzz_frontends.py $(FUZZ_SECONDS) || status=$$?; \
+	NCTRANS_FUZZ_PROFILE_SET=1 NCTRANS_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 tests/fuzz --hypothesis-profile=fuzz || status=$$?; \
+	exit $$status
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -29,7 +29,7 @@ RUNS_PER_DIALECT = 5        # fuzzing restarts after each crash kept, at most th
 # forever runs 2 M steps four times over (minutes), and a seed with a real 100k-move loop
 # (dubovikov-konus.mpf) took 3.5 min per input. Smaller budgets give the same stops sooner;
 # tests/test_hostile*.py hold the defaults to their bounds.
-FUZZ_LIMITS = {"NCTRANS_MAX_STEPS": "5000", "NCTRANS_MAX_LOWERED_BLOCKS": "5000"}
+FUZZ_LIMITS = {"NCTRANS_MAX_STEPS": "5000", "NCTRANS_MAX_LOWERED_BLOCKS": "5000", "NCTRANS_MAX_UNROLLED": "5000"}
 
 
 @contextlib.contextmanager
@@ -67,7 +67,12 @@ def _run_all(dialect: str, data: bytes) -> None:
 
 
 def fuzz(dialect: str) -> None:
-    import atheris
+    try:
+        import atheris
+    except ImportError:
+        sys.exit("atheris is not installed: `pip install -e '.[fuzz]'` installs its wheel (Linux "
+                 "x86_64/aarch64, CPython 3.8-3.12); elsewhere pip builds it from source, which needs "
+                 "clang with libFuzzer (Debian: apt-get install clang libfuzzer-dev; CLANG_BIN=clang)")
     with atheris.instrument_imports():
         import nctrans.api  # noqa: F401  (instrumented: coverage guides the mutations)
         import nctrans.interp.interpreter  # noqa: F401

@@ -240,7 +240,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
             if flatten:
                 streamed = _transpile_flat_stream(ld, target, strict, out, _machine(machine, ld.dialect))
             else:
-                streamed = _transpile_stream(ld, target, strict, out)
+                streamed = _transpile_stream(ld, target, strict, out, machine)
             if streamed is not None:
                 _raise_on_errors(streamed.diagnostics, error_level)
                 return streamed
@@ -343,10 +343,11 @@ def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: 
     return Conversion(result.text, diags, ld.dialect or "", target.name)
 
 
-def _transpile_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any) -> Optional[Conversion]:
+def _transpile_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any,
+                      machine: MachineLike = None) -> Optional[Conversion]:
     """A streamed parse converted as it is read (convert_stream), or None when the whole program
-    must be converted instead (the target does not stream, or a construct it refused may still be
-    lowered to plain motion)."""
+    must be converted instead (the target does not stream, or the program holds structure). The
+    constructs the target refused are lowered to plain motion streamed too (stream_constructs)."""
     from nctrans.convert import convert_stream
     if ld.program is None:
         return None
@@ -356,10 +357,29 @@ def _transpile_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any) 
     pipeline.finish_stream(ld)
     diags = ld.diagnostics
     if result.retry_whole and not any(d.severity == "error" for d in diags):
-        return None
+        result = _lower_constructs_stream(ld, target, result.diagnostics, out, machine)
+        if result is None:
+            return None
     diags.extend(result.diagnostics)
     text = None if result.text is None or any(d.severity == "error" for d in diags) else ""
     return Conversion(text, diags, ld.dialect or "", target.name)
+
+
+def _lower_constructs_stream(ld: pipeline.Loaded, target: Any, found: list[Diagnostic], out: Any,
+                             machine: MachineLike) -> Any:
+    """The constructs of a streamed program the target refused (`found`), lowered to plain motion
+    and written as the program is read again (nctrans.lower.stream_constructs); None when the
+    whole program must be converted instead."""
+    from nctrans.lower.stream_constructs import convert_constructs_stream
+    dialect = pipeline.get_dialect(ld.dialect or "")
+
+    def reparse() -> Optional[Program]:
+        parsed = dialect.parse_stream(ld.source.text, ld.label)
+        return parsed.program if parsed is not None else None
+
+    return convert_constructs_stream(reparse, target, found, out.write, out.reset,
+                                     machine=_machine(machine, ld.dialect),
+                                     resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
 
 
 # --------------------------------------------------------------------------- toolpath

@@ -81,6 +81,16 @@ def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list
     return again, found
 
 
+def whole_failure(refusals: list[Diagnostic], whole: list[Diagnostic]) -> list[Diagnostic]:
+    """The refusals, saying why lowering the whole program failed too when a budget stopped it
+    (`whole`: that lowering's diagnostics): an endless loop is named at its line."""
+    stop = next((d for d in whole if d.rule == "NC205" and d.severity == "error"), None)
+    if stop is None:
+        return refusals
+    why = f"lowering the whole program instead stops at line {stop.line}: {stop.message}"
+    return [dataclasses.replace(d, message=f"{d.message}; {why}") for d in refusals]
+
+
 def _whole_note(refusal: Diagnostic, target: Dialect) -> Diagnostic:
     """The NC401 that says a refusal made the whole program plain motion."""
     d = refusal
@@ -156,6 +166,8 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
             if remaining and not too_large and stream_whole is not None else None
         if streamed is not None and streamed.text is not None:
             return streamed
+        if streamed is not None:
+            remaining = whole_failure(remaining, streamed.diagnostics)
         whole = _lower_whole(program, target, flatten_with, remaining) \
             if remaining and not too_large and streamed is None else None
         if whole is not None and whole[0] is None and whole[1]:
@@ -196,6 +208,7 @@ def stream_chunks(body, size: int = STREAM_CHUNK):
             while run is not None:
                 blocks, run = run.take(size - len(batch))
                 batch.extend(blocks)
+                del blocks          # not held while the next batch is taken
                 if len(batch) >= size:
                     yield batch
                     batch = []

@@ -45,6 +45,12 @@ MAX_STEPS = 2_000_000
 # refused (NC402 at its line) and `convert --flatten` streams the whole program instead (~1 KiB of
 # IR per block: 100,000 blocks ~ 100 MiB). NCTRANS_MAX_LOWERED_BLOCKS overrides it.
 MAX_LOWERED_BLOCKS = 100_000
+# Moves a lowering to plain motion (--flatten, or a conversion's last resort) writes from repeated
+# execution: what its loops and calls unroll into. A cycle inside a loop writes tens of moves per
+# step, so the step budget alone let an endless loop write for minutes (24 M moves at 2 M steps);
+# past this budget the run stops with NC205 at the loop (the lowering is then refused, NC402), in
+# ~10 s. Straight-line blocks and a subprogram's first run are free. NCTRANS_MAX_UNROLLED overrides it.
+MAX_UNROLLED = 500_000
 # Moves one backplot draws: a scene holds each move it draws (~1 KiB with its record), so an endless
 # loop (2 M steps of a drilling cycle: 24 M moves) would need gigabytes. Past it the plot shows the
 # first moves, says so in the plot, and NC011 names the line of the first move left out; the run

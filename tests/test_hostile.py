@@ -374,6 +374,44 @@ def test_the_whole_program_fallback_of_an_endless_loop_streams_to_the_step_budge
     assert not (tmp_path / "e.out").exists()
 
 
+@pytest.mark.parametrize("flatten", [True, False])
+def test_lowering_an_endless_loop_stops_at_the_unrolled_budget(tmp_path, flatten):
+    """--flatten of an endless loop around a cycle, and the whole-program fallback of one that
+    cannot be lowered alone (it sets #1, which the rest reads): each cycle writes ~12 moves per
+    step, so the step budget let them write 24 M moves (> 200 s). The budget of moves written by
+    repeated execution stops the run at the cycle's line and nothing is written (a tenth of the
+    default budget: the same stop, sooner; the default takes ~10 s of CPU)."""
+    text = ENDLESS_AROUND_A_CYCLE.format(cycle="G73")
+    if not flatten:
+        text = text.replace("G80\n", "G80\n#1=#1+1\n").replace("END1\n", "END1\nG0 X#1\n")
+    f = write(tmp_path, "e.nc", text)
+    rc, out, err = run("convert", f.name, "--from", "iso-m", "--to", "sinumerik", "-o", "e.out",
+                       *(["--flatten"] if flatten else []), cwd=tmp_path,
+                       env={"NCTRANS_MAX_UNROLLED": "50000"})
+    assert rc == 1 and located(err, "NC402", "e.nc", 7, 1), err
+    assert "50,000 moves written by repeated execution" in err and "NCTRANS_MAX_UNROLLED" in err
+    assert not (tmp_path / "e.out").exists()
+
+
+def test_the_unrolled_budget_counts_repeated_execution_only(tmp_path):
+    """A straight program's cycles and a loop's first pass are free; the loop's later passes count
+    every move they write: per pass G0 Z5 and 4 holes of G81 (rapid over the hole, rapid to R,
+    feed to Z, rapid back to the initial Z5) = 17 moves, so the two repeated passes write 34; with
+    33 the third pass stops at its fourth hole (X4, line 8)."""
+    holes = "G0 Z5\nG81 X1 Y1 Z-2 R1 F100\nX2\nX3\nX4\nG80\n"
+    straight = write(tmp_path, "s.nc", "G21 G90 G17\n" + holes * 10 + "M30\n")
+    rc, _, err = run("convert", straight.name, "--from", "iso-m", "--to", "iso-m", "--flatten", "-o", "s.out",
+                     cwd=tmp_path, env={"NCTRANS_MAX_UNROLLED": "20"})
+    assert rc == 0 and "NC205" not in err, err
+    looped = write(tmp_path, "l.nc", "G21 G90 G17\n#1=0\nWHILE[#1LT3]DO1\n" + holes + "#1=#1+1\nEND1\nM30\n")
+    for budget, ok in (("34", True), ("33", False)):
+        rc, _, err = run("convert", looped.name, "--from", "iso-m", "--to", "iso-m", "--flatten", "-o", "l.out",
+                         cwd=tmp_path, env={"NCTRANS_MAX_UNROLLED": budget})
+        assert (rc == 0) == ok, err
+        if not ok:
+            assert located(err, "NC205", "l.nc", 8) and located(err, "NC402", "l.nc", 8), err
+
+
 def test_long_straight_program_gives_all_its_moves_and_converts_streamed(tmp_path):
     """3 M straight blocks: every move comes out (the step budget counts repetition only), and the
     streamed conversion gives the text the whole-program conversion gives."""

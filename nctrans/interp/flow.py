@@ -233,6 +233,12 @@ class FlowMixin:
         pc = sidx = 0
         steps = 0
         max_steps = self.max_steps
+        # Records written by repeated execution for a flatten hook (what a lowering to plain
+        # motion unrolls a loop into): a cycle repeated by a loop writes tens of blocks per step,
+        # so the step budget alone would let an endless loop write for minutes.
+        unrolled = 0
+        max_unrolled = self.max_unrolled if self.hook is not None else None
+        repeated = False
         out = self.out
         self._seq = 0
         diag = self.diag
@@ -265,8 +271,9 @@ class FlowMixin:
                 # PlainRun of them, which only a streamed main body holds) running the first
                 # time: a 30 M-block CAM program runs to its end, an endless loop stops.
                 # Running out is an error: the analysis is incomplete.
-                if (op != BLOCK and op != PLAIN
-                        or op == BLOCK and (ins[1] is not None or unit.seen[pc])):
+                repeated = (op != BLOCK and op != PLAIN
+                            or op == BLOCK and (ins[1] is not None or unit.seen[pc]))
+                if repeated:
                     steps += 1
                     if steps > max_steps:
                         sp = ins[3]
@@ -352,6 +359,15 @@ class FlowMixin:
                         unit, code, pc, sidx = self._control(("goto", target, "forward"),
                                                              unit, pc - 1, 0)
                 if out:
+                    if repeated and max_unrolled is not None:
+                        unrolled += len(out)
+                        if unrolled > max_unrolled:
+                            out.clear()
+                            diag("NC205", "error", f"analysis truncated at line {self.span.line}: "
+                                 f"budget of {max_unrolled:,} moves written by repeated execution "
+                                 "(loop iterations, calls) when lowering to plain motion exhausted "
+                                 "(NCTRANS_MAX_UNROLLED; an endless loop?)", self.span)
+                            break
                     yield from self._release(out)
         except _Stop:
             pass

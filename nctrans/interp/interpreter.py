@@ -107,6 +107,10 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.resolver = resolver
         self.max_steps = max_steps
         self.hook = flatten_hook
+        self.max_unrolled: Optional[int] = None
+        if flatten_hook is not None:
+            from nctrans import limits
+            self.max_unrolled = limits.setting("MAX_UNROLLED", limits.MAX_UNROLLED)
         # "jsonl": the consumer takes JsonChunk items (already written records) among the records;
         # "discard": it drops records unseen (lint). Either lets the native kernel run PlainRuns.
         self.native = plainrun.native       # read per run: tests switch the kernel off

@@ -60,6 +60,7 @@ class Segment:
     end_state: Optional[dict] = None
     notes: list[Diagnostic] = field(default_factory=list)    # what plain motion leaves out (NC401/NC403)
     diag_mark: int = 0                  # interpreter diagnostics before it started
+    first_span: Optional[n.Span] = None  # the span its plain motion's first block takes
 
 
 def _line_index(body: list, file: str) -> dict[int, int]:
@@ -73,39 +74,56 @@ def _line_index(body: list, file: str) -> dict[int, int]:
     return index
 
 
-def _modal_runs(body: list) -> list[tuple[int, int]]:
+class _ModalRuns:
     """(first, last) top-level indices of each modal cycle or modal call run: from the block that
     selects it to the block that cancels it (the end of the body when nothing does). An ISO canned
     cycle ends at G80 or a motion code of group 01; a modal call (G66, MCALL) at its cancel only; a
-    programmable frame or G92 shift at a frame cancel (the run's end checks the frame is gone)."""
-    runs = []
-    start: Optional[int] = None
-    kind = ""
-    for i, node in enumerate(body):
+    programmable frame or G92 shift at a frame cancel (the run's end checks the frame is gone).
+    Fed one node at a time, so a streamed body is scanned as it is parsed; `closed(first, last)`
+    is called for each run as it ends."""
+
+    def __init__(self, closed: Callable[[int, int], None]):
+        self.closed = closed
+        self.start: Optional[int] = None
+        self.kind = ""
+
+    def feed(self, i: int, node) -> None:
         if type(node) is not n.Block:
-            continue
+            return
         for s in node.body:
             t = type(s)
             if t is n.ModeChange and s.group == "cycle" and s.value != "off":
-                if start is None:
-                    start, kind = i, "cycle"
+                if self.start is None:
+                    self.start, self.kind = i, "cycle"
             elif (t is n.CycleCall and s.modal) or (t is n.SubCall and s.modal != "none"):
-                if start is None:
-                    start, kind = i, "call"
+                if self.start is None:
+                    self.start, self.kind = i, "call"
             elif (t is n.FrameOp and not s.clear) or t is n.SetPosition:
-                if start is None:
-                    start, kind = i, "frame"
-            elif start is not None and kind == "frame" and (
+                if self.start is None:
+                    self.start, self.kind = i, "frame"
+            elif self.start is not None and self.kind == "frame" and (
                     (t is n.FrameOp and s.clear) or t is n.ResetSetPosition):
-                runs.append((start, i))
-                start = None
-            elif start is not None and (
-                    (kind == "cycle" and t is n.ModeChange and (s.group == "motion" or s.group == "cycle"))
-                    or (kind == "call" and t is n.ModalCallOff)):
-                runs.append((start, i))
-                start = None
-    if start is not None:
-        runs.append((start, len(body) - 1))
+                self.closed(self.start, i)
+                self.start = None
+            elif self.start is not None and (
+                    (self.kind == "cycle" and t is n.ModeChange and (s.group == "motion" or s.group == "cycle"))
+                    or (self.kind == "call" and t is n.ModalCallOff)):
+                self.closed(self.start, i)
+                self.start = None
+
+    def end(self, last: int) -> None:
+        """The body ended at index `last`."""
+        if self.start is not None:
+            self.closed(self.start, last)
+            self.start = None
+
+
+def _modal_runs(body: list) -> list[tuple[int, int]]:
+    runs: list[tuple[int, int]] = []
+    scan = _ModalRuns(lambda a, b: runs.append((a, b)))
+    for i, node in enumerate(body):
+        scan.feed(i, node)
+    scan.end(len(body) - 1)
     return runs
 
 
@@ -127,25 +145,45 @@ def _sets(node, group: str, values=None) -> bool:
         for s in node.body)
 
 
-def _stretch_runs(body: list) -> list[tuple[int, int]]:
+class _StretchRuns:
     """(first, last) top-level indices from a node that selects a STRETCH_MODES value to the node
     before the block that selects another value of the same group (the end of the body when
     nothing does). A segment holding the first node takes the whole run: the target refused the
-    mode, so none of the stretch may keep its structure."""
-    runs = []
-    for group, values in STRETCH_MODES.items():
-        start: Optional[int] = None
-        for i, node in enumerate(body):
+    mode, so none of the stretch may keep its structure. Fed one node at a time (see _ModalRuns);
+    `end` lists them group by group, in STRETCH_MODES order; only those whose first index
+    `keep` accepts are kept."""
+
+    def __init__(self, keep: Callable[[int], bool] = lambda first: True):
+        self.keep = keep
+        self.start: dict[str, Optional[int]] = {group: None for group in STRETCH_MODES}
+        self.found: dict[str, list[tuple[int, int]]] = {group: [] for group in STRETCH_MODES}
+
+    def feed(self, i: int, node) -> None:
+        for group, values in STRETCH_MODES.items():
+            start = self.start[group]
             if start is None:
                 if any(type(s) is n.ModeChange and s.group == group and s.value in values
                        for x in walk([node]) if type(x) is n.Block for s in x.body):
-                    start = i
+                    self.start[group] = i
             elif _sets(node, group) and not _sets(node, group, values):
-                runs.append((start, i - 1))
-                start = None
-        if start is not None:
-            runs.append((start, len(body) - 1))
-    return runs
+                if self.keep(start):
+                    self.found[group].append((start, i - 1))
+                self.start[group] = None
+
+    def end(self, last: int) -> list[tuple[int, int]]:
+        """The runs, the body having ended at index `last`."""
+        for group, start in self.start.items():
+            if start is not None and self.keep(start):
+                self.found[group].append((start, last))
+            self.start[group] = None
+        return [run for group in STRETCH_MODES for run in self.found[group]]
+
+
+def _stretch_runs(body: list) -> list[tuple[int, int]]:
+    scan = _StretchRuns()
+    for i, node in enumerate(body):
+        scan.feed(i, node)
+    return scan.end(len(body) - 1)
 
 
 def _vars(obj, out: set) -> None:
@@ -183,15 +221,21 @@ def _written(nodes: list) -> set:
     return {(sp, k) for sp, k in out if sp != "system"}
 
 
-def _local(space: str, key, program: n.Program) -> bool:
-    """A variable that ends with the program: a DEF local of its main body or an ISO local #1-#33
-    of the main program. Anything else (R parameters, GUD names, common variables) is seen by the
-    next program, so a lowering that drops its assignment would change what happens there."""
+def _local_names(nodes: list) -> set[str]:
+    """The names the nodes declare local (DEF in a main body), upper case."""
+    return {s.name.upper() for b in blocks(nodes) for s in b.body
+            if type(s) is n.VarDecl and s.scope in ("local", "", None)}
+
+
+def _local(space: str, key, local_names: set[str]) -> bool:
+    """A variable that ends with the program: a DEF local of its main body (`local_names`) or an
+    ISO local #1-#33 of the main program. Anything else (R parameters, GUD names, common variables)
+    is seen by the next program, so a lowering that drops its assignment would change what
+    happens there."""
     if space == "num":
         return isinstance(key, int) and 1 <= key <= 33
     if space == "name":
-        return any(type(s) is n.VarDecl and s.name.upper() == key and s.scope in ("local", "", None)
-                   for b in blocks(program.body) for s in b.body)
+        return key in local_names
     return False
 
 
@@ -244,11 +288,17 @@ def _segments(program: n.Program, refusals: list[Diagnostic]) -> tuple[list[Segm
             outside.append(d)
             continue
         found.append(Segment(i, i, [d]))
-    for a, b in _modal_runs(body):
+    return _widened(found, _modal_runs(body), _stretch_runs(body)), outside
+
+
+def _widened(found: list[Segment], modal_runs, stretch_runs) -> list[Segment]:
+    """Each refused node's segment grown over the modal runs and stretches it touches, then
+    segments that meet merged."""
+    for a, b in modal_runs:
         for seg in found:
             if seg.first <= b and seg.last >= a:
                 seg.first, seg.last = min(seg.first, a), max(seg.last, b)
-    for a, b in _stretch_runs(body):
+    for a, b in stretch_runs:
         for seg in found:
             if seg.first <= a <= seg.last:     # the target refused the mode itself
                 seg.last = max(seg.last, b)
@@ -260,7 +310,7 @@ def _segments(program: n.Program, refusals: list[Diagnostic]) -> tuple[list[Segm
             merged[-1].refusals.extend(seg.refusals)
         else:
             merged.append(seg)
-    return merged, outside
+    return merged
 
 
 def _widen_over_jumps(body: list, segments: list[Segment]) -> list[Segment]:
@@ -296,6 +346,7 @@ def _widen_over_jumps(body: list, segments: list[Segment]) -> list[Segment]:
 def _static_checks(program: n.Program, segments: list[Segment]) -> None:
     body = program.body
     subs = [s.body for s in program.subprograms.values()]
+    local_names = _local_names(body)
     for seg in segments:
         inside = body[seg.first:seg.last + 1]
         rest = body[:seg.first] + body[seg.last + 1:]
@@ -318,14 +369,23 @@ def _static_checks(program: n.Program, segments: list[Segment]) -> None:
             _vars(rest, read)
             for sb in subs:
                 _vars(sb, read)
-            written = _written(inside)
-            shared = sorted(str(k) for _, k in written & read)
-            lasting = sorted(str(k) for sp, k in written if not _local(sp, k, program))
-            if shared:
-                seg.why_not = f"it sets {', '.join(shared[:3])}, which the rest of the program reads"
-            elif lasting:
-                seg.why_not = (f"it sets {', '.join(lasting[:3])}, which outlives the program "
-                               "(a global, common or R variable)")
+            seg.why_not = _variables_reason(_written(inside), read,
+                                            lambda sp, k: _local(sp, k, local_names))
+
+
+def _variables_reason(written: set, read_elsewhere: set, local: Callable[[str, object], bool]
+                      ) -> Optional[str]:
+    """Why a segment that writes `written` cannot be lowered on its own (its assignments vanish
+    into plain motion), or None: the rest of the program reads one, or one outlives the program
+    (`local(space, key)` is False)."""
+    shared = sorted(str(k) for _, k in written & read_elsewhere)
+    lasting = sorted(str(k) for sp, k in written if not local(sp, k))
+    if shared:
+        return f"it sets {', '.join(shared[:3])}, which the rest of the program reads"
+    if lasting:
+        return (f"it sets {', '.join(lasting[:3])}, which outlives the program "
+                "(a global, common or R variable)")
+    return None
 
 
 def _mode_state(interp: Interpreter) -> dict:
@@ -410,20 +470,12 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
         if seg.why_not is None and seg.end_state is not None and seg.end_state["comp"]:
             seg.why_not = "cutter radius compensation is on at its end"
         if seg.why_not is not None:
-            remaining.extend(dataclasses.replace(d, message=f"{d.message}; it cannot be lowered to "
-                                                 f"plain motion on its own: {seg.why_not}")
-                             for d in seg.refusals)
+            remaining.extend(refused(seg))
             continue
         nodes = program.body[seg.first:seg.last + 1]
         lines = [b.span.line for b in blocks(nodes)] or [nodes[0].span.line]
         first_line, last_line = min(lines), max(lines)
-        what = "line " + str(first_line) if first_line == last_line else f"lines {first_line}-{last_line}"
-        for d in seg.refusals:
-            notes.append(Diagnostic("NC401", "info", f"{d.message} — {target_name} cannot express it, so "
-                                    f"{what} {'was' if first_line == last_line else 'were'} {NOTE} "
-                                    "(the rest keeps its structure)", d.file, d.line, d.column,
-                                    d.end_line, d.end_column))
-        notes.extend(seg.notes)
+        notes.extend(lowered_notes(seg, target_name, first_line, last_line))
         new_body.extend(program.body[done:seg.first])
         new_body.extend(seg.flattener.blocks)
         last_span = n.Span(program.file, last_line)
@@ -437,6 +489,23 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
         return None, notes, remaining
     new_body.extend(program.body[done:])
     return dataclasses.replace(program, body=new_body), notes, remaining
+
+
+def refused(seg: Segment) -> list[Diagnostic]:
+    """The refusals of a segment that cannot be lowered on its own, saying why."""
+    return [dataclasses.replace(d, message=f"{d.message}; it cannot be lowered to plain motion on "
+                                f"its own: {seg.why_not}") for d in seg.refusals]
+
+
+def lowered_notes(seg: Segment, target_name: str, first_line: int, last_line: int) -> list[Diagnostic]:
+    """The NC401 of each refusal of a segment lowered to plain motion (lines first-last), then
+    what its plain motion leaves out."""
+    what = "line " + str(first_line) if first_line == last_line else f"lines {first_line}-{last_line}"
+    notes = [Diagnostic("NC401", "info", f"{d.message} — {target_name} cannot express it, so "
+                        f"{what} {'was' if first_line == last_line else 'were'} {NOTE} "
+                        "(the rest keeps its structure)", d.file, d.line, d.column,
+                        d.end_line, d.end_column) for d in seg.refusals]
+    return notes + seg.notes
 
 
 def _marker(k: int) -> n.Block:
@@ -453,90 +522,114 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
         body.append(_marker(2 * k))
         body.extend(program.body[seg.first:seg.last + 1])
         body.append(_marker(2 * k + 1))
+        seg.first_span = _first_span(program, seg)
         done = seg.last + 1
     body.extend(program.body[done:])
     marked = dataclasses.replace(program, body=body)
     homing = {(b.span.file, b.span.line) for seg in segments
               for b in blocks(program.body[seg.first:seg.last + 1])
               if any(type(x) is n.HomeReturn for x in b.body)}
-    interp_diags: list[Diagnostic] = []
-    current: list[Optional[Segment]] = [None]
-    interp: list[Optional[Interpreter]] = [None]
-    most = limits.setting("MAX_LOWERED_BLOCKS", limits.MAX_LOWERED_BLOCKS)
-
-    def refuse(seg: Segment, why: str) -> None:
-        """`seg` cannot be lowered: drop what it holds, and end the run once nothing is left to
-        lower."""
-        seg.why_not = seg.why_not or why
-        seg.flattener = None
-        if all(s.why_not is not None for s in segments):
-            raise _AllRefused()
-
-    def hook(rec, work_end, work_center):
-        if rec.file == MARKER_FILE:
-            seg = segments[rec.line // 2]
-            it = interp[0]
-            state = _mode_state(it)
-            if rec.line % 2 == 0:
-                seg.starts += 1
-                seg.diag_mark = len(interp_diags)
-                if seg.starts > 1:
-                    current[0] = None
-                    refuse(seg, "it does not run exactly once")
-                    return
-                if state["comp"]:
-                    seg.why_not = "cutter radius compensation is on where it starts"
-                elif it.st.diameter or getattr(it, "css_surface", None) is not None:
-                    seg.why_not = "diameter programming or constant surface speed is on where it starts"
-                elif state["frame"]:
-                    seg.why_not = "a programmable frame, G92 or local offset is active where it starts"
-                fl = _Flattener(program, machine, seg.notes)
-                fl.interp = it
-                fl.sel, fl.length, fl.motion, fl.plane = None, ("unknown", None), None, None
-                fl.feed, fl.feed_mode, fl.speed, fl.spindle_dir = None, None, it.st.spindle_speed, it.st.spindle_dir
-                fl.mpos = dict(it.mpos)
-                start = [n.ModeChange("units", "mm"), n.ModeChange("distance", "absolute")]
-                if state["arc_absolute"]:
-                    start.append(n.ModeChange("arc_distance", "incremental"))
-                fl.blocks.append(n.Block(_first_span(program, seg), start,
-                                         comment="nctrans: plain motion of a construct the target lacks"))
-                seg.flattener = fl
-                current[0] = seg
-            else:
-                seg.ends += 1
-                seg.end_state = state
-                if state["frame"] and seg.why_not is None:
-                    seg.why_not = "a programmable frame, G92 or local offset is active where it ends"
-                for d in interp_diags[seg.diag_mark:]:
-                    if d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error"):
-                        seg.why_not = seg.why_not or d.message
-                current[0] = None
-            return
-        seg = current[0]
-        if seg is None or seg.flattener is None:
-            return
-        if (rec.file, rec.line) in homing and rec.kind == "rapid" and rec.start is not None and \
-                rec.end is not None and all(abs(rec.end[a] - rec.start.get(a, rec.end[a])) < 1e-9 for a in rec.end):
-            return      # G28's intermediate point where the tool already is: LinuxCNC does not move
-        seg.flattener.hook(rec, work_end, work_center)
-        if len(seg.flattener.blocks) > most:
-            current[0] = None
-            refuse(seg, f"its plain motion runs past {most:,} blocks, {HELD_LIMIT_NOTE} "
-                        "(NCTRANS_MAX_LOWERED_BLOCKS; an endless loop?); convert --flatten streams "
-                        "the whole program instead")
-
-    it = Interpreter(marked, machine, diagnostics=interp_diags, resolver=resolver, flatten_hook=hook)
-    interp[0] = it
+    hook = SegmentHook(program, segments, machine, homing,
+                       limits.setting("MAX_LOWERED_BLOCKS", limits.MAX_LOWERED_BLOCKS))
+    it = Interpreter(marked, machine, diagnostics=hook.diags, resolver=resolver, flatten_hook=hook)
+    hook.interp = it
     try:
         for _ in it.run():
             pass
     except _AllRefused:
         return
-    for seg in segments:
-        if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
-            for d in interp_diags[seg.diag_mark:]:
+    hook.finish()
+
+
+class SegmentHook:
+    """The flatten hook of the one run that lowers the segments: at a segment's start marker it
+    checks the state the segment starts in and gives it a flattener, then hands that flattener
+    the records up to the end marker, where it takes the source's modes. `most`: the plain-motion
+    blocks a segment may hold (None when they are written as they come, not held). Raises
+    _AllRefused once every segment is refused: the rest of the run is moot."""
+
+    def __init__(self, program: n.Program, segments: list[Segment], machine, homing: set,
+                 most: Optional[int]):
+        self.program = program
+        self.segments = segments
+        self.machine = machine
+        self.homing = homing            # (file, line) of the G28/G30 blocks inside segments
+        self.most = most
+        self.diags: list[Diagnostic] = []       # the interpreter's
+        self.interp: Optional[Interpreter] = None
+        self.current: Optional[Segment] = None
+
+    def refuse(self, seg: Segment, why: str) -> None:
+        """`seg` cannot be lowered: drop what it holds, and end the run once nothing is left to
+        lower."""
+        seg.why_not = seg.why_not or why
+        seg.flattener = None
+        if all(s.why_not is not None for s in self.segments):
+            raise _AllRefused()
+
+    def __call__(self, rec, work_end, work_center) -> None:
+        if rec.file == MARKER_FILE:
+            self.marker(self.segments[rec.line // 2], rec.line % 2 == 0)
+            return
+        seg = self.current
+        if seg is None or seg.flattener is None:
+            return
+        if (rec.file, rec.line) in self.homing and rec.kind == "rapid" and rec.start is not None and \
+                rec.end is not None and all(abs(rec.end[a] - rec.start.get(a, rec.end[a])) < 1e-9 for a in rec.end):
+            return      # G28's intermediate point where the tool already is: LinuxCNC does not move
+        seg.flattener.hook(rec, work_end, work_center)
+        if self.most is not None and len(seg.flattener.blocks) > self.most:
+            self.current = None
+            self.refuse(seg, f"its plain motion runs past {self.most:,} blocks, {HELD_LIMIT_NOTE} "
+                             "(NCTRANS_MAX_LOWERED_BLOCKS; an endless loop?); convert --flatten streams "
+                             "the whole program instead")
+
+    def marker(self, seg: Segment, start: bool) -> None:
+        it = self.interp
+        state = _mode_state(it)
+        if not start:
+            seg.ends += 1
+            seg.end_state = state
+            if state["frame"] and seg.why_not is None:
+                seg.why_not = "a programmable frame, G92 or local offset is active where it ends"
+            for d in self.diags[seg.diag_mark:]:
                 if d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error"):
                     seg.why_not = seg.why_not or d.message
+            self.current = None
+            return
+        seg.starts += 1
+        seg.diag_mark = len(self.diags)
+        if seg.starts > 1:
+            self.current = None
+            self.refuse(seg, "it does not run exactly once")
+            return
+        if state["comp"]:
+            seg.why_not = "cutter radius compensation is on where it starts"
+        elif it.st.diameter or getattr(it, "css_surface", None) is not None:
+            seg.why_not = "diameter programming or constant surface speed is on where it starts"
+        elif state["frame"]:
+            seg.why_not = "a programmable frame, G92 or local offset is active where it starts"
+        fl = _Flattener(self.program, self.machine, seg.notes)
+        fl.interp = it
+        fl.sel, fl.length, fl.motion, fl.plane = None, ("unknown", None), None, None
+        fl.feed, fl.feed_mode, fl.speed, fl.spindle_dir = None, None, it.st.spindle_speed, it.st.spindle_dir
+        fl.mpos = dict(it.mpos)
+        begin = [n.ModeChange("units", "mm"), n.ModeChange("distance", "absolute")]
+        if state["arc_absolute"]:
+            begin.append(n.ModeChange("arc_distance", "incremental"))
+        fl.blocks.append(n.Block(seg.first_span, begin,
+                                 comment="nctrans: plain motion of a construct the target lacks"))
+        seg.flattener = fl
+        self.current = seg
+
+    def finish(self) -> None:
+        """After the run: a segment that ended the program (M30 inside it) never reached its end
+        marker, so what the run left out inside it is checked here."""
+        for seg in self.segments:
+            if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
+                for d in self.diags[seg.diag_mark:]:
+                    if d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error"):
+                        seg.why_not = seg.why_not or d.message
 
 
 def _first_span(program: n.Program, seg: Segment) -> n.Span:

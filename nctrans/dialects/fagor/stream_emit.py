@@ -38,10 +38,13 @@ def emit_stream(program: n.Program, chunks: Iterable[list], write: Callable[[str
     e.out.append(f"%{_program_header(program)}")
     e.prologue()
     _flush(e, write)
-    for chunk in ([first] if first is not None else []):
-        _body(e, chunk, write)
+    # each chunk is let go before the next is parsed: one chunk of IR is held at a time
+    if first is not None:
+        _body(e, first, write)
+    first = None
     for chunk in chunks:
         _body(e, chunk, write)
+        del chunk
     return e.diags
 
 

@@ -54,10 +54,13 @@ def emit_stream(program: n.Program, chunks: Iterable[list], write: Callable[[str
     e.fresh_label = no_fresh_label
     e.written = False
     _flush(e, head, write)
-    for chunk in ([first] if first is not None else []):
-        _body(e, chunk, write)
+    # each chunk is let go before the next is parsed: one chunk of IR is held at a time
+    if first is not None:
+        _body(e, first, write)
+    first = None
     for chunk in chunks:
         _body(e, chunk, write)
+        del chunk
     _flush(e, tail, write)
     if not e.written:
         write("\n")                 # as "\n".join([]) + "\n"

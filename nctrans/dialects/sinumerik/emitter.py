@@ -1238,12 +1238,15 @@ def emit_stream(program: ir.Program, chunks, write) -> list[Diagnostic]:
     chunks = iter(chunks)
     first = next(chunks, None)  # a streamed parse fills program.meta (defaults) as it starts
     e.head()
-    for chunk in ([first] if first is not None else []):
-        e.unit(chunk)
+    # each chunk is let go before the next is parsed: one chunk of IR is held at a time
+    if first is not None:
+        e.unit(first)
         e.flush(write)
+    first = None
     for chunk in chunks:
         e.unit(chunk)
         e.flush(write)
+        del chunk
     e.subprograms()
     e.flush(write)
     return e.diags
