@@ -174,3 +174,14 @@ def test_external_frame_round_trips_iso_sinumerik_iso(tmp_path):
     assert api.equiv(src, back, read_a="iso-m", read_b="iso-m")
     # hand-computed ends: G54 + (7, -3); then X 1 + 4; G55 X 2 + 4
     assert _ends(back) == [(17.0, 7.0, 0.0), (5.0, 7.0, 0.0), (6.0, 7.0, 0.0)]
+
+
+def test_offset_data_is_never_dropped_by_a_streamed_conversion(tmp_path, capsys):
+    # convert -o - streams with per-construct lowering: the G10 was lowered alone there too
+    from nctrans import cli
+    src = tmp_path / "p.nc"
+    src.write_text("G21 G90 G17\nG10 L2 P1 X100 Y50\nG54 G0 X10 Y10\nM30\n")
+    assert cli.main(["convert", str(src), "--to", "sinumerik", "-o", "-"]) == 0
+    out = capsys.readouterr().out
+    moves = [r for r in nctrans.toolpath(out, dialect="sinumerik") if r.kind == "rapid"]
+    assert (moves[-1].end["X"], moves[-1].end["Y"]) == (110.0, 60.0)      # hand-computed

@@ -41,6 +41,10 @@ from nctrans.convert import CONSTRUCT_NOTE as NOTE, HELD_LIMIT_NOTE
 # silently leave it out, G16 polar mode written as Cartesian moves)
 SEGMENT_UNMODELLED = UNMODELLED_RULES + ("NC220",)
 
+# why a segment holding a G10 (DataSetting) is not lowered alone (also the streamed lowering's)
+OFFSET_DATA_WHY = "it writes offset data (G10) that the rest of the program runs with"
+
+
 class _AllRefused(Exception):
     """Raised from the run's hook once every segment is refused: the rest of the run is moot."""
 
@@ -363,7 +367,7 @@ def _static_checks(program: n.Program, segments: list[Segment]) -> None:
         elif any(type(x) is n.DataSetting for b in blocks(inside) for x in b.body):
             # G10 writes offsets the later blocks run with: its plain motion is nothing, and the
             # rest would run with the target's old offsets (was silently wrong)
-            seg.why_not = "it writes offset data (G10) that the rest of the program runs with"
+            seg.why_not = OFFSET_DATA_WHY
         else:
             read: set = set()
             _vars(rest, read)

@@ -38,7 +38,7 @@ from nctrans.interp.interpreter import Interpreter
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks
 from nctrans.lower.constructs import (
-    STRETCH_MODES, Segment, SegmentHook, _AllRefused, _local, _local_names, _marker, _ModalRuns,
+    OFFSET_DATA_WHY, STRETCH_MODES, Segment, SegmentHook, _AllRefused, _local, _local_names, _marker, _ModalRuns,
     _restore, _sets, _StretchRuns, _variables_reason, _vars, _written, lowered_notes, refused)
 from nctrans.lower.flatten import _Walker
 
@@ -68,6 +68,7 @@ class _Scan:
     first_line: Optional[int] = None
     last_line: Optional[int] = None
     static_why: Optional[str] = None        # why not, found before the run in convert
+    offset_data: bool = False               # holds a G10: never lowered alone (constructs.py)
     walk_notes: list[Diagnostic] = field(default_factory=list)
 
 
@@ -201,13 +202,17 @@ class _StreamedLowering:
             line = b.span.line
             scan.first_line = line if scan.first_line is None else min(scan.first_line, line)
             scan.last_line = line if scan.last_line is None else max(scan.last_line, line)
+            if any(type(x) is n.DataSetting for x in b.body):
+                scan.offset_data = True
             if any(type(x) is n.HomeReturn for x in b.body):
                 self.hook.homing.add((b.span.file, line))
 
     def _checked(self, seg: Segment, scan: _Scan) -> None:
         """convert's checks before its run, on the segment's nodes now all seen: the variables it
         sets, then what plain motion cannot carry."""
-        if scan.written:
+        if scan.offset_data:
+            scan.static_why = OFFSET_DATA_WHY
+        elif scan.written:
             total, names = self._mentions(scan.written)
             elsewhere = {v for v, count in total.items() if count > scan.mentions.get(v, 0)}
             scan.static_why = _variables_reason(scan.written, elsewhere,
