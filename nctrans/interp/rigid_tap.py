@@ -28,6 +28,8 @@ lead as pitch.
 from __future__ import annotations
 
 INTERPOLATED = "tap_interp"         # Fagor G63
+# the reason a rules table gives a code that taps with a compensating chuck (Sinumerik G63)
+COMPENSATING_CHUCK = "tapping with compensating chuck"
 TAP = "tap_rigid"                   # G331
 RETRACT = "tap_rigid_retract"       # G332
 MODES = frozenset((TAP, RETRACT))

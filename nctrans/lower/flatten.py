@@ -44,6 +44,7 @@ from nctrans.convert import HELD_LIMIT_NOTE as HELD_LIMIT
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
+from nctrans.interp.rigid_tap import COMPENSATING_CHUCK
 from nctrans.interp.unmodelled import no_motion_effect
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
@@ -187,8 +188,8 @@ class _Walker:
             return
         self.dropped.add(key)
         what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
-        if s.dialect == "sinumerik" and s.text.upper() == "G63":    # nctrans.interp.rigid_tap
-            self.diags.append(at_span("NC401", "info", "--flatten writes G63 (tapping with a "
+        if s.reason == COMPENSATING_CHUCK:                       # nctrans.interp.rigid_tap
+            self.diags.append(at_span("NC401", "info", f"--flatten writes {s.text} (tapping with a "
                                       "compensating chuck) as the block's G1 feed move it is; the "
                                       "feed override hold at 100 % is not written", span))
         elif no_motion_effect(s.reason, self.machine_kind):

@@ -1684,7 +1684,8 @@ def emit_program(program: n.Program, emitter: type[IsoEmitter] = IsoEmitter):
 def _external_offset_number(target: n.Var):
     """ISO's external work offset number (#5201 + axis) of a Sinumerik `$P_EXTFRAME[X,TR]`
     target (nctrans.interp.settable_frames models both as one offset), or None."""
-    from nctrans.interp.settable_frames import EXTERNAL
+    from nctrans.interp.settable_frames import external_frame_variable
+    EXTERNAL = external_frame_variable("sinumerik")
     ix = target.indices or []
     if (str(target.key).upper() != EXTERNAL or len(ix) != 2
             or not all(type(i) is n.Var and i.space == "name" and not i.indices for i in ix)

@@ -45,10 +45,11 @@ from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import macro_procs, modal_numbers
 from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
-from nctrans.interp.settable_frames import EXTERNAL as EXTERNAL_FRAME
+from nctrans.interp.settable_frames import external_frame_variable
 from nctrans.interp.unmodelled import FRAME_NOT_MODELLED
 
 DIALECT = "sinumerik"
+EXTERNAL_FRAME = external_frame_variable(DIALECT)
 _DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
