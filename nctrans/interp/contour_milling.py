@@ -187,8 +187,8 @@ def plan72(start, moves, p: dict[str, float], radius: float, here: tuple[float, 
 def run_cycle72(interp, s, unit, pc) -> None:
     """CYCLE72 in the interpreter: read the contour without moving, plan, play the steps."""
     from nctrans.interp.cycles import DRILL_AXIS, PLANE_AXES, milling_cycle
-    from nctrans.interp.milling_cycles import _tool_radius, call_values
-    from nctrans.interp.stock_removal import _contour_blocks
+    from nctrans.interp.milling_cycles import _tool_radius, call_values, run_steps
+    from nctrans.interp.stock_removal import _contour_blocks, capture_at_cycle_feed
     from nctrans.ir import nodes as n
     cyc = milling_cycle(s.name)
     st = interp.st
@@ -209,12 +209,7 @@ def run_cycle72(interp, s, unit, pc) -> None:
             blocks = _contour_blocks(interp, name.value.strip(), unit, pc)
         except MillingError as err:
             raise MillingError("NC225" if err.rule == "NC114" else "NC224", err.severity, err.message)
-        feed = st.feed
-        st.feed = feed or 1.0                       # the contour's own F is not needed: the cycle feeds
-        try:
-            captured = interp._capture_contour(blocks)
-        finally:
-            st.feed = feed
+        captured = capture_at_cycle_feed(interp, blocks)
         if captured is None:
             return                                  # the capture said why (NC133)
         if len(captured) < 2:
@@ -232,20 +227,4 @@ def run_cycle72(interp, s, unit, pc) -> None:
         interp.diag(err.rule, err.severity, f"{s.name} {err.message}; the call is skipped and moves "
                     "nothing in the analysed toolpath")
         return
-    saved = st.feed
-    try:
-        for step in steps:
-            kind = step[0]
-            if kind == "feed":
-                st.feed = step[1]
-                if not st.feed:
-                    interp._need_feed()
-                continue
-            end = dict(interp.pos)
-            end[a1], end[a2], end[ax] = step[1]
-            if kind == "arc":
-                interp._move("arc", end, step[2], step[3], 0)
-            else:
-                interp._move(kind, end)
-    finally:
-        st.feed = saved
+    run_steps(interp, steps, a1, a2, ax)

@@ -773,6 +773,14 @@ def run_milling_cycle(interp, s) -> None:
         interp.diag(err.rule, err.severity, f"{cyc.name} {err.message}; the call is skipped and "
                     "moves nothing in the analysed toolpath")
         return
+    run_steps(interp, steps, a1, a2, ax)
+
+
+def run_steps(interp, steps, a1: str, a2: str, ax: str) -> None:
+    """Move the tool through a planned cycle: ("feed", F) sets the feed for the moves after it,
+    (kind, (p1, p2, depth)[, centre, cw]) moves in the plane axes a1/a2 and the tool axis ax. The
+    program's feed is restored after the cycle, as the control does."""
+    st = interp.st
     saved = st.feed
     try:
         for step in steps:

@@ -335,6 +335,18 @@ def _values(interp, cyc, s) -> dict[str, float]:
     return out
 
 
+def capture_at_cycle_feed(interp, blocks) -> Optional[list]:
+    """The contour's moves (interp._capture_contour), read under any feed: the contour's own F is
+    not needed, the cycle feeds at its own parameters."""
+    st = interp.st
+    feed = st.feed
+    st.feed = feed or 1.0
+    try:
+        return interp._capture_contour(blocks)
+    finally:
+        st.feed = feed
+
+
 def _contour_blocks(interp, npp: str, unit, pc):
     """The blocks of the contour NPP names: a subprogram, or "START:END" labels of the calling
     program (both label blocks included). Blocks after a RET/M17/M30 of the subprogram are not
@@ -389,12 +401,7 @@ def run_cycle95(interp, s, unit, pc) -> None:
         p = _values(interp, cyc, s)
         what, face, inside = variant(p.get("VARI", 0.0))
         blocks = _contour_blocks(interp, npp.value.strip(), unit, pc)
-        feed = st.feed
-        st.feed = feed or 1.0                       # the contour's own F is not needed: the cycle feeds
-        try:
-            captured = interp._capture_contour(blocks)
-        finally:
-            st.feed = feed
+        captured = capture_at_cycle_feed(interp, blocks)
         if captured is None:
             return                                  # the capture said why (NC133)
         if len(captured) < 2:
