@@ -608,6 +608,7 @@ class Equivalence:
     difference: Optional["Difference"] = None
     records: tuple[int, int] = (0, 0)
     diagnostics: list[Diagnostic] = field(default_factory=list)
+    endless: bool = False       # both loop for ever: compared as far as the step budget ran
 
     def __bool__(self) -> bool:
         return self.equivalent
@@ -619,10 +620,17 @@ class Equivalence:
             return text
         if not self.equivalent:
             return "an input did not parse"
-        return f"equivalent within {self.tol:g} mm ({self.records[0]} and {self.records[1]} toolpath records)"
+        endless = "; both endless, compared as far as the step budget ran" if self.endless else ""
+        return (f"equivalent within {self.tol:g} mm ({self.records[0]} and {self.records[1]} toolpath "
+                f"records{endless})")
 
     def __repr__(self) -> str:
         return f"<Equivalence {'yes' if self.equivalent else 'no'}: {self.message}>"
+
+
+def _budget_spent(diags: list[Diagnostic]) -> bool:
+    """The run was cut by the step budget (NC205 as an error: an endless loop)."""
+    return any(d.rule == "NC205" and d.severity == "error" and "step budget" in d.message for d in diags)
 
 
 def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[str] = None,
@@ -635,21 +643,32 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
         raise NCInputError(f"tol must be a positive finite number of mm, not {tol!r}")
     # Both programs run at once, in step (the comparison reads each toolpath as a stream, so
     # memory stays flat); the search path is set once around both runs.
-    with _search_path(search_path):
-        ta = toolpath(a, read_a, machine, file="<a>")
-        tb = toolpath(b, read_b, machine, file="<b>")
-        try:
-            diff = _equivalence.compare(ta, tb, tol) if ta.parsed and tb.parsed else None
-            for _ in ta:                # the rest of each run: its diagnostics complete
-                pass
-            for _ in tb:
-                pass
-        finally:
-            ta.close()
-            tb.close()
+    from nctrans.interp.flow import RESTART_MAIN
+    restarts = RESTART_MAIN.set(True)       # M99 in a main program loops, as a LOOP does
+    try:
+        with _search_path(search_path):
+            ta = toolpath(a, read_a, machine, file="<a>")
+            tb = toolpath(b, read_b, machine, file="<b>")
+            try:
+                diff = _equivalence.compare(ta, tb, tol) if ta.parsed and tb.parsed else None
+                for _ in ta:                # the rest of each run: its diagnostics complete
+                    pass
+                for _ in tb:
+                    pass
+            finally:
+                ta.close()
+                tb.close()
+    finally:
+        RESTART_MAIN.reset(restarts)
     diags = ta.diagnostics + tb.diagnostics
+    if diff is not None and diff.at_end and _budget_spent(ta.diagnostics) and _budget_spent(tb.diagnostics):
+        # both endless (a LOOP, M99 restarting a main program), both cut by the step budget at
+        # different points: they agreed on everything both ran
+        diff, endless = None, True
+    else:
+        endless = False
     if not (ta.parsed and tb.parsed):
         return Equivalence(False, tol, None, (ta.count, tb.count), diags)
-    return Equivalence(diff is None, tol, diff, (ta.count, tb.count), diags)
+    return Equivalence(diff is None, tol, diff, (ta.count, tb.count), diags, endless)
 
 

@@ -46,6 +46,8 @@ def stable_number(name: str, taken: set[int] = frozenset()) -> int:
 # the locals of the G65 letters in the order a PROC's parameters take them (nctrans.dialects.iso_m
 # plan.ARG_LETTERS), then I J K (#4-#6)
 LETTER_LOCALS = (1, 2, 3, 7, 8, 9, 11, 13, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 4, 5, 6)
+# a converted call's parameters past the 18 letters, passed in spill slots, follow them in its event
+SPILLED_AFTER = 18
 
 
 def call_arguments(call) -> list:

@@ -42,6 +42,7 @@ class Difference:
     message: str
     a: Optional[ToolpathRecord]
     b: Optional[ToolpathRecord]
+    at_end: bool = False        # one toolpath ended where the other goes on (all before agreed)
 
     def where(self, rec: Optional[ToolpathRecord], label: str) -> str:
         return f"{rec.file}:{rec.line}" if rec is not None else f"{label}: (end of toolpath)"
@@ -412,7 +413,7 @@ def _compare_runs(A: _Run, B: _Run, sa: _Stream, sb: _Stream, tol: float) -> Opt
             follows = sa.what_next()
             return Difference(f"A's {cls} motion ends at {fmt(A.last_point())}"
                               f"{' and ' + follows + ' follows' if follows else ''}; "
-                              f"B's goes on to {fmt(q)}", A.last[1], beyond)
+                              f"B's goes on to {fmt(q)}", A.last[1], beyond, at_end=sa.peek() is None)
     if fb is None:
         q, beyond = _beyond(A, ba.j, B.last_point(), tol)
         A.drain()
@@ -420,7 +421,7 @@ def _compare_runs(A: _Run, B: _Run, sa: _Stream, sb: _Stream, tol: float) -> Opt
             follows = sb.what_next()
             return Difference(f"B's {cls} motion ends at {fmt(B.last_point())}"
                               f"{' and ' + follows + ' follows' if follows else ''}; "
-                              f"A's goes on to {fmt(q)}", beyond, B.last[1])
+                              f"A's goes on to {fmt(q)}", beyond, B.last[1], at_end=sb.peek() is None)
     if fa is not None:
         q, near = _near(B, ab.j)
         return Difference(f"path leaves tolerance {tol:g} mm: A passes {fmt(A.point(fa))}, "
@@ -542,9 +543,9 @@ def differences(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: f
             name, t, other = ("A", ta, last_b) if tb is None else ("B", tb, last_a)
             what = f"{t[1]} motion"
             if name == "A":
-                yield Difference(f"A continues with {what}; B has ended", t[3], other)
+                yield Difference(f"A continues with {what}; B has ended", t[3], other, at_end=True)
             else:
-                yield Difference(f"B continues with {what}; A has ended", other, t[3])
+                yield Difference(f"B continues with {what}; A has ended", other, t[3], at_end=True)
             return
         A, B = _Run(sa, axes, sa.take()), _Run(sb, axes, sb.take())
         d = _compare_runs(A, B, sa, sb, tol)

@@ -184,7 +184,30 @@ class CallsMixin:
                     values.append(self._value(lambda: raw, "call argument"))
             except EvalError:
                 values.append(None)
+        if s.named_args and not s.args:
+            values = self._with_spilled(values)
         self._record("call", call=s.name, args=values)
+
+    def _with_spilled(self, values: list) -> list:
+        """A G65 of a converted program passes the parameters past its 18 letters in the spill
+        slots #[#149+150].. (nctrans.dialects.iso_m.plan), ending at a vacant slot: they follow the
+        letters in the call event, so it shows every argument the source call had."""
+        from nctrans.calls import SPILLED_AFTER
+        read = self.ev.read_num
+        try:
+            pointer = read(149)
+            base = 150 + int(pointer if isinstance(pointer, float) else 0)
+        except (EvalError, ValueError, OverflowError):
+            return values
+        spilled = []
+        for k in range(base, 200):
+            v = read(k)
+            if not isinstance(v, float):
+                break
+            spilled.append(v)
+        if not spilled:
+            return values
+        return values[:SPILLED_AFTER] + [None] * (SPILLED_AFTER - len(values)) + spilled
 
     def _return(self, to_label):
         fr = self.stack[-1]

@@ -18,6 +18,7 @@ A mixin of Interpreter.
 """
 from __future__ import annotations
 
+from contextvars import ContextVar
 from typing import Any, Callable, Iterator, Optional
 
 from nctrans.interp import unmodelled
@@ -29,6 +30,11 @@ from nctrans.interp.native import KERNEL_BLOCKS
 from nctrans.ir import nodes as n
 from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
+
+# M99 in a main program restarts it on the control, for ever. A toolpath analyses one pass (NC205
+# warning); `equiv` sets this so the program restarts as on the control (state kept, as a jump to
+# its first block), within the step budget, and compares with a Sinumerik LOOP of the same body.
+RESTART_MAIN: ContextVar[bool] = ContextVar("RESTART_MAIN", default=False)
 
 STREAM_BATCH = 256          # blocks of a streamed main body compiled at a time
 
@@ -190,6 +196,8 @@ class FlowMixin:
         if s.kind == "restart" and self.stack:
             # M99 at the end of a file's main body that was called as a subprogram: a return
             return ("return", None)
+        if s.kind == "restart" and not self.stack and RESTART_MAIN.get() and self._main is not None:
+            return ("restart",)
         self._comp_flush()
         self._record("stop", stop_kind="end")
         if s.kind == "restart" and not self.stack:
@@ -229,6 +237,7 @@ class FlowMixin:
             stream = iter(body)
             body = []
         main = self.unit_for(id(prog), prog.name or "main", body, prog.file, [])
+        self._main = main if stream is None else None      # a streamed body cannot restart
         unit, code = main, main.code
         pc = sidx = 0
         steps = 0
@@ -405,6 +414,8 @@ class FlowMixin:
         kind = ctl[0]
         if kind == "turning":
             return self._turning_control(ctl[1], unit, pc, sidx)
+        if kind == "restart":
+            return self._main, self._main.code, 0, 0
         if kind == "goto":
             target = self._find_label(unit, ctl[1], ctl[2], pc)
             if target is None and self.stack and self.stack[-1].section:

@@ -1421,7 +1421,15 @@ class IsoEmitter(IsoSpelling, Emitter):
             "NC404", "warning", f"the call of {s.name} is kept as {self.code_for(*_CALL[kind])} P{number}: {s.name} is not in "
             f"this program nor found beside it, so the target control must provide O{number} "
             f"(convert {s.name}'s own file to get it)", self._where()))
-        return self._call_lines(s, kind, number, unit, params)
+        lines = self._call_lines(s, kind, number, unit, params)
+        if type(lines) is _Lines and unit.frame and pl.SPILL_BASE + unit.frame <= pl.SPILL_END:
+            # the slot past the spilled arguments vacant: where the call's arguments end for a
+            # reader of the call (the call event, nctrans.interp.calls._with_spilled)
+            at = next(i for i, group in enumerate(lines) if group and group[0][0] != "#")
+            lines.insert(at, [("#", f"#[#{pl.SPILL_POINTER}+{pl.SPILL_BASE + unit.frame}]=#0")])
+            # and the first slot vacant after it, so a later call passes no stale arguments
+            lines.append([("#", f"#[#{pl.SPILL_POINTER}+{pl.SPILL_BASE}]=#0")])
+        return lines
 
     def _extern_params(self, s: n.SubCall) -> list:
         declared = ((self.program.meta or {}).get("extern_params") or {}).get(s.name.upper())
