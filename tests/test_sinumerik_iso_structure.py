@@ -269,6 +269,9 @@ def test_arguments_past_the_g65_letters_are_in_the_call_event():
     assert same, same.message
     events = [r.args for r in nctrans.toolpath(conv.text, dialect="iso-m") if r.kind == "call"]
     assert events == [[float(i + 1) for i in range(20)], [7.0]]      # SMALL gets no stale slots
+    # a call that does not use all 18 letters spilled nothing: a value left in a slot is not its
+    stale = "%\nO1\n#150=5.\nG65 P9999 A1.\nM30\n%\n"
+    assert [r.args for r in nctrans.toolpath(stale, dialect="iso-m") if r.kind == "call"] == [[1.0]]
     # a spilled argument that differs is a difference
     other = api.equiv(src, conv.text.replace("#[#149+151]=20", "#[#149+151]=21"), read_a="sinumerik",
                       read_b="iso-m")

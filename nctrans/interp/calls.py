@@ -170,7 +170,7 @@ class CallsMixin:
         """A call nothing here defines: a "call" record (name, evaluated arguments in the order
         nctrans.calls.call_arguments gives; a string as its string number), so a conversion that
         keeps the call can be compared with its source."""
-        from nctrans.calls import call_arguments, string_number
+        from nctrans.calls import SPILLED_AFTER, call_arguments, string_number
         values = []
         for e in call_arguments(s):
             if e is None or (type(e) is n.Num and e.text == ""):
@@ -184,8 +184,8 @@ class CallsMixin:
                     values.append(self._value(lambda: raw, "call argument"))
             except EvalError:
                 values.append(None)
-        if s.named_args and not s.args:
-            values = self._with_spilled(values)
+        if s.named_args and not s.args and len(values) >= SPILLED_AFTER and values[SPILLED_AFTER - 1] is not None:
+            values = self._with_spilled(values)     # all 18 letters used: more may be spilled
         self._record("call", call=s.name, args=values)
 
     def _with_spilled(self, values: list) -> list:
