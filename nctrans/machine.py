@@ -81,9 +81,12 @@ class Tool:
     # turning tool: tip direction 0-9 of the nose radius (Fanuc/Haas imaginary tool tip, Sinumerik
     # cutting edge position); `radius` is then the nose radius (nctrans.interp.nose)
     tip: Optional[int] = None
+    # grooving tool: its cutting width, the distance between its two cutting edges (the Siemens
+    # grooving cycle CYCLE93 cuts with both; nctrans.interp.grooving)
+    width: Optional[float] = None
 
     def __post_init__(self) -> None:
-        for name in ("length", "radius", "cutting_length", "holder_radius", "holder_length"):
+        for name in ("length", "radius", "cutting_length", "holder_radius", "holder_length", "width"):
             v = getattr(self, name)
             if v is not None and v < 0:
                 raise ValueError(f"{name} must not be negative, not {v:g}")

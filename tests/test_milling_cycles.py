@@ -640,13 +640,16 @@ def test_any_arguments_plan_or_refuse(name, data):
     try:
         if cyc["shape"] == "thread_turn":
             steps = thread_turn_steps(p, (30.0, 10.0))
+        elif cyc["shape"] == "groove":
+            from nctrans.interp.grooving import groove_steps
+            steps = groove_steps(p, data.draw(st.floats(0.1, 10), label="width"))
         else:
             steps = milling_steps(cyc["shape"], p, data.draw(st.floats(0.1, 10), label="radius"),
                                   (0.0, 0.0, 50.0), 100.0)
     except MillingError as err:
-        assert err.rule in ("NC206", "NC224", "NC225") and err.message
+        assert err.rule in ("NC206", "NC224", "NC225", "NC113", "NC114") and err.message
         return
     assert len(steps) <= MAX_MOVES + 1
     for s in steps:
-        if s[0] != "feed":
+        if s[0] not in ("feed", "dwell"):
             assert all(math.isfinite(v) for v in s[1])

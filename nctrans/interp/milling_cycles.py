@@ -748,6 +748,10 @@ def run_milling_cycle(interp, s) -> None:
     if cyc is None:
         interp.diag("NC103", "warning", f"milling cycle {s.name} is not known")
         return
+    if cyc.shape == "groove":                   # a turning cycle (nctrans.interp.grooving)
+        from nctrans.interp.grooving import run_cycle93
+        run_cycle93(interp, cyc, s)
+        return
     if s.modal:
         select_modal(interp, s)
         return
