@@ -68,9 +68,10 @@ def _refusals(text: str, src: str, dst: str) -> list:
 
 def test_system_variables_without_an_equivalent_are_refused_at_their_line():
     # #4009 (modal canned cycle: no Sinumerik G group holds it; #4014 now maps to $P_GG[8]+52,
-    # tests/test_iso_to_sinumerik_structure.py), #2001 (length of offset H1: Sinumerik keeps
-    # lengths per tool edge, $TC_DP3[t,d])
-    for number in (4009, 2001):
+    # tests/test_iso_to_sinumerik_structure.py), #2201 (length wear of offset H1: a wear write
+    # adds to the geometry in the analysis, no edge datum of Sinumerik is proven the same; the
+    # geometry registers #2001/#2401 map to $TC_DP3[d]/$TC_DP6[d], test_iso_sinumerik_mappings.py)
+    for number in (4009, 2201):
         found = _refusals(f"G0 X0\n#1=#{number}\nM30\n", "iso-m", "sinumerik")
         assert found and found[0].line == 2 and f"#{number}" in found[0].message
     # a write to a position is refused, not turned into a write of $AA_IM

@@ -44,7 +44,7 @@ from typing import Any, Iterator, Optional
 
 from nctrans import plainrun
 from nctrans.diagnostics import at_span
-from nctrans.interp import ggroups, settable_frames, sysvars
+from nctrans.interp import edge_data, ggroups, settable_frames, sysvars
 from nctrans.interp.evaluate import AxisName, EvalError, Evaluator, FrameValue
 from nctrans.interp.frames import Offsets, PLANE_AXES, ProgrammableFrame
 from nctrans.interp.lathe import LatheMixin
@@ -226,6 +226,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
             sysv[str(name).upper()] = lambda value=value: float(value)
         sysvars.register(self, self.program.dialect)
         settable_frames.register(self)
+        edge_data.register(self)
         gg = ggroups.index_reader(self.program.dialect, st.groups, self.spelt_codes,
                                   lambda: self.unmodelled_motion)
         if gg is not None:

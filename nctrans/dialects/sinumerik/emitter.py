@@ -185,6 +185,9 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                                   "external zero offset frame $P_EXTFRAME")
             return f"{EXTERNAL_FRAME}[{'XYZABC'[v.key - 5201]},TR]"
         if isinstance(v.key, int) and v.key >= 1000 and not v.indices:
+            edge = self.edge_register(v.key)
+            if edge is not None:
+                return edge
             return self.system_var(v, target)
         self.info("num", "ISO macro variables #n written as R parameters Rn")
         if v.key is None:
@@ -210,6 +213,23 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         name, axis = found
         self.info("sysvar", "ISO system variables written as the Sinumerik variables of the same meaning")
         return f"{name}[{axis}]" if axis else name
+
+    def edge_register(self, number: int) -> Optional[str]:
+        """An ISO tool offset register (#2001 length 1, #2401 radius 1: the source table's
+        "tool_length" / "tool_radius" ranges) as the cutting-edge datum of the same flat D number
+        (`$TC_DP3[1]`, `$TC_DP6[1]`; rules/sinumerik.toml [options.flat_edge_data]), read or written;
+        None for any other number. The output's D words are the ISO numbers already, so both name
+        the same register (MD 18102 flat D number structure)."""
+        spell = {k: sp for sp, k in (self.t.options.get("flat_edge_data") or {}).items()}
+        for e in ((self.p.meta or {}).get("options") or {}).get("numbered_variables") or ():
+            first = int(e.get("first", -1)) if isinstance(e, dict) else -1
+            kind = {"tool_length": "length", "tool_radius": "radius"}.get(e.get("source"))
+            if kind in spell and first <= number <= int(e.get("last", first)):
+                self.info("edge-data", "ISO tool offset registers (#2001.., #2401..) written as the "
+                                       "edge data of the same flat D number ($TC_DP3[d] length, "
+                                       "$TC_DP6[d] radius; MD 18102 flat D numbers)")
+                return f"{spell[kind]}[{number - first + 1}]"
+        return None
 
     def numbered_meaning(self, number: int) -> str:
         """What the source's numbered-variable table says a number is (ISO #2001: tool length
