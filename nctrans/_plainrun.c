@@ -182,9 +182,11 @@ static int motion_g(const char *s, int len)
     return whole <= 3 ? (int)whole : -1;
 }
 
-/* Strict scanning (dialects whose words are separated, such as Sinumerik: `X1 Y2`, never `X1Y2`):
- * the raw line text[p:q) has no blank between an address letter and its number and no letter
- * right after a number (`G1X10`), so cleaning it changes no word. 1 when it is so. */
+/* Strict scanning (dialects whose words are separated, such as Sinumerik and Fagor: `X1 Y2`,
+ * never `X1Y2`): the raw line text[p:q) has no blank between an address letter and its number, no
+ * letter right after a number (`G1X10`) and nothing but a letter after a blank (`X1 0`, which
+ * these dialects read as a syntax error, would clean to X10), so cleaning it changes no word.
+ * 1 when it is so. */
 static int words_separated(const Text *t, Py_ssize_t p, Py_ssize_t q)
 {
     Py_UCS4 prev = ' ';
@@ -194,6 +196,8 @@ static int words_separated(const Text *t, Py_ssize_t p, Py_ssize_t q)
         if (c == ' ' && ((prev >= 'A' && prev <= 'Z') || (prev >= 'a' && prev <= 'z')))
             return 0;
         if (letter && ((prev >= '0' && prev <= '9') || prev == '.'))
+            return 0;
+        if (prev == ' ' && c != ' ' && c != '\r' && !letter)
             return 0;
         prev = c;
     }

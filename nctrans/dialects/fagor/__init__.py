@@ -41,15 +41,16 @@ class Fagor(IsoFamily):
     gives the G/M codes their neutral meaning), but the rest of its block language (`[ ]`
     expressions, `( )` comments anywhere, `$` flow, `#` instructions, P/V variables, `N<n>:` and
     `[LABEL]` targets) has its own grammar of record, so it brings its own front end and emitter
-    instead of the ISO Lowering/IsoEmitter. Programs are read as a whole; a program converted to
-    Fagor that runs straight through is written as it is read (stream_emit)."""
+    instead of the ISO Lowering/IsoEmitter. A program that runs straight through (CAM output) is
+    parsed as it runs (stream.py says where the line is; the rest is read as a whole), and a
+    program converted to Fagor that runs straight through is written as it is read (stream_emit)."""
     name = "fagor"
     description = "Fagor CNC 8060/8065"
     extensions = (".nc", ".pim", ".fnc")
     markers = MARKERS
     comment_evidence = {"semicolon_line": (0.5, 2)}
     subprogram_endings = (".nc", ".NC", ".pim", ".fnc", ".fst")
-    streams = False
+    streams = True                     # CAM programs: stream.streamable
     lowering_passes = ()      # Fagor has $FOR, $WHILE, $DO and $SWITCH of its own
 
     def sniff(self, text: str) -> float:
@@ -69,7 +70,8 @@ class Fagor(IsoFamily):
         return parse(text, file)
 
     def parse_stream(self, text: str, file: str = "<stdin>") -> ParseResult | None:
-        return None
+        from .stream import parse_stream
+        return parse_stream(text, file)
 
     def lowering(self):
         raise NotImplementedError("fagor has its own front end (nctrans.dialects.fagor.frontend)")

@@ -790,33 +790,38 @@ class Parser:
 
     def run(self) -> ir.Program:
         for line in blocks.lines(self.text):
-            if line.kind == "unclosed_comment":
-                self.error("NC006", "#COMMENT BEGIN without #COMMENT END", 1)
-                continue
-            self.low.line = line.lineno
-            self.low.col = line.col
-            if line.kind == "blank":
-                if line.comment and line.raw.strip():
-                    self.unit.current.append(ir.Block(self.span(line), [], comment=line.comment))
-                continue
-            if line.kind == "local_sub":
-                self.close_unit(line.lineno)
-                self.unit = _Unit(line.name.upper(), self.span(line))
-                self.subs.append(self.unit)
-                continue
-            if line.kind == "header":
-                if self.unit is not self.main:
-                    self.close_unit(line.lineno)
-                    self.unit = self.main
-                if line.name and "program_name" not in self.meta:
-                    self.meta["program_name"] = line.name
-                self.meta.setdefault("headers", []).append(line.name or "")
-                continue
-            self.block(line)
+            self.take(line)
         self.close_unit(None)
         self.unit = self.main
         self.close_unit(None)
         return self.program()
+
+    def take(self, line: blocks.Line) -> None:
+        """One split line into the unit being read (the streamed parse, nctrans.dialects.fagor.
+        stream, hands its lines here one at a time as well)."""
+        if line.kind == "unclosed_comment":
+            self.error("NC006", "#COMMENT BEGIN without #COMMENT END", 1)
+            return
+        self.low.line = line.lineno
+        self.low.col = line.col
+        if line.kind == "blank":
+            if line.comment and line.raw.strip():
+                self.unit.current.append(ir.Block(self.span(line), [], comment=line.comment))
+            return
+        if line.kind == "local_sub":
+            self.close_unit(line.lineno)
+            self.unit = _Unit(line.name.upper(), self.span(line))
+            self.subs.append(self.unit)
+            return
+        if line.kind == "header":
+            if self.unit is not self.main:
+                self.close_unit(line.lineno)
+                self.unit = self.main
+            if line.name and "program_name" not in self.meta:
+                self.meta["program_name"] = line.name
+            self.meta.setdefault("headers", []).append(line.name or "")
+            return
+        self.block(line)
 
     def close_unit(self, line: Optional[int]) -> None:
         u = self.unit
