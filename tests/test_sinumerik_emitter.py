@@ -142,8 +142,12 @@ def test_iso_cycles_without_siemens_equivalent_are_refused():
 
 
 def test_foreign_passthrough_is_reported():
+    # Haas G47 (engraving) is no Sinumerik word: never copied as if it meant something there
     out = emit(ir.Program("iso.nc", "iso-m", [block(ir.Passthrough("G47 X1", "engraving", "iso-m"))]))
-    assert [d.rule for d in out.diagnostics] == ["NC403"] and out.text.strip() == "G47 X1"
+    assert [d.rule for d in out.diagnostics] == ["NC402"] and out.text.strip().startswith(";")
+    # foreign text that is a Sinumerik word of its own meaning is kept, with NC403
+    out = emit(ir.Program("iso.nc", "iso-m", [block(ir.Passthrough("G64", "contouring", "iso-m"))]))
+    assert [d.rule for d in out.diagnostics] == ["NC403"] and out.text.strip() == "G64"
     out = emit(ir.Program("iso.nc", "iso-m", [block(ir.Passthrough("#1=[#2 EQ 1]*", "odd", "iso-m"))]))
     assert [d.rule for d in out.diagnostics] == ["NC402"]
     assert out.text.strip().startswith(";")                 # kept as a comment, still parses

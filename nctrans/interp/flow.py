@@ -181,12 +181,20 @@ class FlowMixin:
 
     def _c_goto(self, s: n.Goto):
         cond = None if s.cond is None else self._cond(s.cond)
+        if s.computed is not None:
+            return (self._h_goto, (self.ev.compile(s.computed), s.direction, cond))
         return (self._h_goto, (label_key(s.target), s.direction, cond))
 
     def _h_goto(self, d):
         target, direction, cond = d
         if cond is not None and not cond():
             return None
+        if callable(target):             # ISO GOTO #2: the block number its value rounds to
+            value = target()
+            if isinstance(value, (int, float)) and value == value and abs(value) < 1e9:
+                target = int(round(value))
+            else:                        # reported as a target not found, and the run stops
+                target = f"(computed block number {value})"
         return ("goto", target, direction)
 
     def _h_return(self, s: n.Return):

@@ -340,10 +340,13 @@ class VarDecl:
 @node
 class Goto:
     """Jump to a label or block number. direction: "forward", "backward", "any".
-    cond: jump only when true (ISO IF [..] GOTO n, Sinumerik IF .. GOTOF L)."""
+    cond: jump only when true (ISO IF [..] GOTO n, Sinumerik IF .. GOTOF L).
+    computed: the block number as an expression evaluated when the jump runs (ISO `GOTO #2`);
+    `target` is then only its text."""
     target: str
     direction: str = "any"
     cond: Optional[Expr] = None
+    computed: Optional[Expr] = None
 
 
 @node

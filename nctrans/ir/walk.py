@@ -58,7 +58,10 @@ def jump_targets(nodes: Iterable) -> set[str]:
         t = type(node)
         if t is n.Block:
             for s in node.body:
-                if type(s) is n.Goto:
+                if type(s) is n.Goto and s.computed is not None:
+                    # a computed block number can land on any numbered block of these nodes
+                    out.update(str(b.number) for b in blocks(nodes) if b.number is not None)
+                elif type(s) is n.Goto:
                     out.add(str(s.target))
                 elif type(s) is n.Return and s.to_label:
                     out.add(str(s.to_label))

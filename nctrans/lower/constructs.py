@@ -264,6 +264,9 @@ def _jump_targets(nodes: list) -> set[str]:
     for node in walk(nodes):
         if type(node) is n.Block:
             out.update(str(s.target) for s in node.body if type(s) is n.Goto)
+            if any(type(s) is n.Goto and s.computed is not None for s in node.body):
+                # ISO GOTO #2 can land on any numbered block
+                out.update(str(b.number) for b in walk(nodes) if type(b) is n.Block and b.number)
             out.update(str(s.to_label) for s in node.body if type(s) is n.Return and s.to_label)
             # a section repetition (REPEAT start end, REPEATB) runs its labels' blocks again: a
             # label it names inside a lowered stretch would be gone from the output

@@ -484,6 +484,10 @@ class FagorEmitter(FagorSpelling, Emitter):
         word("", f"{self.var_text(s.target)}={self.expr(s.value)}", alone=True)
 
     def w_Goto(self, s: n.Goto, word, new_line, rest: list):
+        if s.computed is not None:
+            # $GOTO N<expr> exists, but nctrans cannot follow it on Fagor (NC415 when read back)
+            raise NotExpressible(f"a computed jump (GOTO {s.target}): a Fagor $GOTO to a computed "
+                                 "block number is not analysed, so the conversion could not be proven")
         new_line()
         target = self._target(s.target)
         if s.cond is not None:

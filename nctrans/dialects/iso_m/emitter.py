@@ -1537,7 +1537,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         return [("", text)] if text else []
 
     def w_Goto(self, s: n.Goto):
-        target = self._goto_target(s.target)
+        target = self.value(s.computed) if s.computed is not None else self._goto_target(s.target)
         if s.cond is not None:
             return [("GOTO", f"IF[{self.cond(s.cond)}]GOTO{target}")]
         return [("GOTO", f"GOTO{target}")]

@@ -99,6 +99,11 @@ def _word_text(letter: str, v: Any) -> str:
 
 
 
+def _computed(v: Any) -> Any:
+    """The block number of `GOTO #2` / `GOTO [#1+10]` as an expression (None for `GOTO 30`)."""
+    return None if _digits(v) is not None or type(v) is str else v
+
+
 def _signed_float(text: str) -> float:
     """A word's number; repeated signs (`Z--17.352`, unary minus applied twice) fold into one."""
     try:
@@ -643,9 +648,9 @@ class Lowering:
                 else:
                     out.append((B_ASSIGN, Assign(it[1], it[2])))
             elif tag == "GOTO":
-                out.append((B_END, Goto(self._target(it[1]))))
+                out.append((B_END, Goto(self._target(it[1]), computed=_computed(it[1]))))
             elif tag == "IFGOTO":
-                out.append((B_END, Goto(self._target(it[2]), cond=it[1])))
+                out.append((B_END, Goto(self._target(it[2]), cond=it[1], computed=_computed(it[2]))))
             else:
                 structure.append(it)
 

@@ -47,10 +47,13 @@ from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp.settable_frames import external_frame_variable
 from nctrans.interp.unmodelled import FRAME_NOT_MODELLED
+from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 
 DIALECT = "sinumerik"
 EXTERNAL_FRAME = external_frame_variable(DIALECT)
 _DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
+# the cycle alarm a computed ISO jump raises when its value names no block of the unit
+COMPUTED_GOTO_ALARM = 65000
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
 # address letters whose value may be an expression written `M=R501` (seed "Indirect programming":
@@ -106,6 +109,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.st = _State()
         self.pending = None
         self.targets = walk.program_jump_targets(program)
+        self.unit_nodes: list = []
         # G65 macros written as PROCs with named parameters (nctrans.lower.macro_procs), and while
         # one is written, its locals #n by name
         self.procs = macro_procs.plan(program) if program.dialect != DIALECT else {}
@@ -461,12 +465,37 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         out.alone(self.vardecl([s]))
 
     def w_Goto(self, s: ir.Goto, out: "_Line") -> None:
+        if s.computed is not None:
+            self.computed_goto(s, out)
+            return
         tgt = "N" + s.target if s.target.isascii() and s.target.isdigit() else s.target
         kw = _GOTO.get(s.direction, "GOTO")
         if s.cond is not None:
             out.alone(f"IF {self.expr(s.cond)} {kw} {tgt}")
         else:
             out.words.append(f"{kw} {tgt}")
+
+    def computed_goto(self, s: ir.Goto, out: "_Line") -> None:
+        """ISO `GOTO #2`: Sinumerik jumps to labels and block numbers written out only, so the
+        jump becomes a CASE over the block numbers of its program unit (the value rounded, as ISO
+        reads a block number); a value that names none of them raises an alarm, as the ISO
+        control stops with "sequence number not found"."""
+        numbers: list[int] = []
+        for b in walk.blocks(self.unit_nodes):
+            if b.number is not None and b.number.isdigit() and int(b.number) not in numbers:
+                numbers.append(int(b.number))
+        self.info("computed_goto", f"computed jump GOTO {s.target} written as a CASE over the "
+                                   "block numbers of its program unit, with an alarm (SETAL) when "
+                                   "none matches")
+        cond = None if s.cond is None else self.expr(s.cond)
+        if cond is not None:
+            out.alone(f"IF {cond}")
+        if numbers:
+            branches = " ".join(f"{k} GOTO N{k}" for k in numbers)
+            out.alone(f"CASE ROUND({self.expr(s.computed)}) OF {branches}")
+        out.alone(f'SETAL({COMPUTED_GOTO_ALARM}, "COMPUTED JUMP: NO SUCH BLOCK NUMBER")')
+        if cond is not None:
+            out.alone("ENDIF")
 
     def w_SectionRepeat(self, s: ir.SectionRepeat, out: "_Line") -> None:
         words = ["REPEATB" if s.line_only else "REPEAT", s.start] + ([s.end] if s.end else [])
@@ -513,6 +542,14 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             # meaning of the text, unproven
             self.refuse_because(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
             out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
+        elif s.reason.startswith(NO_EFFECT_PREFIX):
+            # the source control's own function with no effect on the path (ISO POPEN/DPRNT,
+            # Haas G103, M29): never written as a Sinumerik word it does not mean
+            self.diags.append(at_span("NC413", "warning", f"{s.dialect} {s.text} has no Sinumerik "
+                                      f"equivalent ({s.reason}): written as a comment; the toolpath "
+                                      f"is the same, but what it does on its own control is not done",
+                                      self.span))
+            out.comment_extra.append(f"NC413 {s.dialect}: {s.text}")
         elif _reads_as_sinumerik(s.text, moves_allowed=s.reason != "directive"):
             self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
                                       f"{s.text} ({s.reason})", self.span))
@@ -1030,6 +1067,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
 
     def unit(self, nodes: list) -> None:
         """Emit a unit's nodes with DEF blocks that follow code hoisted to the end of the preamble."""
+        self.unit_nodes = nodes          # the blocks a computed jump can land on
         pre = 0
         for n in nodes:
             if isinstance(n, ir.Block) and all(isinstance(s, ir.VarDecl) for s in n.body):
@@ -1197,11 +1235,17 @@ def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
     if not text.strip() or "\n" in text or ";" in text:
         return False
     res = parse(text, "<passthrough>")
+    # a foreign word Sinumerik reads only as a word it does not know (G123), or as a call of a
+    # subprogram nobody wrote (ISO POPEN), would not mean on the target what it meant at the source
     return not res.diagnostics and all(
-        (not isinstance(s, ir.Passthrough) or s.reason != "syntax error")
+        (not isinstance(s, ir.Passthrough) or s.reason not in _NOT_SINUMERIK)
+        and not isinstance(s, (ir.SubCall, ir.CycleCall))
         and (moves_allowed or not isinstance(s, ir.Motion))
         for b in res.program.body if isinstance(b, ir.Block) for s in b.body)
 
+
+# what the Sinumerik front end makes of text that is no Sinumerik vocabulary
+_NOT_SINUMERIK = frozenset(("syntax error", "unknown function", "invalid number", "address without value"))
 
 _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z_0-9]{0,30}$")
 

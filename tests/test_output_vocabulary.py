@@ -1,0 +1,138 @@
+"""A conversion never writes another dialect's words into its output as if they meant something on
+the target: every construct is translated, lowered to an equivalent, or reported at its line
+(issue #9 with #8's "never silently wrong" rule).
+
+Cases from real probing and macro programs: ISO computed jumps (`GOTO #2`), Fanuc external output
+(POPEN/PCLOS/DPRNT), Haas G103 and M29, unknown G codes."""
+from __future__ import annotations
+
+import nctrans
+from nctrans import api
+from nctrans.ir import nodes as ir
+from nctrans.ir import walk
+
+
+def _convert(text: str, write: str, read: str = "iso-m") -> nctrans.Conversion:
+    return nctrans.transpile(text, read=read, write=write)
+
+
+def _toolpath(text: str, dialect: str) -> list:
+    return [r for r in nctrans.toolpath(text, dialect) if r.kind in ("rapid", "linear", "arc")]
+
+
+def _read_back(text: str, dialect: str) -> tuple[ir.Program, list]:
+    ld = api._load(text, dialect, file="<converted>")
+    return ld.program, ld.diagnostics
+
+
+def _code_words(text: str) -> list[str]:
+    """The output's words outside comments (Sinumerik `;`)."""
+    return [w for line in text.splitlines() for w in line.split(";", 1)[0].split()]
+
+
+# ------------------------------------------------------------------ computed GOTO (ISO macro B)
+
+COMPUTED_GOTO = """O1000
+#1=1
+#2=20
+IF [#1 GT 0] GOTO [#2+10]
+N10 G0 X1
+GOTO #2
+N20 G0 X2
+N30 G0 X3
+M30
+"""
+
+
+def test_iso_computed_goto_is_followed_by_the_analysis():
+    # #2+10 = 30 is taken first: only N30's move runs (hand-followed)
+    ends = [r.end["X"] for r in _toolpath(COMPUTED_GOTO, "iso-m")]
+    assert ends == [3.0]
+    # with the condition false N10 runs, then GOTO #2 (#2=30) skips N20's move
+    src = COMPUTED_GOTO.replace("#1=1", "#1=0").replace("#2=20", "#2=30")
+    assert [r.end["X"] for r in _toolpath(src, "iso-m")] == [1.0, 3.0]
+
+
+def test_iso_computed_goto_rounds_its_value_to_a_block_number():
+    text = "#2=19.6\nGOTO #2\nN10 G0 X1\nN20 G0 X2\nM30\n"
+    assert [r.end["X"] for r in _toolpath(text, "iso-m")] == [2.0]
+
+
+def test_iso_computed_goto_to_a_missing_block_is_a_located_error():
+    text = "#2=15\nGOTO #2\nN10 G0 X1\nM30\n"
+    found = [d for d in nctrans.lint(text, dialect="iso-m") if d.rule == "NC102"]
+    assert [(d.line, d.severity) for d in found] == [(2, "error")]
+
+
+def test_iso_computed_goto_becomes_a_case_dispatch_on_sinumerik():
+    conv = _convert(COMPUTED_GOTO, "sinumerik")
+    assert conv.ok, [d.format_text() for d in conv.diagnostics]
+    lines = conv.text.splitlines()
+    assert "GOTO #2" not in conv.text and "GOTO [" not in conv.text
+    assert "CASE ROUND(R2) OF 10 GOTO N10 20 GOTO N20 30 GOTO N30" in lines
+    assert "CASE ROUND(R2+10) OF 10 GOTO N10 20 GOTO N20 30 GOTO N30" in lines
+    i = lines.index("CASE ROUND(R2+10) OF 10 GOTO N10 20 GOTO N20 30 GOTO N30")
+    assert lines[i - 1] == "IF R1>0" and lines[i + 1].startswith("SETAL(65000") and lines[i + 2] == "ENDIF"
+    assert any(d.rule == "NC401" and d.line == 4 and "CASE" in d.message for d in conv.diagnostics)
+    _, diags = _read_back(conv.text, "sinumerik")
+    assert not [d for d in diags if d.rule.startswith("NC0")]
+    for change in ("#1=1", "#1=0"):
+        src = COMPUTED_GOTO.replace("#1=1", change).replace("#2=20", "#2=30")
+        out = _convert(src, "sinumerik").text
+        assert nctrans.equiv(src, out, read_a="iso-m", read_b="sinumerik"), change
+
+
+def test_sinumerik_dispatch_raises_the_alarm_where_iso_finds_no_block():
+    text = "#2=15\nGOTO #2\nN10 G0 X1\nM30\n"
+    out = _convert(text, "sinumerik").text
+    assert _toolpath(out, "sinumerik") == []
+    found = [d for d in nctrans.lint(out, dialect="sinumerik") if d.rule == "NC221"]
+    assert found and "65000" in found[0].message
+
+
+def test_iso_computed_goto_stays_computed_in_iso_and_is_not_guessed_on_fagor():
+    conv = _convert(COMPUTED_GOTO, "iso-m")
+    assert "GOTO#2" in conv.text and "GOTO[#2+10]" in conv.text
+    assert nctrans.equiv(COMPUTED_GOTO, conv.text, read_a="iso-m", read_b="iso-m")
+    fagor = _convert(COMPUTED_GOTO, "fagor")
+    # Fagor's $GOTO to a computed number is not analysed: never written, the jump runs as plain motion
+    assert fagor.text is None or "$GOTO" not in fagor.text
+    if fagor.text is not None:
+        assert nctrans.equiv(COMPUTED_GOTO, fagor.text, read_a="iso-m", read_b="fagor")
+
+
+# --------------------------------------------- ISO vocabulary without a Sinumerik counterpart
+
+PROBE_REPORT = """G103 P1
+POPEN
+DPRNT[X#5001[44]]
+PCLOS
+M29 S500
+G0 X1 Y2
+M30
+"""
+
+
+def test_iso_external_output_and_haas_codes_are_comments_with_a_warning_on_sinumerik():
+    conv = _convert(PROBE_REPORT, "sinumerik")
+    assert conv.ok
+    words = _code_words(conv.text)
+    for foreign in ("G103", "G103P1", "POPEN", "PCLOS", "DPRNT[X#5001[44]]", "M29"):
+        assert foreign not in words, conv.text
+    warned = {d.line for d in conv.diagnostics if d.rule == "NC413" and d.severity == "warning"}
+    assert warned == {1, 2, 3, 4, 5}
+    for name in ("POPEN", "PCLOS", "DPRNT", "G103"):
+        assert any(name in line.split(";", 1)[1] for line in conv.text.splitlines() if ";" in line), name
+    program, diags = _read_back(conv.text, "sinumerik")
+    assert not [d for d in diags if d.rule.startswith("NC0")]
+    # nothing of the output reads as a call of a subprogram nobody wrote (POPEN as a call)
+    assert not [s for b in walk.blocks(program.body) for s in b.body if isinstance(s, ir.SubCall)]
+    assert nctrans.equiv(PROBE_REPORT, conv.text, read_a="iso-m", read_b="sinumerik")
+
+
+def test_unknown_iso_g_code_is_refused_at_its_line_not_copied():
+    text = "G0 X1\nG123\nG1 X2 F100\nM30\n"
+    conv = _convert(text, "sinumerik")
+    assert conv.text is None or "G123" not in _code_words(conv.text)
+    refused = [d for d in conv.diagnostics if d.rule == "NC402"]
+    assert [d.line for d in refused] == [2] and "G123" in refused[0].message
