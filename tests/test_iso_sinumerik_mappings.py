@@ -31,6 +31,23 @@ ROWS = [
     Row("radius register computed from another (#2403 from #2402)",
         "G90 G17 G21\n#2402=1.5\n#2403=#2402+.5\nG0 X0 Y0\nG1 G42 D3 X10 F50\nX20\nG40 X30\nM30\n",
         ("$TC_DP6[2]=1.5", "$TC_DP6[3]=$TC_DP6[2]+.5", "F50 G42 D3 G1 X10")),
+    # G40/G41/G42 are places 1/2/3 of Sinumerik G group 7: index = #143 - 39
+    Row("computed G word of one group (G#143, #143 = 41 or 42)",
+        "G90 G17 G21\n#2402=1.\n#143=42\nIF[#1EQ1]GOTO5\n#143=41\nN5 G0 X0 Y0\n"
+        "G1 G#143 X10 Y0 D2 F100\nY10\nG40 X20\nM30\n",
+        ("DEF INT INDEX_G7_143", "R143=42", "R143=41", "INDEX_G7_143=R143-39",
+         "G[7]=INDEX_G7_143 G1 X10 Y0")),
+    # G17/G18/G19 are places 1/2/3 of group 6: index = #5 - 16
+    Row("computed plane (G#5, #5 = 17 or 18)",
+        "G90 G21\n#5=18\nG#5\nG0 X0 Z0\nG2 X10 Z0 R5 F100\n#5=17\nG#5\nG2 X0 Y0 R5\nM30\n",
+        ("DEF INT INDEX_G6_5", "INDEX_G6_5=R5-16", "G[6]=INDEX_G6_5")),
+    Row("computed program number of M98 (M98 P#144)",
+        "G90 G17 G21\n#144=1000\nG0 X0 Y0\nM98 P#144\nG1 X5 F100\nM30\nO1000\nG1 Y5 F10\nM99\n",
+        ("DEF INT CALL_NUMBER", "DEF STRING[32] CALL_NAME", "CALL_NUMBER=R144",
+         'CALL_NAME="L"<<CALL_NUMBER', "CALL CALL_NAME")),
+    Row("computed call of a program the target control provides (kept as a call event)",
+        "G90 G17 G21\n#144=9010\nG0 X0 Y0\nM98 P#144\n#144=9011\nM98 P#144\nM30\n",
+        ("CALL_NUMBER=R144", "CALL CALL_NAME", "R144=9011", "CALL CALL_NAME")),
 ]
 
 
@@ -84,3 +101,38 @@ def test_edge_write_with_unknown_number_is_said_not_dropped():
     tp = nctrans.toolpath("G17 G90\n$TC_DP6[$AC_TIME+1]=2\nG0 X0\nM30\n", "sinumerik")
     list(tp)
     assert any(d.rule == "NC107" and d.line == 2 for d in tp.diagnostics), tp.diagnostics
+
+
+@pytest.mark.parametrize("iso, why", [
+    ("#1=41\nG#1\n#1=54\nG#1\nG0 X0\nM30\n", "two groups"),
+    ("#1=#4007\nG#1\nG0 X0\nM30\n", "not constants"),
+    ("#1=41\nG#[#1]\nG0 X0\nM30\n", "an expression, not one variable"),
+])
+def test_computed_g_the_program_does_not_pin_to_one_group_is_refused_at_its_line(iso, why):
+    conv = nctrans.transpile(iso, read="iso-m", write="sinumerik", strict=True)
+    assert not conv.ok
+    assert any(d.rule == "NC402" and d.severity == "error" and "G#" in d.message
+               for d in conv.diagnostics), (why, conv.diagnostics)
+
+
+def test_iso_computed_g_selects_the_code_it_names():
+    # hand-computed: G42 with radius 1 runs right of the +X move (Y=-1); G#1 = 38 is no modelled
+    # code (NC220, nothing selected); a vacant #2 leaves the word out (the control ignores it)
+    tp = nctrans.toolpath("G90 G17 G21\n#2402=1.\n#143=42\nG0 X0 Y0\nG1 G#143 X10 Y0 D2 F100\n"
+                          "X20\nG40 X30\n#1=38\nG#1\nG#2\nM30\n", "iso-m")
+    moves = [r for r in tp if r.kind == "linear"]
+    assert moves[0].end["Y"] == pytest.approx(-1.0)
+    assert moves[-1].end["Y"] == pytest.approx(0.0)
+    rules = [(d.rule, d.line) for d in tp.diagnostics]
+    assert ("NC220", 9) in rules and not any(line == 10 for _, line in rules)
+
+
+def test_sinumerik_indirect_call_runs_the_named_program():
+    text = ('DEF STRING[32] PNAME\nG90 G17 G71\nPNAME="/_N_WCS_DIR/_N_PART1_SPF"\nG0 X0 Y0\n'
+            "CALL PNAME\nM30\n%_N_PART1_SPF\nPROC PART1\nG1 X7 F100\nRET\n")
+    tp = nctrans.toolpath(text, "sinumerik")
+    moves = [r for r in tp if r.kind == "linear"]
+    assert [m.end["X"] for m in moves] == [pytest.approx(7.0)]
+    unknown = nctrans.toolpath("DEF STRING[8] PNAME\nG0 X0\nCALL PNAME\nM30\n", "sinumerik")
+    list(unknown)
+    assert any(d.rule == "NC107" and d.line == 3 for d in unknown.diagnostics), unknown.diagnostics

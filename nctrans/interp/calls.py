@@ -7,6 +7,7 @@ flow.py stays one generator. A mixin of Interpreter.
 """
 from __future__ import annotations
 
+import re
 from typing import Callable, Optional
 
 from nctrans.interp import sections
@@ -165,6 +166,33 @@ class CallsMixin:
                     self.ev.R[var.key] = v
             return sc
         return make
+
+    def _computed_call(self, s: n.SubCall) -> Optional[n.SubCall]:
+        """The call with its program named by the value computed now: ISO `M98 P#144` (the
+        number in named_args["P"]: program O<n>) or Sinumerik `CALL PROGNAME` (the string's last
+        path part without _N_ and _SPF: "/_N_WCS_DIR/_N_PART1_SPF" -> PART1). None, said at the
+        line, when the name cannot be known; the call is then skipped."""
+        import dataclasses
+        try:
+            if s.target is not None:
+                raw = self.ev.compile(s.target)()
+                if not isinstance(raw, str) or not raw.strip():
+                    raise EvalError("NC107", "the called program's name is not a string known to "
+                                    "the analysis", "warning")
+                name = re.sub(r"^_N_|_(?:SPF|MPF)$", "", raw.strip().rsplit("/", 1)[-1].upper())
+                return dataclasses.replace(s, name=name, target=None)
+            p = s.named_args.get("P")
+            v = self._value(self.ev.compile(p), "program number P") if p is not None else None
+            if v is None:
+                raise EvalError("NC107", "the called program's number is not known to the "
+                                "analysis", "warning")
+            if v != int(v) or v < 0:
+                raise EvalError("NC105", f"program number P{v:g} is not a program number")
+            rest = {k: e for k, e in s.named_args.items() if k != "P"}
+            return dataclasses.replace(s, name=f"O{int(v)}", named_args=rest)
+        except EvalError as ex:
+            self.diag(ex.rule, ex.severity, f"{ex.message}; the call is skipped")
+            return None
 
     def _opaque_call(self, s: n.SubCall) -> None:
         """A call nothing here defines: a "call" record (name, evaluated arguments in the order

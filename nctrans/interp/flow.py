@@ -454,6 +454,10 @@ class FlowMixin:
                 args = None
             else:
                 s, args, _ = self.modal_call
+            if not s.name:                  # M98 P#144, CALL PROGNAME: named as the call runs
+                s = self._computed_call(s)
+                if s is None:
+                    return unit, unit.code, pc, sidx
             callee = self._find_unit(s.name)
             if callee is None:
                 what = unmodelled_cycle(s.name)

@@ -285,7 +285,9 @@ class SubCall:
     kind: how the source spelled it ("m98", "g65", "g66", "call", "proc", "l") for emitters.
     bindings: where each named argument lands in the callee (ISO G65 "A" -> Var("num", 1)), so the
     interpreter binds arguments without dialect knowledge. Positional args bind to the callee's
-    Subprogram.params in order.
+    Subprogram.params in order. target: the program's name computed as the call runs (Sinumerik
+    indirect `CALL <string variable>`; name is then ""); an ISO `M98 P#144` keeps its number in
+    named_args["P"] with name "".
     """
     name: str
     args: list[Expr] = field(default_factory=list)
@@ -294,6 +296,7 @@ class SubCall:
     modal: str = "none"
     kind: str = ""
     bindings: dict[str, "Var"] = field(default_factory=dict)
+    target: Optional[Expr] = None
 
 
 @node

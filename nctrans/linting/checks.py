@@ -77,7 +77,7 @@ def _reads(stmt) -> Iterator[n.Var]:
     elif isinstance(stmt, n.VarDecl):
         yield from _exprs(stmt.init)
     elif isinstance(stmt, n.SubCall):        # bindings are where the callee receives, not reads
-        yield from _exprs([stmt.args, stmt.named_args, stmt.repeat])
+        yield from _exprs([stmt.args, stmt.named_args, stmt.repeat, stmt.target])
     else:
         yield from _exprs(stmt)
 

@@ -496,6 +496,8 @@ class FagorEmitter(FagorSpelling, Emitter):
             word("", f"$GOTO {target}", alone=True)
 
     def w_SubCall(self, s: n.SubCall, word, new_line, rest: list):
+        if s.target is not None:
+            raise NotExpressible("an indirect call (the called program's name is a string computed as the program runs)")
         self._subcall(s, word)
 
     def w_ModalCallOff(self, s: n.ModalCallOff, word, new_line, rest: list):

@@ -1337,6 +1337,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         return lines
 
     def w_SubCall(self, s: n.SubCall):
+        if s.target is not None:
+            raise NotExpressible("an indirect call (the called program's name is a string computed as the program runs)")
         self.forget()
         callee = None
         if self.program.dialect != self.dialect and s.name and pl.iso_number(s.name) is None:

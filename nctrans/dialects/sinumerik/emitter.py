@@ -42,7 +42,7 @@ from nctrans.dialects.sinumerik.spelling import format_number as _fmt
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
-from nctrans.lower import macro_procs, modal_numbers
+from nctrans.lower import computed_g, macro_procs, modal_numbers
 from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp.settable_frames import external_frame_variable
@@ -113,6 +113,10 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         # G65 macros written as PROCs with named parameters (nctrans.lower.macro_procs), and while
         # one is written, its locals #n by name
         self.procs = macro_procs.plan(program) if program.dialect != DIALECT else {}
+        self.indirect_g = computed_g.plan(program, self.t) if program.dialect != DIALECT else {}
+        self.unit_is_main = True
+        self.call_variables = (computed_g.call_variables(program)
+                               if program.dialect != DIALECT else ())
         self.local_names: dict[int, str] = {}
         self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
 
@@ -531,6 +535,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def w_Passthrough(self, s: ir.Passthrough, out: "_Line") -> None:
         if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
             out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
+        elif computed_g.is_computed_g(s):
+            self.computed_g(s, out)
         elif s.address and s.value is not None and s.address in _COMPUTED_WORDS:
             # a code word with a computed value (ISO M#501): the same word, Sinumerik syntax
             text = f"{s.address}={self.expr(s.value)}"
@@ -557,6 +563,21 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         else:
             self.refuse_because(f"{s.dialect} construct has no Sinumerik equivalent: {s.text} ({s.reason})")
             out.comment_extra.append(f"NC402 {s.dialect}: {s.text}")
+
+    def computed_g(self, s: ir.Passthrough, out: "_Line") -> None:
+        """ISO `G#143` as indirect G code: the group's index computed into the declared INT
+        variable in a line of its own, then `G[7]=<variable>` in the block (nctrans.lower.computed_g)."""
+        key = s.value.key if type(s.value) is ir.Var else None
+        found = self.indirect_g.get(key) if self.unit_is_main else None
+        if found is None:
+            raise NotExpressible(f"{s.text} (a computed G code: Sinumerik indirect G code needs the "
+                                 "G group, and this program does not set the variable to constants "
+                                 "of one group only)")
+        self.info("computed-g", f"computed G code {s.text} written as indirect G code "
+                  f"G[{found.family}]= (the program sets it to {', '.join(found.codes)} only)")
+        index = ir.Binary("-", s.value, ir.Num(found.offset)) if found.offset else s.value
+        out.alone(f"{found.variable}={self.expr(index)}")
+        out.words.append(f"G[{found.family}]={found.variable}")
 
     def external_offset(self, s: ir.DataSetting, out: "_Line") -> bool:
         """ISO G10 L2 P0 (absolute) as the external zero offset frame it writes, one axis
@@ -812,10 +833,11 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         return any(key(k) == key(name) for k in self.p.subprograms)
 
     def subcall(self, c: ir.SubCall, out: "_Line") -> None:
+        if c.target is not None:            # CALL PROGNAME, read from Sinumerik
+            out.words.append(f"CALL {self.expr(c.target)}")
+            return
         if not c.name and "P" in c.named_args and self.p.dialect != DIALECT:
-            # ISO M98 P#144: Sinumerik would say CALL "L" << R144, which nctrans does not analyse
-            self.refuse_because(f"the called program's number is computed (P={self.expr(c.named_args['P'])}): "
-                                "a Sinumerik indirect CALL is not analysed, so the conversion could not be proven")
+            self.indirect_call(c, out)
             return
         name = self.subname(c.name)
         if self.p.dialect != DIALECT and c.name and not self._defined(c.name):
@@ -853,6 +875,29 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             text += " " + self.word("P", c.repeat)
         out.words.extend(pre)
         out.words.append(text)
+
+    def indirect_call(self, c: ir.SubCall, out: "_Line") -> None:
+        """ISO `M98 P#144` as the Sinumerik indirect call of the program named L<number>: the
+        number into an INT variable, the name built from it in a STRING variable, `CALL <variable>`
+        (seed sinumerik-840d-advanced-programming L5110-5130: indirect calls pass no parameters).
+        The variables are declared at the top of the main program (computed_g.call_variables)."""
+        number = c.named_args["P"]
+        if (not self.unit_is_main or not self.call_variables or c.repeat is not None
+                or len(c.named_args) != 1 or c.args or c.modal != "none"):
+            self.refuse_because(f"the called program's number is computed (P={self.expr(number)}) "
+                                "in a call Sinumerik cannot make indirectly (repeated, with arguments, "
+                                "modal, or in a subprogram)")
+            return
+        count, name = self.call_variables
+        self.diags.append(at_span(
+            "NC404", "warning", f"the call of the program numbered P={self.expr(number)} is kept as an "
+            "indirect CALL of L<number>: the target control must provide the programs this file "
+            "does not define", self.span))
+        self.info("indirect-call", "ISO M98 P<expression> written as the indirect CALL of a STRING "
+                                   f'variable ("L"<<number)')
+        out.alone(f"{count}={self.expr(number)}")
+        out.alone(f'{name}="L"<<{count}')
+        out.alone(f"CALL {name}")
 
     def fresh_locals(self, c: ir.SubCall) -> list[str]:
         """A G65 call of a macro in this program written with R parameters: the macro's locals
@@ -1145,6 +1190,11 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             self.lines.append(f"%{meta['header']}")
         if meta.get("path"):
             self.lines.append(f";$PATH={meta['path']}")
+        for found in self.indirect_g.values():        # DEF before the first executable block
+            self.lines.append(f"DEF INT {found.variable}")
+        if self.call_variables:
+            self.lines.append(f"DEF INT {self.call_variables[0]}")
+            self.lines.append(f"DEF STRING[32] {self.call_variables[1]}")
         self.prologue(meta.get("defaults") or {})
 
     def flush(self, write) -> None:
@@ -1154,6 +1204,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             self.lines.clear()
 
     def subprograms(self) -> None:
+        self.unit_is_main = False       # what the main body declared is not seen here
         p = self.p
         meta = p.meta or {}
         entry = meta.get("entry")

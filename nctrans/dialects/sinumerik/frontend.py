@@ -646,6 +646,9 @@ class Lowerer:
                 target = expr(ch[1]) if ch[1] is not None else None
                 if isinstance(target, ir.Str) and ch[2] is None:
                     w.out.append(ir.SubCall(target.value.upper(), kind="call"))
+                elif type(target) is ir.Var and ch[2] is None:
+                    # CALL PROGNAME: the name is the string variable's value when the call runs
+                    w.out.append(ir.SubCall("", kind="call", target=target))
                 else:
                     w.out.append(ir.Passthrough(_t(text), "indirect call", DIALECT))
             elif d == "pcall_stmt":
