@@ -24,11 +24,13 @@ def diags(text: str) -> list[tuple]:
 
 
 def test_right_hand_tap_and_retract():
-    # K1.5 at S500: 750 mm/min both ways; G332 reverses the spindle, M3 turns it back
+    # K1.5 at S500: 750 mm/min both ways; G332 reverses the spindle and, retracted, it turns as
+    # before the G331 again (cw); the M3 after it is recorded too
     text = "G17 G90 G0 X10 Y20 Z5\nS500 M3\nG331 Z-20 K1.5\nG332 Z5 K1.5\nM3\nG0 Z50\nM30\n"
     assert events(text) == [("rapid", 5.0, None, None), ("spindle", "cw"),
                             ("linear", -20.0, 750.0, 1.5), ("spindle", "ccw"),
-                            ("linear", 5.0, 750.0, 1.5), ("spindle", "cw"), ("rapid", 50.0, None, None)]
+                            ("linear", 5.0, 750.0, 1.5), ("spindle", "cw"), ("spindle", "cw"),
+                            ("rapid", 50.0, None, None)]
     assert diags(text) == []
 
 
@@ -53,11 +55,11 @@ def test_tapping_ignores_f_and_restores_it_after():
     assert ev[2] == ("linear", 4.0, 100.0, None) and ev[-1] == ("linear", 6.0, 100.0, None)
 
 
-def test_modal_g331_taps_again_with_its_lead_and_without_it_refuses():
+def test_modal_g331_taps_again_with_its_lead():
     text = "G0 X0 Y0 Z5\nS100 M3\nG331 Z-5 K2\nZ-8 K2\nZ-9\nM30\n"
     ev = events(text)
-    assert ev[2:] == [("linear", -5.0, 200.0, 2.0), ("linear", -8.0, 200.0, 2.0)]
-    assert ("NC206", 5, "error") in diags(text)
+    assert ev[2:] == [("linear", -5.0, 200.0, 2.0), ("linear", -8.0, 200.0, 2.0), ("linear", -9.0, 200.0, 2.0)]
+    assert diags(text) == []
 
 
 def test_no_spindle_speed_is_an_error_and_no_move():
@@ -110,13 +112,13 @@ def test_sinumerik_output_keeps_g331_g332():
 def test_modal_stretch_is_lowered_whole_for_iso():
     """Axis words after G331/G332 still tap: the whole stretch up to G1/G0 is lowered, so no
     later block runs as a plain G33 in the wrong mode (hand-counted: 4 taps down, 2 up; the
-    spindle reversed once, before the first G332 move)."""
+    spindle reversed for each G332 block and back to M3 after it)."""
     text = ("G0 X0 Y0 Z5\nS500 M3\nG331 Z-20 K1.5\nZ-22 K1.5\nG1 X1 F100\nG331 Z-24 K1.5\n"
             "Z-25 K1.5\nG332 Z5 K1.5\nZ6 K1.5\nG0 Z10\nM30\n")
     want = [("rapid", 5.0, None, None), ("spindle", "cw"), ("linear", -20.0, 750.0, 1.5), ("linear", -22.0, 750.0, 1.5),
             ("linear", -22.0, 100.0, None), ("linear", -24.0, 750.0, 1.5),
-            ("linear", -25.0, 750.0, 1.5), ("spindle", "ccw"), ("linear", 5.0, 750.0, 1.5),
-            ("linear", 6.0, 750.0, 1.5), ("rapid", 10.0, None, None)]
+            ("linear", -25.0, 750.0, 1.5), ("spindle", "ccw"), ("linear", 5.0, 750.0, 1.5), ("spindle", "cw"),
+            ("spindle", "ccw"), ("linear", 6.0, 750.0, 1.5), ("spindle", "cw"), ("rapid", 10.0, None, None)]
     assert events(text) == want
     out = api.transpile(text, "sinumerik", "iso-m")
     assert events(out.text, "iso-m") == want
@@ -154,3 +156,35 @@ def test_p_f_reads_the_feed_in_its_own_unit():
     text = "G70 G1 X0 F100\nR1=$P_F\nG700 F4\nR2=$P_F\nG71 G0 X=R1 Y=R2\nM30\n"
     rapid = [r for r in nctrans.toolpath(text, "sinumerik") if r.kind == "rapid"][-1]
     assert (rapid.end["X"], rapid.end["Y"]) == (100.0, 4.0)
+
+
+# ---------------------------------------------------------------- modal lead, spindle after G332
+
+def test_modal_lead_taps_without_k_and_with_none_refuses():
+    # the lead is modal: Z-9 after K2 taps with 2 (200 mm/min at S100); G332 without K retracts
+    # with it too; a G331 with no lead ever programmed is NC206 and does not move
+    text = "G0 X0 Y0 Z5\nS100 M3\nG331 Z-5 K2\nZ-9\nG332 Z5\nM30\n"
+    ev = [e for e in events(text) if e[0] == "linear"]
+    assert ev == [("linear", -5.0, 200.0, 2.0), ("linear", -9.0, 200.0, 2.0), ("linear", 5.0, 200.0, 2.0)]
+    assert diags(text) == []
+    none = "G0 X0 Y0 Z5\nS100 M3\nG331 Z-5\nM30\n"
+    assert [e for e in events(none) if e[0] == "linear"] == []
+    assert ("NC206", 3, "error") in diags(none)
+
+
+def test_spindle_returns_after_g332_to_its_state_before_g331():
+    # right-hand tap under M3: G332 reverses (ccw), and once it has retracted the spindle turns
+    # clockwise again, recorded at the G332 line (4); standing before (M5) it stands again
+    text = "G0 X0 Y0 Z5\nS500 M3\nG331 Z-20 K1.5\nG332 Z5 K1.5\nG0 Z50\nM30\n"
+    recs = [(r.line, r.kind, r.spindle_dir) for r in nctrans.toolpath(text, "sinumerik") if r.kind == "spindle"]
+    assert recs == [(2, "spindle", "cw"), (4, "spindle", "ccw"), (4, "spindle", "cw")]
+    spos = "G0 X0 Y0 Z5\nS600 M5\nG331 Z-25 K2\nG332 Z5 K2\nG0 Z50\nM30\n"
+    assert [e for e in events(spos) if e[0] == "spindle"] == [("spindle", "off"), ("spindle", "cw"),
+                                                               ("spindle", "ccw"), ("spindle", "off")]
+    # M5 between the two: the retraction reverses, then the spindle stands as M5 left it
+    m5 = "G0 X0 Y0 Z5\nS500 M3\nG331 Z-10 K1\nM5\nG332 Z5 K1\nM30\n"
+    assert [e for e in events(m5) if e[0] == "spindle"] == [("spindle", "cw"), ("spindle", "off"),
+                                                             ("spindle", "ccw"), ("spindle", "off")]
+    for t in (text, spos):
+        out = api.transpile(t, "sinumerik", "iso-m")
+        assert out.text is not None and api.equiv(t, out.text, read_a="sinumerik", read_b="iso-m").equivalent

@@ -270,9 +270,13 @@ class CycleCallsMixin:
         p["pitch"] = lead
         p["feed"] = lead * st.spindle_speed / st.scale
         after = {3: "cw", 4: "ccw", 5: "off"}.get(int(p.get("sdac", 0) or 0))
+        before = None
+        if (s.name or "").upper() == "CYCLE84":     # taps with G331/G332 on the control
+            from nctrans.interp.rigid_tap import spindle_state
+            before = spindle_state(self)
         steps = tap_steps(plane=st.plane, approach=approach, bottom=bottom, retract=retract,
                           dwell_s=p.get("dwell"), forward="ccw" if kind == "tap_left" else "cw",
-                          after=after)
+                          after=after, before=before)
         return kind, steps
 
     def _deep_hole(self, p: dict, approach: float, bottom: float, retract: float):

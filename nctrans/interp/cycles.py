@@ -253,18 +253,24 @@ def deep_hole_steps(*, plane: str, vari: int, approach: float, rfp: float, botto
 
 
 def tap_steps(*, plane: str, approach: float, bottom: float, retract: float,
-              dwell_s: Optional[float], forward: str, after: Optional[str]) -> list[Step]:
+              dwell_s: Optional[float], forward: str, after: Optional[str],
+              before: Optional[str] = None) -> list[Step]:
     """Sinumerik CYCLE84/CYCLE840 at the current position [GK, Siemens cycles manual]: G0 to
     RFP+SDIS, tap to the depth (G331: spindle-synchronised), dwell DTB, spindle reversed and tap
     back (G332) to RFP+SDIS, spindle `after` (SDAC; else as before), G0 to RTP. The caller marks
-    the two linear steps as synchronised (the record's pitch)."""
+    the two linear steps as synchronised (the record's pitch). `before`: the spindle's state at
+    the call, which the control's G332 returns to before SDAC applies (nctrans.interp.rigid_tap);
+    None when the cycle does not tap with G331/G332."""
     ax = DRILL_AXIS[plane]
     up = 1.0 if approach >= bottom else -1.0
     reverse = "ccw" if forward == "cw" else "cw"
     steps: list[Step] = [("rapid", {ax: approach}), ("linear", {ax: bottom})]
     if dwell_s:
         steps.append(("dwell", dwell_s))
-    steps += [("spindle", reverse), ("linear", {ax: approach}), ("spindle", after or forward)]
+    steps += [("spindle", reverse), ("linear", {ax: approach})]
+    if before is not None and before != reverse:
+        steps.append(("spindle", before))
+    steps.append(("spindle", after or forward))
     steps.append(("rapid", {ax: retract if (retract - approach) * up > 0 else approach}))
     return steps
 

@@ -7,10 +7,16 @@ hand: positive a right-hand thread (spindle clockwise, as M3), negative a left-h
 [GK, Siemens Fundamentals, "Tapping without compensating chuck"]. G332 runs the spindle the other
 way (the control reverses it); the feed of both is lead x S, F is not read.
 
+The lead is modal: a G331/G332 block without I/J/K taps with the last lead programmed (the control
+keeps it [GK]); with none programmed before, the block is NC206 and moves nothing.
+
 The toolpath holds them as CYCLE84's tapping does (cycles.tap_steps): linear records carrying the
 pitch, and the spindle direction they need set (and recorded) where it changes: G331 turns it the
-thread's way, G332 the other way, and it stays so until the program says otherwise (M3/M4/M5), as
-a CYCLE84 written with G331/G332 and its SDAC leaves it.
+thread's way, G332 the other way. After each G332 move the spindle is back in the state it had
+before the tapping began (turning M3 or M4, or standing: M5, SPOS) [GK: the control reverses the
+spindle for G332 only; the seed is silent], recorded at the G332 block, so a following G332 block
+reverses it again; an M3/M4/M5 between G331 and G332 becomes that state. CYCLE84 (G331/G332 in
+the control's own code) does the same before its SDAC.
 
 Sinumerik G63, tapping with a compensating chuck (seed L24397: non-modal, group 2, written
 `G63 Z.. G1`): the block's move is a plain feed at F with the feed override held at 100 %; the
@@ -43,11 +49,16 @@ def rigid_tap_move(it, vals, center, motion: str) -> None:
     code = "G331" if motion == TAP else "G332"
     target = it._target(vals)
     leads = {w: v for w, v, _ in it._eval_words(center)} if center else {}
-    if not leads:
-        it.diag("NC206", "error", f"{code} without a thread lead (K, or I/J for X/Y): the move is not made")
-        return
-    travel = {w: abs(target.get(a, 0.0) - it.pos.get(a, 0.0)) for w, a in _AXIS_OF_LEAD}
-    lead = leads[max(leads, key=lambda w: travel.get(w, 0.0))]
+    if leads:
+        travel = {w: abs(target.get(a, 0.0) - it.pos.get(a, 0.0)) for w, a in _AXIS_OF_LEAD}
+        lead = leads[max(leads, key=lambda w: travel.get(w, 0.0))]
+        it.tap_lead = lead
+    else:
+        lead = getattr(it, "tap_lead", None)          # modal: the last lead programmed
+        if lead is None:
+            it.diag("NC206", "error", f"{code} without a thread lead (K, or I/J for X/Y), and none "
+                    "programmed before: the move is not made")
+            return
     if not lead:
         it.diag("NC206", "error", f"{code} with a zero lead: the move is not made")
         return
@@ -55,6 +66,9 @@ def rigid_tap_move(it, vals, center, motion: str) -> None:
         it.diag("NC206", "error", f"{code} with no spindle speed: the tapping feed (lead x S) is "
                 "unknown, the move is not made")
         return
+    before = getattr(it, "tap_spindle_before", None)
+    if before is None:                              # the tapping begins: remember the spindle
+        before = it.tap_spindle_before = spindle_state(it)
     hand = "cw" if lead > 0 else "ccw"
     turning = hand if motion == TAP else ("ccw" if hand == "cw" else "cw")
     if st.spindle_dir != turning or it.spindle_stopped:
@@ -62,6 +76,25 @@ def rigid_tap_move(it, vals, center, motion: str) -> None:
         it.spindle_stopped = False
         it._record("spindle", spindle_dir=turning, spindle=st.spindle_speed)
     it._lead_move(target, abs(lead))
+    if motion == RETRACT:                           # back to the state before the tapping
+        it.tap_spindle_before = None
+        if spindle_state(it) != before:
+            st.set("spindle", before)
+            it.spindle_stopped = before in ("off", "orient")
+            it._record("spindle", spindle_dir=before, spindle=st.spindle_speed)
+
+
+def spindle_state(it) -> str:
+    """The spindle's state as a direction: cw, ccw, or off/orient when it stands."""
+    d = it.st.spindle_dir
+    if it.spindle_stopped or d not in ("cw", "ccw"):
+        return d if d in ("off", "orient") else "off"
+    return d
+
+
+def spindle_programmed(it) -> None:
+    """M3/M4/M5 (or an orientation) between G331 and G332: the state G332 returns to is that one."""
+    it.tap_spindle_before = None
 
 
 def compensating_chuck(it) -> None:

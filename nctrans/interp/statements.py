@@ -75,6 +75,7 @@ class StatementsMixin:
             st.set(g, v)
             self.spindle_stopped = v == "off"
             self.spindle_reported = False
+            rigid_tap.spindle_programmed(self)
             self._record("spindle", spindle_dir=v, spindle=st.spindle_speed)
         elif g == "coolant":
             st.set(g, v)
