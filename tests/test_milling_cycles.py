@@ -640,6 +640,9 @@ def test_any_arguments_plan_or_refuse(name, data):
     try:
         if cyc["shape"] == "thread_turn":
             steps = thread_turn_steps(p, (30.0, 10.0))
+        elif cyc["shape"] == "thread_chain":
+            from nctrans.interp.milling_cycles import thread_chain_steps
+            steps = thread_chain_steps(p, (30.0, 10.0))
         elif cyc["shape"] == "groove":
             from nctrans.interp.grooving import groove_steps
             steps = groove_steps(p, data.draw(st.floats(0.1, 10), label="width"))

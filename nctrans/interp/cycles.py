@@ -397,7 +397,8 @@ class MillingCycle:
     __pydantic_config__ = {"extra": "forbid"}
     name: str
     shape: Literal["rect_pocket", "circ_pocket", "rect_pocket3", "circ_pocket4", "rect_spigot", "circ_spigot", "slots_circle",
-                   "arc_slots", "long_holes", "face", "thread_mill", "thread_turn", "stock_removal", "contour_mill", "groove"]
+                   "arc_slots", "long_holes", "face", "thread_mill", "thread_turn", "stock_removal", "contour_mill", "groove",
+                   "thread_chain"]
     params: list[str]
     meaning: str = ""
 

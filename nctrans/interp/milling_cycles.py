@@ -37,8 +37,8 @@ Modelling choices [NC] where the manual leaves the path to the control (or the s
   (internal) or from outside (external) by a straight feed.
 MCALL of a milling cycle calls it after every following block that moves in the plane, with the
 values its arguments had at the MCALL (`select_modal`).
-The lathe's thread cutting cycle CYCLE97 is planned here as well (`thread_turn_steps`, its facts
-and choices in its docstring). Finishing spindle speed SSF has no effect on the path and is not
+The lathe's thread cutting cycles CYCLE97 and CYCLE98 (chained threads) are planned here as well
+(`thread_turn_steps`, `thread_chain_steps`, their facts and choices in their docstrings). Finishing spindle speed SSF has no effect on the path and is not
 modelled. Calls that ask for what
 is not modelled (helical or oscillating insertion, a pre-machined blank, a floor allowance in
 SLOT1/SLOT2) say so (NC224) and move nothing.
@@ -758,6 +758,9 @@ def run_milling_cycle(interp, s) -> None:
     if cyc.shape == "thread_turn":
         _run_thread_turn(interp, cyc, s)
         return
+    if cyc.shape == "thread_chain":
+        _run_thread_turn(interp, cyc, s, thread_chain_steps)
+        return
     radius = _tool_radius(interp)
     if radius is None:
         interp.diag("NC224", "warning", f"{cyc.name} ({cyc.meaning}) needs the tool radius: no tool "
@@ -884,14 +887,95 @@ def thread_turn_steps(p: dict[str, float], start: tuple[float, float]) -> list[S
     return [s for i, s in enumerate(steps) if i == 0 or s[:2] != steps[i - 1][:2]]
 
 
-def _run_thread_turn(interp, cyc, s) -> None:
-    """CYCLE97 in the interpreter: X is the radius, Z the thread axis; the thread cuts are
-    spindle-synchronised (feed = lead x S, the records carry the lead as G33 moves do)."""
+# ---------------------------------------------------------------------------------------------
+# CYCLE98: chained threads on a lathe (up to three sections in one pass)
+
+def thread_chain_steps(p: dict[str, float], start: tuple[float, float]) -> list[Step]:
+    """CYCLE98 passes from `start` = (X radius, Z), as CYCLE97's (`thread_turn_steps`) but each
+    pass runs through the chain PO1 -> PO2 -> PO3 -> PO4 on the diameters DM1..DM4, the k-th
+    section with the lead PPk [GK, Siemens cycles manual]; APP runs in before PO1 and ROP out after
+    PO4. [NC] The run-in continues the first section's taper and the run-out the last one's;
+    each pass keeps its depth below the crest at every chain point; the sections must run one way
+    along Z and be threads, not faces (each at most 45 degrees steep): a chain that turns back or
+    a face section is not modelled (NC224)."""
+    _finite(p)
+    vari = int(p.get("VARI", 1))
+    if vari not in (1, 2, 3, 4):
+        raise _impossible(f"with VARI {vari} (1/3 external, 2/4 internal thread)")
+    if int(p.get("NUMTH", 1) or 1) > 1:
+        raise _unmodelled("with several thread starts NUMTH: not modelled")
+    zs = [p.get(f"PO{k}", 0.0) for k in range(1, 5)]
+    ds = [p.get(f"DM{k}", 0.0) for k in range(1, 5)]
+    leads = [abs(p.get(f"PP{k}", 0.0)) for k in range(1, 4)]
+    if any(d <= 0 for d in ds):
+        raise _impossible("with a diameter DM1..DM4 not above 0")
+    if any(lead <= 0 for lead in leads):
+        raise _impossible("without a thread pitch PP1, PP2 and PP3 for its three sections")
+    sp = 1.0 if zs[1] > zs[0] else -1.0
+    for a, b, da, db in zip(zs, zs[1:], ds, ds[1:]):
+        if (b - a) * sp <= _EPS:
+            raise _unmodelled("with sections that do not run one way along Z: not modelled")
+        if abs(db - da) / 2 > abs(b - a) + _EPS:
+            raise _unmodelled("with a section steeper than 45 degrees (a face thread): not modelled")
+    tdep, fal = abs(p.get("TDEP", 0.0)), abs(p.get("FAL", 0.0))
+    if tdep <= _EPS or fal >= tdep:
+        raise _impossible("with no thread depth TDEP (or a finishing allowance FAL not below it)")
+    nrc = max(1, int(p.get("NRC", 1) or 1))
+    nid = int(p.get("NID", 0) or 0)
+    if nrc > MAX_PASSES or nid > MAX_PASSES:
+        raise _impossible(f"with more than {MAX_PASSES} roughing cuts or idle passes")
+    app, rop = abs(p.get("APP", 0.0)), abs(p.get("ROP", 0.0))
+    slope0 = (ds[1] - ds[0]) / 2 / (zs[1] - zs[0])
+    slope1 = (ds[3] - ds[2]) / 2 / (zs[3] - zs[2])
+    chain = [(ds[0] / 2 - slope0 * sp * app, zs[0] - sp * app)] + \
+        [(d / 2, z) for d, z in zip(ds, zs)] + [(ds[3] / 2 + slope1 * sp * rop, zs[3] + sp * rop)]
+    pitch = [leads[0], leads[0]] + leads + [leads[2]]   # the lead of the move that ends at each point
+    external = vari in (1, 3)
+    sd = -1.0 if external else 1.0
+    crest = [(r if external else r - tdep, z) for r, z in chain]
+    vrt = abs(p.get("VRT", 0.0)) or 1.0
+    clear = (max(r for r, _ in crest) + vrt) if external else (min(r for r, _ in crest) - vrt)
+    rough = tdep - fal
+    if vari in (1, 2):
+        depths = [rough * k / nrc for k in range(1, nrc + 1)]
+    else:
+        depths = [rough * math.sqrt(k / nrc) for k in range(1, nrc + 1)]
+    if fal > 0:
+        depths.append(tdep)
+    depths += [tdep] * max(0, nid)
+    iang = p.get("IANG", 0.0)
+    tan = math.tan(math.radians(abs(iang))) if iang else 0.0
+    steps: list[Step] = []
+    x, z = start
+    z0 = chain[0][1]
+    if (x - clear) * sd > 0:
+        steps.append(("rapid", (clear, z)))
+    steps.append(("rapid", (clear, z0)))
+    for k, depth in enumerate(depths):
+        flank = -1.0 if iang < 0 and k % 2 else 1.0
+        shift = -sp * (tdep - depth) * tan * flank
+        steps.append(("rapid", (clear, z0 + shift)))
+        steps.append(("rapid", (crest[0][0] + sd * depth, z0 + shift)))
+        for i in range(1, len(crest)):
+            steps.append(("thread", (crest[i][0] + sd * depth, crest[i][1] + shift), pitch[i]))
+        steps.append(("rapid", (clear, crest[-1][1] + shift)))
+        if len(steps) > MAX_MOVES:
+            raise _impossible(f"with more than {MAX_MOVES} moves")
+    steps.append(("rapid", (clear, z0)))
+    out = [s for i, s in enumerate(steps) if i == 0 or s[:2] != steps[i - 1][:2]]
+    # a run-in or run-out of 0 leaves a thread move that goes nowhere
+    return [s for i, s in enumerate(out) if s[0] != "thread" or s[1] != out[i - 1][1]]
+
+
+def _run_thread_turn(interp, cyc, s, plan: Callable = thread_turn_steps) -> None:
+    """CYCLE97 (CYCLE98: plan = thread_chain_steps) in the interpreter: X is the radius, Z the
+    thread axis; the thread cuts are spindle-synchronised (feed = lead x S, the records carry the
+    lead as G33 moves do)."""
     st = interp.st
     try:
         if not st.spindle_speed:
             raise _impossible("with no spindle speed (the thread feed is the lead x S)")
-        steps = thread_turn_steps(call_values(interp, cyc, s), (interp.pos.get("X", 0.0), interp.pos.get("Z", 0.0)))
+        steps = plan(call_values(interp, cyc, s), (interp.pos.get("X", 0.0), interp.pos.get("Z", 0.0)))
     except MillingError as err:
         interp.diag(err.rule, err.severity, f"{cyc.name} {err.message}; the call is skipped and "
                     "moves nothing in the analysed toolpath")
