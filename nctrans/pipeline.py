@@ -311,9 +311,12 @@ def _parse_definition(path: Path, dialect: str) -> Optional[Program]:
     if not src.ok:
         return None
     try:
-        return get_dialect(dialect).parse(src.text, src.file).program
+        d = get_dialect(dialect)
     except PipelineError:
         return None
+    # parsed once per content and code version across processes (nctrans.parse_cache)
+    from nctrans import parse_cache
+    return parse_cache.definition(src.text, src.file, dialect, lambda: d.parse(src.text, src.file).program)
 
 
 def run_toolpath(program: Program, machine: Optional[Machine], diagnostics: list[Diagnostic], *,

@@ -261,3 +261,26 @@ def test_streamed_conversion_writes_what_the_whole_program_converts_to(target):
             assert result.text == "" and buf.getvalue() == whole and not resets
     finally:
         plainrun.native = saved
+
+
+def test_a_cam_program_runs_without_loading_the_grammar(tmp_path):
+    """Plain CAM blocks, `;` and `( )` comments, tool and spindle words need no parser: lark (~25 ms
+    of start-up with its tables) is never imported for them; a block that needs it loads it."""
+    import json
+    import subprocess
+    import sys
+    prog = tmp_path / "cam.nc"
+    prog.write_text("%CAM\n; CAM\nG71 G17 G90\nT1 M6 (tool)\nS1000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F100\n"
+                    "X10 Y0\nG2 X20 Y0 I5 J0\nM30\n")
+    code = ("import sys, nctrans.cli as c; c.main(['toolpath', sys.argv[1], '--from', 'fagor', '--format', "
+            "'jsonl']); print('lark' in sys.modules, file=sys.stderr)")
+    proc = subprocess.run([sys.executable, "-c", code, str(prog)], capture_output=True, text=True)
+    assert proc.stderr.strip().splitlines()[-1] == "False", proc.stderr
+    kinds = [json.loads(line)["kind"] for line in proc.stdout.splitlines()]
+    assert kinds == ["tool_change", "spindle", "rapid", "linear", "linear", "arc", "stop"]
+    arc = json.loads(proc.stdout.splitlines()[5])
+    assert arc["end"] == {"X": 20.0, "Y": 0.0, "Z": -1.0} and arc["center"] == {"X": 15.0, "Y": 0.0, "Z": -1.0}
+    prog.write_text("P100=2\nG1 X[P100*5] F100\nM30\n")
+    proc = subprocess.run([sys.executable, "-c", code, str(prog)], capture_output=True, text=True)
+    assert proc.stderr.strip().splitlines()[-1] == "True", proc.stderr
+    assert json.loads(proc.stdout.splitlines()[0])["end"]["X"] == 10.0

@@ -26,9 +26,6 @@ import re
 from functools import lru_cache
 from typing import Any, Optional
 
-from lark import Lark, Token, Tree
-from lark.exceptions import LarkError, UnexpectedCharacters, UnexpectedInput, UnexpectedToken
-
 from nctrans import limits, resources
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import ParseResult
@@ -73,9 +70,28 @@ NO_PATH_EFFECT = "directive"
 NUMBERED_AXIS = re.compile(r"^([XYZUVWABC])([1-9])$")
 
 
+class _LarkNotLoaded(Exception):
+    """What lark's names below stand for until _load_lark(): nothing is an instance of it."""
+
+
+# lark (~15 ms of start-up, and ~10 ms more for the cached tables) is imported when the first block
+# needs the grammar: blocks of letter-number words (_plain_items, the kernel's runs) never do, so a
+# CAM program runs without it. Until then its names are the placeholder above.
+Lark = Token = Tree = _LarkNotLoaded
+LarkError = UnexpectedCharacters = UnexpectedInput = UnexpectedToken = _LarkNotLoaded
+
+
+def _load_lark() -> None:
+    global Lark, Token, Tree, LarkError, UnexpectedCharacters, UnexpectedInput, UnexpectedToken
+    from lark import Lark, Token, Tree
+    from lark.exceptions import LarkError, UnexpectedCharacters, UnexpectedInput, UnexpectedToken
+
+
 @lru_cache(maxsize=1)
-def parser() -> Lark:
+def parser():
+    """The LALR parser of grammars/fagor.lark (tables cached on disk, see lark_cache)."""
     from nctrans.lark_cache import cache_option
+    _load_lark()
     return Lark(GRAMMAR.read_text(encoding="utf-8"), parser="lalr", lexer="basic", start=STARTS,
                 propagate_positions=False, maybe_placeholders=False, cache=cache_option("fagor"))
 
@@ -880,15 +896,14 @@ class Parser:
         body: list = []
         try:
             fast = _plain_items(head)
-            tree = Tree("start", fast) if fast is not None else (  # type: ignore[arg-type]
-                parser().parse(head, start="start") if head.strip() else Tree("start", []))
+            ch = fast if fast is not None else (
+                parser().parse(head, start="start").children if head.strip() else [])
         except UnexpectedInput as e:
             self._syntax(e, head, line)
             self.unit.current.append(ir.Block(span, [ir.Passthrough(code, "syntax error", DIALECT)],
                                               number, line.label, 0 if line.skip else None,
                                               line.comment))
             return
-        ch = tree.children
         if ch and isinstance(ch[0], Tree) and ch[0].data in _FLOW:
             if instr is not None:
                 self.error("NC002", "a $ statement stands alone in its block", line.lineno, line.col)
