@@ -10,7 +10,8 @@ the text) and the interpreter's peak is measured above it; the streamed parse + 
 (source text held by the caller) must stay flat. Then lint as users run it (lines/s in-process
 and through the CLI) and the per-file start-up of `nctrans lint` on small ISO and Sinumerik programs.
 Last, the peak resident memory of the CLI's `convert` (to every target, with and without --flatten)
-and `equiv` at 1x and 10x the program (`--peaks` runs only that table). Plain-text table; no assertions.
+and `equiv` at 1x and 10x the program, and of the program written as Fagor read back (toolpath,
+lint, convert) (`--peaks` runs only that table). Plain-text table; no assertions.
 """
 from __future__ import annotations
 
@@ -189,6 +190,8 @@ def peaks(text: str, name: str) -> tuple[float, float]:
 TARGET_ISO_X10 = 0.35          # ISO program x10: CLI toolpath time / rs274 on the same file
 TARGET_SINUMERIK = 2.0         # the program as Sinumerik: CLI toolpath / rs274 on the ISO original
 TARGET_SINUMERIK_MEMORY = 1.5  # Sinumerik x10 / x1: peak resident memory of the CLI toolpath
+# The project standard "memory flat in program size" for Fagor sources too (x10 / x1 peak RSS).
+TARGET_FAGOR_MEMORY = 1.5
 
 
 def conditions() -> str:
@@ -201,18 +204,22 @@ def targets(base: Path, repeat: int, tmp: Path) -> None:
     """The issue #7 targets in one run, side by side with rs274: the ISO program repeated ten
     times; the same program written as Sinumerik (nctrans convert --to sinumerik: `;` comments,
     G74 homing, tool length from D) against rs274 on the ISO original; the Sinumerik program's
-    peak memory at 10x against 1x; and the per-file start-up of `lint` on a small Sinumerik file.
+    peak memory at 10x against 1x; the same for the program written as Fagor (nctrans convert
+    --to fagor: `;` comments, D offsets), its time against rs274 on the ISO original and its
+    memory at 10x against 1x; and the per-file start-up of `lint` on a small Sinumerik file.
     Times are shown as wall and CPU (user + system of the process); a target is judged on the CPU
     ratio, which waiting for a core on a loaded machine does not inflate."""
     text = read_text(base)
     iso = {1: base, 10: tmp / "target-x10.nc"}
     iso[10].write_text(repeated(text, 10))
-    sin = {}
+    sin, fag = {}, {}
     for times, path in iso.items():
         sin[times] = tmp / f"target-x{times}.mpf"
-        subprocess.run(NCTRANS + ["convert", str(path), "--from", "iso-m", "--to", "sinumerik", "-o",
-                                  str(sin[times]), "--overwrite"], stdout=subprocess.DEVNULL,
-                       stderr=subprocess.DEVNULL)
+        fag[times] = tmp / f"target-x{times}-fagor.nc"
+        for dialect, out in (("sinumerik", sin[times]), ("fagor", fag[times])):
+            subprocess.run(NCTRANS + ["convert", str(path), "--from", "iso-m", "--to", dialect, "-o",
+                                      str(out), "--overwrite"], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL)
     rows = []
 
     def toolpath(path: Path, dialect: str):
@@ -233,15 +240,19 @@ def targets(base: Path, repeat: int, tmp: Path) -> None:
     timed_row("ISO x1: toolpath", toolpath(base, "iso-m"), rs1, None)
     if sin[1].exists():
         timed_row("Sinumerik x1: toolpath (rs274: ISO x1)", toolpath(sin[1], "sinumerik"), rs1, TARGET_SINUMERIK)
-    mem = {}
-    for times, path in sin.items():
-        if path.exists():
-            peaks_ = [peak_rss(NCTRANS + ["toolpath", str(path), "--from", "sinumerik", "--format", "jsonl",
-                                          ])[0] for _ in range(max(1, min(repeat, 3)))]
-            mem[times] = min(peaks_)
-    if len(mem) == 2:
-        rows.append(("Sinumerik toolpath max RSS MiB: x10 vs x1", mem[10], mem[1], ratio(mem[10], mem[1]),
-                     TARGET_SINUMERIK_MEMORY))
+    if fag[1].exists():
+        timed_row("Fagor x1: toolpath (rs274: ISO x1)", toolpath(fag[1], "fagor"), rs1, None)
+    for label, files, dialect, target in (("Sinumerik", sin, "sinumerik", TARGET_SINUMERIK_MEMORY),
+                                          ("Fagor", fag, "fagor", TARGET_FAGOR_MEMORY)):
+        mem = {}
+        for times, path in files.items():
+            if path.exists():
+                peaks_ = [peak_rss(NCTRANS + ["toolpath", str(path), "--from", dialect, "--format", "jsonl",
+                                              ])[0] for _ in range(max(1, min(repeat, 3)))]
+                mem[times] = min(peaks_)
+        if len(mem) == 2:
+            rows.append((f"{label} toolpath max RSS MiB: x10 vs x1", mem[10], mem[1], ratio(mem[10], mem[1]),
+                         target))
     small = STARTUP_PROGRAM
     if small.exists():
         t, cpu, rc = timed(NCTRANS + ["lint", str(small)], repeat)
@@ -430,7 +441,8 @@ def peak_rss(cmd: list[str]) -> tuple[float, float, int]:
 
 
 # (label, command after `nctrans`) of each CLI run whose peak memory `cli_peaks` measures; SRC is
-# the ISO program, MPF its conversion to Sinumerik (written by the first row), OUT a scratch output.
+# the ISO program, MPF its conversion to Sinumerik (written by the first row), FAG its conversion
+# to Fagor, OUT a scratch output.
 PEAK_RUNS = (
     ("convert --to sinumerik", ["convert", "SRC", "--from", "iso-m", "--to", "sinumerik", "-o", "MPF"]),
     ("convert --to iso-m", ["convert", "SRC", "--from", "iso-m", "--to", "iso-m", "-o", "OUT"]),
@@ -440,12 +452,16 @@ PEAK_RUNS = (
                                           "--flatten", "-o", "OUT"]),
     # the program's G28 blocks (and Fagor's missing cycles) are lowered to plain motion on their
     # own, streamed (nctrans.lower.stream_constructs)
-    ("convert --to fagor", ["convert", "SRC", "--from", "iso-m", "--to", "fagor", "-o", "OUT"]),
+    ("convert --to fagor", ["convert", "SRC", "--from", "iso-m", "--to", "fagor", "-o", "FAG"]),
     ("convert --flatten --to fagor", ["convert", "SRC", "--from", "iso-m", "--to", "fagor", "--flatten",
                                       "-o", "OUT"]),
     ("convert --to iso-t", ["convert", "SRC", "--from", "iso-m", "--to", "iso-t", "-o", "OUT"]),
     ("convert --flatten --to iso-t", ["convert", "SRC", "--from", "iso-m", "--to", "iso-t", "--flatten",
                                       "-o", "OUT"]),
+    # the program as Fagor (FAG, written by the `convert --to fagor` row) read back: streamed
+    ("toolpath --from fagor", ["toolpath", "FAG", "--from", "fagor", "--format", "jsonl"]),
+    ("lint --from fagor", ["lint", "FAG", "--from", "fagor"]),
+    ("convert --from fagor --to iso-m", ["convert", "FAG", "--from", "fagor", "--to", "iso-m", "-o", "OUT"]),
     ("equiv iso-m iso-m", ["equiv", "SRC", "SRC", "--from-a", "iso-m", "--from-b", "iso-m"]),
     ("equiv iso-m sinumerik", ["equiv", "SRC", "MPF", "--from-a", "iso-m", "--from-b", "sinumerik"]),
 )
@@ -468,7 +484,7 @@ def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
         mem, secs = [], []
         for times in (1, 10):
             names = {"SRC": tmp / f"peak-x{times}.nc", "MPF": tmp / f"peak-x{times}.mpf",
-                     "OUT": tmp / f"peak-out-x{times}.nc"}
+                     "FAG": tmp / f"peak-x{times}-fagor.nc", "OUT": tmp / f"peak-out-x{times}.nc"}
             m, s, rc = peak_rss(NCTRANS + [str(names.get(a, a)) for a in cmd])
             if rc >= 2:
                 notes.append(f"{label} x{times}: exit {rc}")
