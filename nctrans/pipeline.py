@@ -58,11 +58,26 @@ def get_dialect(name: str) -> base.Dialect:
     return d
 
 
+def _family_evidence_only(dialect: str, other: str) -> bool:
+    """`other`'s markers are those of a family `dialect` belongs to, for another kind of machine
+    (ISO milling's are the ISO family's): a lathe program with no lathe construct in it (G0/G1 on
+    X and Z, as a conversion from another control writes it) is still a lathe program, not
+    "clearly another dialect"."""
+    d, o = base.get(dialect), base.get(other)
+    if d is None or o is None:
+        return False
+    family = type(o).__mro__[1]
+    return (isinstance(d, family) and o.markers is getattr(family, "markers", None)
+            and d.machine_kind != o.machine_kind)
+
+
 def _wrong_dialect(src: _source.SourceText, dialect: str, guess: _detect.Guess) -> Optional[Diagnostic]:
     """NC005 when the text (whatever the file is called) is clearly another dialect than the one it
     is parsed as: strong markers of the other dialect and next to none of this one."""
     other, share, evidence = guess.content_leader()
     if other is None or other == dialect or share < WRONG_DIALECT_CONFIDENCE or evidence < WRONG_DIALECT_EVIDENCE:
+        return None
+    if _family_evidence_only(dialect, other):
         return None
     line, col, text = guess.first_marker.get(other, (1, 1, ""))
     what = f" ({text!r} at line {line})" if text else ""

@@ -136,3 +136,22 @@ def test_unknown_iso_g_code_is_refused_at_its_line_not_copied():
     assert conv.text is None or "G123" not in _code_words(conv.text)
     refused = [d for d in conv.diagnostics if d.rule == "NC402"]
     assert [d.line for d in refused] == [2] and "G123" in refused[0].message
+
+
+# ------------------------------------------------------------- what iso-t output reads back as
+
+def test_a_machine_axis_name_is_never_written_as_an_iso_turning_word():
+    text = "G18 G0 X20 Z5\nG1 XV=4 Z-10 F100\nG1 X30\nM30\n"
+    for target in ("iso-t", "iso-m"):
+        conv = _convert(text, target, read="sinumerik")
+        assert conv.text is None or "XV" not in conv.text, target
+        assert any(d.rule == "NC402" and d.line == 2 and "axis XV" in d.message for d in conv.diagnostics)
+
+
+def test_iso_turning_output_without_a_lathe_construct_reads_back_as_iso_turning():
+    # plain G0/G1 on X and Z: nothing in it is lathe-only, and nothing is another dialect's either
+    conv = _convert(COMPUTED_GOTO, "iso-t")
+    assert conv.ok and conv.text.startswith("%")
+    _, diags = _read_back(conv.text, "iso-t")
+    assert not [d for d in diags if d.rule.startswith("NC0")], [d.format_text() for d in diags]
+    # (a lathe program read as milling is still NC005: tests/test_iso_t.py)

@@ -41,6 +41,9 @@ class TurningEmitter(iso.IsoEmitter):
     def _axes(self, target: dict) -> list:
         words = []
         for k, av in target.items():
+            if k not in iso.AXES or len(k) != 1:
+                # a machine's own axis name (XV, C1): which ISO letter drives it is the machine's
+                raise iso.NotConvertible(f"the axis {k} (ISO axes are the letters {iso.AXES})", f"axis {k}")
             value = av.value
             if k == "X" and not self.diameter:
                 value = n.Num(2 * value.value) if type(value) is n.Num else n.Binary("*", value, n.Num(2.0))
