@@ -6,10 +6,17 @@ Cases from real probing and macro programs: ISO computed jumps (`GOTO #2`), Fanu
 (POPEN/PCLOS/DPRNT), Haas G103 and M29, unknown G codes."""
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+
 import nctrans
+from conftest import CORPUS
 from nctrans import api
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _convert(text: str, write: str, read: str = "iso-m") -> nctrans.Conversion:
@@ -155,3 +162,55 @@ def test_iso_turning_output_without_a_lathe_construct_reads_back_as_iso_turning(
     _, diags = _read_back(conv.text, "iso-t")
     assert not [d for d in diags if d.rule.startswith("NC0")], [d.format_text() for d in diags]
     # (a lathe program read as milling is still NC005: tests/test_iso_t.py)
+
+
+# ------------------------------------------------- the sweep: every corpus program, every target
+
+TARGETS = ("iso-m", "iso-t", "sinumerik", "fagor")
+_SHARED_DIALECT = {"iso-mill": "iso-m", "iso-turn": "iso-t", "linuxcnc": "iso-m", "sinumerik": "sinumerik"}
+# a real program small enough for the sweep to stay fast (the largest CAM files add only more of
+# the same G0/G1 blocks)
+_SWEEP_BYTES = 20_000
+# what a front end makes of text that is not its dialect's vocabulary (an unknown G code, a word
+# it cannot read); an M function it does not know is the machine builder's and stays allowed
+_NOT_VOCABULARY = ("syntax error", "unknown function", "unknown G code", "unknown code",
+                   "invalid number", "address without value")
+
+
+def _sweep_programs() -> list[tuple[str, str]]:
+    out = []
+    for d in TARGETS:
+        out += [(str(p), d) for p in sorted((ROOT / "corpus" / d).glob("*"))
+                if p.suffix.lower() not in (".def",)]
+    if CORPUS.is_dir():
+        for sub, d in _SHARED_DIALECT.items():
+            out += [(str(p), d) for p in sorted((CORPUS / sub).iterdir())
+                    if p.suffix.upper() not in (".DEF", ".DRS") and p.stat().st_size <= _SWEEP_BYTES]
+    return out
+
+
+def _foreign_words(program: ir.Program) -> list[ir.Passthrough]:
+    bodies = [program.body] + [s.body for s in (program.subprograms or {}).values()]
+    return [s for body in bodies for b in walk.blocks(body) for s in b.body
+            if isinstance(s, ir.Passthrough) and s.reason.startswith(_NOT_VOCABULARY)]
+
+
+@pytest.mark.parametrize("target", TARGETS)
+def test_every_corpus_program_converts_to_the_targets_own_vocabulary(target):
+    """Each program of the corpus converted to `target`: either refused with a located NC402, or
+    an output the target's own front end reads with no NC0xx and no word it does not know."""
+    problems = []
+    programs = [(p, d) for p, d in _sweep_programs() if d != target]
+    assert len(programs) > 40
+    for path, source in programs:
+        name = Path(path).name
+        conv = nctrans.transpile(Path(path), read=source, write=target)
+        if conv.text is None:
+            located = [d for d in conv.diagnostics if d.severity == "error" and d.line >= 1]
+            if not located:
+                problems.append(f"{name}: refused without a located error")
+            continue
+        program, diags = _read_back(conv.text, target)
+        problems += [f"{name}: {d.format_text()}" for d in diags if d.rule.startswith("NC0")]
+        problems += [f"{name}: {s.text!r} ({s.reason})" for s in _foreign_words(program)]
+    assert not problems, "\n".join(problems)
