@@ -214,3 +214,15 @@ def test_every_corpus_program_converts_to_the_targets_own_vocabulary(target):
         problems += [f"{name}: {d.format_text()}" for d in diags if d.rule.startswith("NC0")]
         problems += [f"{name}: {s.text!r} ({s.reason})" for s in _foreign_words(program)]
     assert not problems, "\n".join(problems)
+
+
+def test_iso_external_output_on_fagor_is_a_comment_and_kept_as_is_in_iso_turning():
+    fagor = _convert(PROBE_REPORT, "fagor")
+    assert fagor.ok
+    code = [line.split(";", 1)[0] for line in fagor.text.splitlines()]
+    assert not [c for c in code if any(w in c for w in ("POPEN", "PCLOS", "DPRNT", "G103", "M29"))]
+    assert {d.line for d in fagor.diagnostics if d.rule == "NC413"} == {1, 2, 3, 4, 5}
+    assert nctrans.equiv(PROBE_REPORT, fagor.text, read_a="iso-m", read_b="fagor")
+    # ISO turning is Fanuc macro B too: the same words mean the same there
+    lathe = _convert(PROBE_REPORT, "iso-t").text.splitlines()
+    assert "POPEN" in lathe and "DPRNT[X#5001[44]]" in lathe and "PCLOS" in lathe

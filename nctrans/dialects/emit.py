@@ -256,6 +256,15 @@ class Emitter(Spelling):
         text = f"lowered for {self.lowered_for}: {what}" if self.lowered_for else what
         self.diags.append(at_span("NC401", "info", text, self._where()))
 
+    def foreign_function_comment(self, s: n.Passthrough) -> str:
+        """NC413: a function of the source control with no effect on the path and no counterpart
+        here (ISO POPEN/DPRNT, Haas G103): the text of the comment that stands in its place, never
+        a word the target would read as something else."""
+        self.diags.append(at_span("NC413", "warning", f"{s.dialect} {s.text} has no {self.target_text} "
+                                  f"equivalent ({s.reason}): written as a comment; the toolpath is the "
+                                  "same, but what it does on its own control is not done", self._where()))
+        return f"NC413 {s.dialect}: {s.text}"
+
     def refuse(self, what: str) -> None:
         """NC402: the target cannot express `what`; the text leaves it out."""
         line = self.span.line if self.span is not None else 1

@@ -23,6 +23,7 @@ from nctrans.dialects.base import get as get_dialect
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
 from nctrans.ir import nodes as n
 from nctrans.ir import walk as ir_walk
+from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans.rules import load_table
 
 __all__ = ["FagorSpelling", "FagorEmitter", "NotExpressible", "format_number", "format_expr", "emit_program"]
@@ -556,6 +557,8 @@ class FagorEmitter(FagorSpelling, Emitter):
     def w_Passthrough(self, s: n.Passthrough, word, new_line, rest: list):
         if s.dialect == DIALECT:
             word("", s.text, alone=s.text.startswith("#"))
+        elif s.dialect and s.reason.startswith(NO_EFFECT_PREFIX):
+            word("", "; " + self.foreign_function_comment(s), alone=True)
         else:
             raise NotExpressible(f"{s.text!r} ({s.reason or 'kept verbatim'} from {s.dialect or 'the source'})")
 

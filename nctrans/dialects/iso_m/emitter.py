@@ -1638,6 +1638,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.forget()
         if s.dialect not in ("", self.dialect):
             from nctrans.interp.unmodelled import no_motion_effect
+            if self._same_in_target(s):
+                return [("", s.text)]
             if no_motion_effect(s.reason):
                 # a declaration, preprocessing stop, attribute ...: nothing to do on an ISO control,
                 # kept in sight as a comment
@@ -1646,6 +1648,18 @@ class IsoEmitter(IsoSpelling, Emitter):
                 return [("", self._comment(s.text.strip()))]
             raise NotConvertible(f"{s.dialect} text {s.text!r}", s.text.strip())
         return [("", s.text)]
+
+    def _same_in_target(self, s: n.Passthrough) -> bool:
+        """Text of another dialect that this dialect's own front end reads as the same construct
+        (ISO milling's POPEN/DPRNT in ISO turning: the same macro B words, the same meaning)."""
+        from nctrans.dialects.base import get
+        own = get(self.dialect)
+        if own is None or not s.text.strip() or "\n" in s.text:
+            return False
+        res = own.parse(s.text, "<passthrough>")
+        body = [x for b in res.program.body if isinstance(b, n.Block) for x in b.body]
+        return (not res.diagnostics and len(body) == 1 and isinstance(body[0], n.Passthrough)
+                and body[0].reason == s.reason)
 
     def w_DataSetting(self, s: n.DataSetting):
         classes = {("work_offset", False): "2", ("work_offset", True): "20", ("tool_length", False): "10",

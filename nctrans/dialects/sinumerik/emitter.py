@@ -551,11 +551,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         elif s.reason.startswith(NO_EFFECT_PREFIX):
             # the source control's own function with no effect on the path (ISO POPEN/DPRNT,
             # Haas G103, M29): never written as a Sinumerik word it does not mean
-            self.diags.append(at_span("NC413", "warning", f"{s.dialect} {s.text} has no Sinumerik "
-                                      f"equivalent ({s.reason}): written as a comment; the toolpath "
-                                      f"is the same, but what it does on its own control is not done",
-                                      self.span))
-            out.comment_extra.append(f"NC413 {s.dialect}: {s.text}")
+            out.comment_extra.append(self.foreign_function_comment(s))
         elif _reads_as_sinumerik(s.text, moves_allowed=s.reason != "directive"):
             self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect}: "
                                       f"{s.text} ({s.reason})", self.span))
