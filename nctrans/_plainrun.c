@@ -271,6 +271,9 @@ static int parse_block_as(const char *buf, int n, Block *b, int strict)
 static int parse_block(const char *buf, int n, Block *b) { return parse_block_as(buf, n, b, 0); }
 
 /* Exact powers of ten: every 10^k with k <= 22 is a double without rounding. */
+/* limits.MAX_COORDINATE: a coordinate beyond it is out of range (NC108, reported by Python) */
+#define MAX_COORDINATE 1e12
+
 static const double POW10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
                                1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
@@ -906,7 +909,7 @@ static PyObject *run(PyObject *self, PyObject *args)
             }
             for (int k = 0; k < naxes; k++) {
                 mend[k] = has_tot ? tgt[k] + tot[k] : tgt[k];
-                if (!isfinite(mend[k]))
+                if (!isfinite(mend[k]) || fabs(mend[k]) > MAX_COORDINATE)
                     bail = 1;
             }
             if (bail)
@@ -915,6 +918,9 @@ static PyObject *run(PyObject *self, PyObject *args)
                 double cp[3] = {c1, c2, tgt[pa[2]]};
                 for (int j = 0; j < 3; j++)
                     mc[j] = has_tot ? cp[j] + tot[pa[j]] : cp[j];
+                if (!(fabs(mc[0]) <= MAX_COORDINATE && fabs(mc[1]) <= MAX_COORDINATE
+                      && fabs(mc[2]) <= MAX_COORDINATE))
+                    break;          /* out of range: Python reports it (NC108) */
             }
             if (write) {
                 int el = spell_point(mend, naxes, axes, end_json);

@@ -661,6 +661,10 @@ def _main(argv: Optional[list[str]]) -> int:
             _err(f"--search-path {d}: not a directory")
             return EXIT_USAGE
     pipeline.SEARCH_PATHS[:] = getattr(args, "search_path", [])
+    from nctrans.limits import environment_errors
+    for problem in environment_errors():
+        _err(problem)
+        return EXIT_USAGE
     try:
         return args.func(args)
     except (UsageError, pipeline.PipelineError, api.NCError) as e:

@@ -56,15 +56,44 @@ MAX_UNROLLED = 500_000
 # first moves, says so in the plot, and NC011 names the line of the first move left out; the run
 # goes on to its end (its diagnostics). NCTRANS_MAX_PLOTTED_MOVES overrides it.
 MAX_PLOTTED_MOVES = 250_000
+# The largest coordinate (mm or degrees) a toolpath record holds: no machine travels a million
+# kilometres, and past it squares and sums of coordinates (lengths, times, bounds) overflowed.
+# Beyond it a move is out of range (NC108), as infinity is. The native kernel holds the same number.
+MAX_COORDINATE = 1e12
 # Elements of one declared array (DEF REAL A[n,m]): REP() and SET() walk them all.
 MAX_ARRAY_ELEMENTS = 1_000_000
 
 
+def _whole_number(text: str) -> Optional[int]:
+    """`text` as a whole number of ASCII digits (blanks around allowed), else None."""
+    text = text.strip()
+    return int(text) if text.isascii() and text.isdigit() else None
+
+
 def setting(name: str, default: int) -> int:
     """A limit from the environment (NCTRANS_<NAME>, a whole number), else `default`: for a shop
-    whose programs need more, and for the catalogue's examples, which need less."""
-    env = os.environ.get(f"NCTRANS_{name}", "")
-    return int(env) if env.isdigit() else default
+    whose programs need more, and for the catalogue's examples, which need less. A value that is
+    not a whole number is ignored here; the CLI refuses it first (environment_errors)."""
+    value = _whole_number(os.environ.get(f"NCTRANS_{name}", ""))
+    return default if value is None else value
+
+
+# The limits the environment may set (NCTRANS_<NAME>).
+SETTINGS = ("MAX_INPUT_BYTES", "MAX_BLOCK_CHARS", "MAX_STEPS", "MAX_LOWERED_BLOCKS", "MAX_UNROLLED",
+            "MAX_PLOTTED_MOVES", "MAX_DIAGNOSTICS")
+
+
+
+def environment_errors() -> list[str]:
+    """What is wrong with the limits set in the environment: a value that is not a whole number
+    (negative, a fraction, text) would otherwise be dropped silently for the default."""
+    out = []
+    for name in SETTINGS:
+        raw = os.environ.get(f"NCTRANS_{name}")
+        if raw is not None and raw.strip() and _whole_number(raw) is None:
+            out.append(f"NCTRANS_{name}={raw!r} is not a whole number of 0 or more "
+                       "(README \"Limits\")")
+    return out
 
 
 _OPERATOR_CHARS = re.compile(r"[-+*/<>=]|\b(?:AND|OR|XOR|MOD|NOT|B_AND|B_OR|B_XOR|B_NOT|DIV)\b",

@@ -212,14 +212,13 @@ def is_regular_file(path: str | Path) -> bool:
 
 
 def _too_large(path: str, size: int) -> SourceError:
-    return SourceError(f"{path}: {size} bytes is more than the {limits.MAX_INPUT_BYTES} bytes "
+    return SourceError(f"{path}: {size} bytes is more than the {max_input_bytes()} bytes "
                        "nctrans reads (README \"Limits\"; NCTRANS_MAX_INPUT_BYTES raises it)")
 
 
 def max_input_bytes() -> int:
     """The input size limit: limits.MAX_INPUT_BYTES, or NCTRANS_MAX_INPUT_BYTES when set."""
-    env = os.environ.get("NCTRANS_MAX_INPUT_BYTES", "")
-    return int(env) if env.isdigit() else limits.MAX_INPUT_BYTES
+    return limits.setting("MAX_INPUT_BYTES", limits.MAX_INPUT_BYTES)
 
 
 def read_bytes(path: str | Path, limit: Optional[int] = None) -> bytes:

@@ -27,6 +27,7 @@ from nctrans.interp.compiled import (BLOCK, CASE, EXEC, Frame, JFALSE, JUMP, MAX
 from nctrans.interp.cycles import unmodelled_cycle
 from nctrans.interp.evaluate import EvalError, UNKNOWN
 from nctrans.interp.native import KERNEL_BLOCKS
+from nctrans.limits import MAX_COORDINATE
 from nctrans.ir import nodes as n
 from nctrans.plainrun import JsonChunk, PlainRun
 from nctrans.toolpath import ToolpathRecord
@@ -406,7 +407,7 @@ class FlowMixin:
             if end is not None and not _finite_point(end, rec.center):
                 out.clear()
                 self.diag("NC108", "error", f"a coordinate of this {rec.kind} move is out of range "
-                          f"(infinite or not a number): {end}; the analysis stops here",
+                          f"(infinite, not a number, or beyond {MAX_COORDINATE:g}): {end}; the analysis stops here",
                           n.Span(rec.file, rec.line, 1))
                 raise _Stop()
             self._seq += 1
@@ -421,7 +422,12 @@ class FlowMixin:
         """Apply a control result from a statement: goto, call, return."""
         kind = ctl[0]
         if kind == "turning":
-            return self._turning_control(ctl[1], unit, pc, sidx)
+            try:
+                return self._turning_control(ctl[1], unit, pc, sidx)
+            except EvalError as ex:         # a parameter that cannot be evaluated (SQRT(-1))
+                self.diag(ex.rule, ex.severity, f"{ex.message}; the cycle is skipped and moves nothing "
+                          "in the analysed toolpath")
+                return unit, unit.code, pc, sidx
         if kind == "restart":
             return self._main, self._main.code, 0, 0
         if kind == "goto":
@@ -524,9 +530,11 @@ class FlowMixin:
 
 
 def _finite_point(end: dict, center: Optional[dict]) -> bool:
-    """No infinity or NaN in a record's end point or centre (a sum overflows only if a term is
-    ~1e308, which is out of any range anyway)."""
-    t = sum(end.values())
-    if center is not None:
-        t += sum(center.values())
-    return t - t == 0.0
+    """No infinity or NaN in a record's end point or centre, and no coordinate beyond
+    limits.MAX_COORDINATE (squared or summed by every consumer, 1e300 overflowed them)."""
+    for point in (end, center):
+        if point:
+            t = sum(point.values())
+            if t - t != 0.0 or max(point.values()) > MAX_COORDINATE or min(point.values()) < -MAX_COORDINATE:
+                return False
+    return True

@@ -101,6 +101,9 @@ def compensating_chuck(it) -> None:
     """G63 in a Sinumerik block (see the module doc): nothing to change under G1; else NC226."""
     motion = it.st.motion
     if motion == "linear":
+        if not it.st.spindle_speed:         # S0, or none programmed: the tap would not turn
+            it.diag("NC209", "warning", "G63 (tapping with compensating chuck) with no spindle speed "
+                    "(S0 or none): the tap does not turn and breaks; program S and M3/M4 first")
         return
     it.unmodelled_motion = "G63"
     it._unmodelled_at = it.span
