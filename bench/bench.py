@@ -170,6 +170,19 @@ def repeated(text: str, times: int) -> str:
     return "%\n" + "\n".join([body] * times) + "\nM30\n%\n"
 
 
+# What makes a CAM program structured (bench `--peaks`, second table): a subprogram called
+# twice, a G28 and a WHILE loop of peck drilling (G73: Sinumerik and Fagor lower it), then the
+# subprogram after M30, so the program is parsed whole (compact for runs, Dialect.parse_compact).
+STRUCTURE = ("G40 G80 G90\nM98 P2000 L2\nG28 G91 Z0\nG90\n#1=0\nWHILE[#1LT3]DO1\nG0 X[#1*10] Y0 Z5.\n"
+             "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nG80\n#1=#1+1\nEND1\n")
+
+
+def structured(text: str, times: int) -> str:
+    """repeated() with STRUCTURE after the body and the subprogram it calls after M30."""
+    body = repeated(text, times).removesuffix("\nM30\n%\n")
+    return body + "\n" + STRUCTURE + "M30\nO2000\nG91 G1 X1. F100.\nY1.\nG90\nM99\n%\n"
+
+
 def peaks(text: str, name: str) -> tuple[float, float]:
     """(peak MiB while parsing, peak MiB above the parsed IR while interpreting + serialising)."""
     gc.collect()
@@ -473,21 +486,30 @@ def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
     holds, 0.6 MB -> 5.7 MB here)."""
     print("CLI peak memory (max RSS of the process, MiB) and wall time at 1x and 10x the program")
     text = read_text(base)
+    for kind in ("straight", "structured"):
+        _peak_table(kind, base, text, tmp, notes)
+
+
+def _peak_table(kind: str, base: Path, text: str, tmp: Path, notes: list) -> None:
+    """cli_peaks of the program as it is (straight) or made structured (structured())."""
     sizes = []
     for times in (1, 10):
-        src = tmp / f"peak-x{times}.nc"
-        src.write_text(repeated(text, times) if times > 1 else text)
+        src = tmp / f"peak-{kind}-x{times}.nc"
+        if kind == "structured":
+            src.write_text(structured(text, times))
+        else:
+            src.write_text(repeated(text, times) if times > 1 else text)
         sizes.append(src.stat().st_size / 2**20)
-    print(f"{base.name}: {sizes[0]:.1f} MB and {sizes[1]:.1f} MB")
+    print(f"{base.name} ({kind}): {sizes[0]:.1f} MB and {sizes[1]:.1f} MB")
     print(f"{'run':34} {'1x MiB':>8} {'10x MiB':>8} {'10x/1x':>7} {'1x s':>7} {'10x s':>7}")
     for label, cmd in PEAK_RUNS:
         mem, secs = [], []
         for times in (1, 10):
-            names = {"SRC": tmp / f"peak-x{times}.nc", "MPF": tmp / f"peak-x{times}.mpf",
-                     "FAG": tmp / f"peak-x{times}-fagor.nc", "OUT": tmp / f"peak-out-x{times}.nc"}
+            names = {"SRC": tmp / f"peak-{kind}-x{times}.nc", "MPF": tmp / f"peak-{kind}-x{times}.mpf",
+                     "FAG": tmp / f"peak-{kind}-x{times}-fagor.nc", "OUT": tmp / f"peak-{kind}-out-x{times}.nc"}
             m, s, rc = peak_rss(NCTRANS + [str(names.get(a, a)) for a in cmd])
             if rc >= 2:
-                notes.append(f"{label} x{times}: exit {rc}")
+                notes.append(f"{kind} {label} x{times}: exit {rc}")
             mem.append(m)
             secs.append(s)
         print(f"{label:34} {mem[0]:>8.1f} {mem[1]:>8.1f} {mem[1] / mem[0]:>7.2f} {secs[0]:>7.2f} {secs[1]:>7.2f}")

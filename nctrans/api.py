@@ -137,21 +137,22 @@ def _machine(machine: MachineLike, dialect: Optional[str]) -> Machine:
 
 
 def _load(source: Union[str, "os.PathLike[str]", _source.SourceText], dialect: Optional[str], *,
-          stream: bool = False, file: str = STRING_LABEL, fallback: Optional[str] = None) -> pipeline.Loaded:
+          stream: bool = False, file: str = STRING_LABEL, fallback: Optional[str] = None,
+          compact: bool = False) -> pipeline.Loaded:
     """Read and parse text (a str) or a file (a PathLike). The CLI also passes already decoded
-    standard input (a SourceText)."""
+    standard input (a SourceText). `compact`: see pipeline.load_source (runs only)."""
     _check_dialect(dialect)
     with _api_errors():
         if isinstance(source, _source.SourceText):
-            return pipeline.load_source(source, _source.STDIN, dialect, stream, fallback)
+            return pipeline.load_source(source, _source.STDIN, dialect, stream, fallback, compact)
         if isinstance(source, str):
             return pipeline.load_source(_source.from_text(source, file), _source.STDIN, dialect, stream,
-                                        fallback)
+                                        fallback, compact)
         if isinstance(source, os.PathLike):
             path = os.fspath(source)
             if os.path.isdir(path):
                 raise NCInputError(f"{path}: is a directory (lint takes directories)")
-            return pipeline.load(path, dialect, stream, fallback)
+            return pipeline.load(path, dialect, stream, fallback, compact)
     raise NCInputError(f"source must be program text (str) or a path (os.PathLike), not {type(source).__name__}")
 
 
@@ -231,7 +232,8 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     long it is. On refusal what was written must be discarded (reset() or OutputFile.discard())."""
     _check_dialect(write)
     with _search_path(search_path):
-        ld = _load(text, read, file=file, stream=out is not None)
+        # --flatten written as it runs only runs the program: compact when it holds structure
+        ld = _load(text, read, file=file, stream=out is not None, compact=flatten and out is not None)
         _set_profile(ld, profile)
         with _api_errors():
             target = pipeline.get_dialect(write)
@@ -467,7 +469,7 @@ def toolpath(source: Source, dialect: Optional[str] = None, machine: MachineLike
             records = pipeline.run_toolpath(source, m, diags, dialect=dialect or source.dialect)
         return Toolpath(run(records), diags, source.file, dialect or source.dialect)
     with _search_path(dirs):
-        ld = _load(source, dialect, stream=True, file=file)
+        ld = _load(source, dialect, stream=True, file=file, compact=True)
     m = _machine(machine, ld.dialect)
     return Toolpath(run(pipeline.toolpath_of(ld, m)), ld.diagnostics, ld.label, ld.dialect,
                     parsed=ld.program is not None)

@@ -94,8 +94,8 @@ _CHECK_HEAD = 4 * 1024
 
 
 def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Optional[str] = None,
-                stream: bool = False, fallback: Optional[str] = None) -> Loaded:
-    """Parse already-read text: choose the dialect (given, else the file's own `nctrans: dialect=`
+                stream: bool = False, fallback: Optional[str] = None, compact: bool = False) -> Loaded:
+    """Parse already-read text (`compact`: see Dialect.parse_compact; for runs only): choose the dialect (given, else the file's own `nctrans: dialect=`
     pragma, else `fallback` (the project configuration's), else detected), parse, collect
     diagnostics. With `stream` the parse may be lazy (Dialect.streams): the program must then be
     run exactly once, through toolpath_of or lint, which complete the diagnostics."""
@@ -119,6 +119,13 @@ def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Opt
         if result is not None:
             return Loaded(path, label, src, dialect, result.program, diags, guess,
                           streamed=result.diagnostics)
+    if compact:
+        # only run (toolpath, equiv, --flatten): a structured program whose plain stretches are
+        # held as spans of the text (Dialect.parse_compact), complete like a whole parse
+        result = d.parse_compact(src.text, label)
+        if result is not None:
+            _add_parse_diagnostics(diags, result.diagnostics, src, dialect, guess)
+            return Loaded(path, label, src, dialect, result.program, diags, guess)
     result = d.parse(src.text, label)
     _freeze_for_process(result.program)
     _add_parse_diagnostics(diags, result.diagnostics, src, dialect, guess)
@@ -191,14 +198,14 @@ def finish_stream(ld: Loaded) -> None:
 
 
 def load(path: str, dialect: Optional[str] = None, stream: bool = False,
-         fallback: Optional[str] = None) -> Loaded:
+         fallback: Optional[str] = None, compact: bool = False) -> Loaded:
     """Read, decode, detect and parse one file ('-' = stdin). PipelineError if it cannot be read.
     `stream`, `fallback`: see load_source."""
     try:
         src = _source.read_source(path)
     except _source.SourceError as e:
         raise PipelineError(str(e)) from None
-    return load_source(src, path, dialect, stream, fallback)
+    return load_source(src, path, dialect, stream, fallback, compact)
 
 
 def _pragma_dialect(src: _source.SourceText) -> Optional[str]:

@@ -47,6 +47,23 @@ class EmitResult:
     diagnostics: list[Diagnostic] = field(default_factory=list)
 
 
+class CompactBody:
+    """The main body of a Program parsed compact (Dialect.parse_compact): its items in order,
+    each run of plain blocks as a PlainRun read again from the text when it runs. Not a list, so
+    the interpreter runs it batch by batch as a streamed body (iterated again, it starts over);
+    only the interpreter and the streamed flattening take it (they take PlainRuns apart)."""
+    __slots__ = ("items",)
+
+    def __init__(self, items: list):
+        self.items = items
+
+    def __iter__(self):
+        return iter(self.items)
+
+    def drain(self) -> None:
+        """Nothing is left to parse."""
+
+
 class StreamedBody:
     """The main body of a streamed Program (Dialect.parse_stream): iterating it parses the next
     blocks, once. The interpreter runs each block as it comes and drops it; `drain()` parses what
@@ -153,6 +170,11 @@ class Dialect:
         from a streamed parse), handing the text to `write` as it is produced: emit()'s text and
         diagnostics without holding either whole. None when this dialect does not stream its
         output (the caller then emits the whole program)."""
+        return None
+
+    def parse_compact(self, text: str, file: str = "<stdin>") -> Optional[ParseResult]:
+        """A whole parse whose main body is a CompactBody, or None (parse() then): for the runs
+        of a program that holds structure (loops, calls) around long plain stretches."""
         return None
 
     def parse_stream(self, text: str, file: str = "<stdin>") -> Optional[ParseResult]:

@@ -122,7 +122,12 @@ class _Walker:
         if id(p) in self.seen_programs:
             return
         self.seen_programs.add(id(p))
-        self.nodes(p.body)
+        if type(p.body) is list:
+            self.nodes(p.body)
+        else:                       # a compact body (base.CompactBody): its runs taken apart
+            from nctrans.convert import stream_chunks
+            for chunk in stream_chunks(p.body, 256):
+                self.nodes(chunk)
         for sub in (p.subprograms or {}).values():
             self.nodes(sub.body)
 
@@ -478,7 +483,8 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
     if machine is None:
         from nctrans.machine import default_mill
         machine = default_mill()
-    streamed = type(program.body) is not list
+    from nctrans.dialects.base import CompactBody
+    streamed = type(program.body) is not list and type(program.body) is not CompactBody
     first_diag = len(diagnostics)
     # A streamed body (a straight program parsed as it runs) is walked block by block as the
     # interpreter takes it; its notes go where the whole walk would have put them, first.

@@ -105,6 +105,10 @@ class IsoFamily(Dialect):
         from .frontend import parse_stream
         return parse_stream(text, file, self.lowering())
 
+    def parse_compact(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        from .frontend import parse_compact
+        return parse_compact(text, file, self.lowering())
+
     def emit(self, program) -> EmitResult:
         from .emitter import emit_program
         return emit_program(program, self.emitter())

@@ -882,6 +882,47 @@ def _parse_program(text: str, file: str, lowering: type[Lowering]):
     return ParseResult(program, diags)
 
 
+def parse_compact(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lowering):
+    """A whole parse whose main body is held compact (base.CompactBody): each run of plain lines
+    at its top level is one PlainRun (a span of the text, read again when it runs) instead of its
+    Blocks (~1.2 KiB each), so a CAM body of millions of lines around a few loops and calls costs
+    little. The interpreter runs such a body as it runs a streamed one, batch by batch, which
+    holds only where nothing jumps back into the main body: None when anything may (a GOTO or an
+    M99 in it, M99 ending it (a restart), an M99 P return to one of its block numbers), or when
+    nothing would be compacted
+    (without the native kernel there are no runs): parse_program then."""
+    from nctrans.dialects.base import CompactBody, ParseResult
+    if plainrun.native is None:
+        return None
+    gc_was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        diags: list[Diagnostic] = DiagnosticList()
+        program = Program(file, lowering.dialect, [], {}, {}, None)
+        for _ in _parse_lines(text, file, program, diags, program.body, False, lowering, compact=True):
+            pass
+    finally:
+        if gc_was_enabled:
+            gc.enable()
+    items = program.body
+    if not any(type(x) is plainrun.PlainRun for x in items) or _jumps_into_main(program):
+        return None
+    program.body = CompactBody(items)
+    return ParseResult(program, diags)
+
+
+def _jumps_into_main(program: Program) -> bool:
+    """Whether anything may jump to a place in the main body (see parse_compact)."""
+    from nctrans.ir.walk import blocks
+    from nctrans.ir import nodes as n
+    main = [x for x in program.body if type(x) is not plainrun.PlainRun]
+    if any(type(s) in (n.Goto, n.Return, n.SectionRepeat) or (type(s) is n.ProgramEnd and s.kind == "restart")
+           for b in blocks(main) for s in b.body):
+        return True
+    return any(type(s) is n.Return and s.to_label for sub in program.subprograms.values()
+               for b in blocks(sub.body) for s in b.body)
+
+
 # What needs the main body held whole: a jump (GOTO, IF, WHILE/DO/END, M99 P), a call (M98, M97,
 # G65, G66/G67, M17/M99 returns) or a macro expression (# [ ]). Matches inside comments are skipped;
 # anything else that matches only costs the streaming (the full parse is always correct).
@@ -992,7 +1033,7 @@ class _Lines:
 
 
 def _parse_lines(text: str, file: str, program: Program, diags: list, main: list, stream: bool,
-                 lowering: type[Lowering] = Lowering):
+                 lowering: type[Lowering] = Lowering, compact: bool = False):
     """The parse proper. Fills program.meta/name/subprograms and `main`; with `stream` the blocks
     of the main body are yielded (and dropped from `main`) line by line instead."""
     low = lowering(file, diags)
@@ -1018,10 +1059,11 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                                 file, 1))
         text = text.replace("\x00", "")
     sep = "\n" if "\n" in text else "\r"
-    lines = _Lines(text, sep) if stream else enumerate(text.split(sep), 1)
+    lines = _Lines(text, sep) if stream or compact else enumerate(text.split(sep), 1)
     # Streamed and with the native kernel: runs of plain lines become one PlainRun each.
-    plain_scan = plainrun.native.scan if stream and plainrun.native is not None and not low.standard \
-        and low.plain_runs else None
+    # Compact (parse_compact): runs at the top of the main body become PlainRuns too, held.
+    plain_scan = plainrun.native.scan if (stream or compact) and plainrun.native is not None \
+        and not low.standard and low.plain_runs else None
     plain_line = low.plain_line
     fast_plain = PLAIN.fullmatch
     fast_words = WORD.findall
@@ -1050,7 +1092,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
             main_seen = True
             yield from main
             main.clear()
-        if plain_scan is not None and cur is main:
+        if plain_scan is not None and cur is main and not stack:
             # A run starts here when its first PLAIN_RUN_MIN lines are plain. Where it ends the
             # kernel finds as it runs it (one pass over the lines), before the body is iterated
             # on; else extent() finds it with scan().
@@ -1059,7 +1101,10 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 run = plainrun.PlainRun.open(file, text, lines.start, lineno, sep, plain_line, low.motion,
                                              low.cycle, low.arc_abs, False, max_block)
                 main_seen = True
-                yield run
+                if stream:
+                    yield run
+                else:
+                    main.append(run)
                 ends = run.extent()
                 lines.skip_to(ends.pos, ends.line - lineno)
                 low.motion, low.cycle = ends.motion, ends.cycle
