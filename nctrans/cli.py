@@ -293,7 +293,8 @@ def cmd_lint(args) -> int:
 
 def cmd_toolpath(args) -> int:
     _check_dialect(args.from_)
-    ld = pipeline.load(args.src, args.from_, stream=True)
+    # a structured program is only run here: compact (its plain stretches as spans of the text)
+    ld = pipeline.load(args.src, args.from_, stream=True, compact=True)
     machine = pipeline.load_machine(args.machine, ld.dialect)
     if ld.program is None:
         _print_text_diags(ld.diagnostics, sys.stderr)

@@ -5,12 +5,13 @@ runs it must give what the whole parse gives: the toolpath and the flattened con
 compared with the whole parse's on generated programs and on every corpus program it takes."""
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import pytest
 
 from conftest import CORPUS
-from nctrans import api, pipeline, plainrun
+from nctrans import api, pipeline, plainrun, toolpath_io
 from nctrans.dialects.base import CompactBody
 from nctrans.dialects.iso_m.frontend import parse_compact
 from nctrans.source import from_text
@@ -72,6 +73,13 @@ def _compare(text: str, name: str) -> None:
     a, b = list(pipeline.toolpath_of(whole)), list(pipeline.toolpath_of(compact))
     assert [r.to_dict() for r in a] == [r.to_dict() for r in b]
     assert [d.format_text() for d in whole.diagnostics] == [d.format_text() for d in compact.diagnostics]
+    # `nctrans toolpath` (jsonl): the runs go through the native kernel
+    texts = []
+    for ld in (pipeline.load_source(src, name, "iso-m"), pipeline.load_source(src, name, "iso-m", compact=True)):
+        buf = io.StringIO()
+        toolpath_io.write_jsonl(pipeline.toolpath_of(ld, fast_sink="jsonl"), buf)
+        texts.append((buf.getvalue(), [d.format_text() for d in ld.diagnostics]))
+    assert texts[0] == texts[1]
     for target in ("iso-m", "sinumerik", "fagor"):
         held = api.transpile(text, "iso-m", target, flatten=True, file=name)
         sink = Sink()

@@ -496,3 +496,57 @@ def test_plain_mpf_calling_a_subprogram_by_name_is_sinumerik(tmp_path):
     assert rc == 0 and "sinumerik" in out and "ambiguous" not in out + err
     rc, out, _ = run("toolpath", f.name, cwd=tmp_path)
     assert rc == 0 and '"X":5.0' in out
+
+
+def _structured_program(path: Path, cam_lines: int) -> None:
+    """An ISO macro program: `cam_lines` CAM moves (lines 4..) around a subprogram called twice,
+    a G28 and a WHILE loop of peck drilling (G73), the subprogram after M30."""
+    half = cam_lines // 2
+    with path.open("w") as fh:
+        fh.write("%\nO1000\nG21 G90 G17 G40 G49 G80 G1 F500\n")
+        for lo, hi in ((0, half), (half, cam_lines)):
+            for i in range(lo, hi, 10_000):
+                fh.write("".join(f"G1 X{j % 997}.125 Y{j % 389}.25 Z-{j % 7}.5\n" for j in range(i, min(i + 10_000, hi))))
+            if lo == 0:
+                fh.write("M98 P2000 L2\nG28 G91 Z0\nG90\n#1=0\nWHILE[#1LT3]DO1\nG0 X[#1*10] Y0 Z5.\n"
+                         "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nG80\n#1=#1+1\nEND1\nG1 F500\n")
+        fh.write("M30\nO2000\nG91 G1 X1. F100.\nY1.\nG90\nM99\n%\n")
+
+
+def test_thirty_megabyte_macro_program_runs_in_bounded_memory(tmp_path):
+    """30 MB of ISO macro program (1.2 M CAM moves around calls and a loop) is parsed whole, its
+    plain stretches held as spans of the text (Dialect.parse_compact): the whole IR took ~1.2 KiB
+    per block (1.4 GiB here). Every CAM line gives its one move, and the run reaches M30."""
+    n = 1_200_000
+    f = tmp_path / "macro.nc"
+    _structured_program(f, n)
+    assert f.stat().st_size > 30_000_000
+    end_line = n + 15                                   # 3 header lines, 11 of structure, then M30
+    p = subprocess.Popen([*NCTRANS, "toolpath", f.name, "--from", "iso-m"], cwd=tmp_path,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_limits)
+    cam = 0
+    last = b""
+    for rec in p.stdout:
+        m = re.search(rb'"line":(\d+)', rec)
+        line = int(m.group(1))
+        if 4 <= line < 4 + n // 2 or 4 + n // 2 + 11 <= line < end_line:
+            cam += 1
+        last = rec
+    err = p.stderr.read().decode()
+    assert p.wait() == 0 and "NC205" not in err, err
+    assert cam == n and b'"kind":"stop"' in last and f'"line":{end_line},'.encode() in last
+
+
+@pytest.mark.parametrize("command", ["convert-flatten", "equiv"])
+def test_structured_program_flattens_and_compares_in_bounded_memory(tmp_path, command):
+    """A 6 MB macro program converted with --flatten (to Fagor, which lacks G73) and compared
+    with itself: run compact, not held whole (~300 MiB held whole at this size)."""
+    f = tmp_path / "macro.nc"
+    _structured_program(f, 240_000)
+    if command == "equiv":
+        rc, out, err = run("equiv", f.name, f.name, "--from-a", "iso-m", "--from-b", "iso-m", cwd=tmp_path)
+        assert rc == 0 and "equivalent" in out, err
+        return
+    rc, _, err = run("convert", f.name, "--from", "iso-m", "--to", "fagor", "--flatten", "-o", "m.out", cwd=tmp_path)
+    text = (tmp_path / "m.out").read_text()
+    assert rc == 0 and "G73" not in text and text.count("\n") > 240_000, err
