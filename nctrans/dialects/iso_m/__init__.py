@@ -106,6 +106,9 @@ class IsoFamily(Dialect):
         return parse_stream(text, file, self.lowering())
 
     def parse_compact(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        """None for a member with a front end of its own (Fagor, ISO turning): parse() then."""
+        if type(self).parse is not IsoFamily.parse:
+            return None
         from .frontend import parse_compact
         return parse_compact(text, file, self.lowering())
 
