@@ -31,6 +31,12 @@ def register(interp) -> None:
         before = interp.ev.indexed_system.get(name)
         interp.ev.indexed_system[name] = (
             lambda idx, kind=kind, before=before: _read(interp, kind, idx, before))
+        edges = interp.ev.system_writers.get(name)
+        if edges is not None:       # nctrans.interp.tool_edges writes the [tool, edge] form
+            interp.ev.system_writers[name] = (
+                lambda key, v, name=name, kind=kind, edges=edges:
+                _write_flat(interp, name, kind, key[0], v) if len(key) == 1 else edges(key, v))
+            continue
         interp.ev.frame_component_setters[name] = (
             lambda ix, v, name=name, kind=kind: _write(interp, name, kind, ix, v))
 
@@ -45,11 +51,14 @@ def _read(interp, kind: str, idx: tuple, before) -> Any:
 
 
 def _write(interp, name: str, kind: str, indices: list, v: Any) -> None:
-    from nctrans.interp.sysvars import _machine, _value
     if len(indices) != 1:
         interp.ev.system[name] = lambda: v      # tool and edge: kept as before (not analysed here)
         return
-    got = interp.ev.compile(indices[0])()
+    _write_flat(interp, name, kind, interp.ev.compile(indices[0])(), v)
+
+
+def _write_flat(interp, name: str, kind: str, got: Any, v: Any) -> None:
+    from nctrans.interp.sysvars import _machine, _value
     if got is None or got is UNKNOWN or isinstance(got, str) or got != int(got) or got < 1:
         raise EvalError("NC107", f"{name}[..]: the D number is not known to the analysis; the "
                         "offset is kept as it was", "warning")

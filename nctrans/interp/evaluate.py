@@ -29,6 +29,7 @@ class _Unknown:
 
 UNKNOWN = _Unknown()
 _MISSING = object()
+_MISSING_KEY = object()      # no first subscript given to Evaluator._system_key
 
 
 class EvalError(Exception):
@@ -342,6 +343,18 @@ class Evaluator:
         # frame variables whose components a program writes (Sinumerik $P_EXTFRAME[X,TR]=v):
         # name -> writer(indices as written, value) (nctrans.interp.settable_frames)
         self.frame_component_setters: dict[str, Callable[[list, Any], None]] = {}
+        # indexed system data a program writes with an effect (Sinumerik settable frames
+        # $P_UIFR[n,X,TR], tool edges $TC_DP3[t,d]): name -> writer(subscripts, value), the
+        # subscripts evaluated (numbers as int, axis and component names as upper-case strings)
+        self.system_writers: dict[str, Callable[[tuple, Any], None]] = {}
+        # system variables written that nothing models: (name, subscripts) -> value, read back
+        self.written_system: dict[tuple[str, tuple], Any] = {}
+        # what a write to an unmodelled system variable is: "read_only" (NC228), "no_effect"
+        # (stored quietly) or "unmodelled" (stored, NC237); set from the rules table (sysvars)
+        self.write_policy: Callable[[str], str] = lambda name: "unmodelled"
+        # told the name of a system variable read that nothing models (the interpreter says
+        # NC236 at the line); None: reads stay quiet (tests that run the evaluator alone)
+        self.on_unmodelled_read: Optional[Callable[[str], None]] = None
         # number ranges (first, last) a write refuses / a write leaves unknown (sysvars registers)
         self.read_only_numbers: tuple[tuple[int, int], ...] = ()
         self.running_numbers: tuple[tuple[int, int], ...] = ()
@@ -596,6 +609,35 @@ class Evaluator:
             out.append(int(round(v)))
         return tuple(out)
 
+    def _system_index_fns(self, var: n.Var) -> list[Callable[[], Any]]:
+        """Subscripts of a system variable: a bare name that is no variable of the program is
+        itself the subscript ($P_UIFR[1,X,TR], $AA_IW[X]): its upper-case name."""
+        out = []
+        for ix in var.indices or ():
+            if type(ix) is n.Var and ix.space == "name" and not ix.indices:
+                key = str(ix.key).upper()
+                out.append(lambda key=key: (key if self._lookup_name(key) is None
+                                            else self.read_name(key, None)))
+            else:
+                out.append(self.compile(ix))
+        return out
+
+    def _system_key(self, fns, first: Any = _MISSING_KEY) -> tuple:
+        """The evaluated subscripts: numbers as int, axis names as their geometry axis, other
+        names upper case; NC104 for a vacant or unknown subscript."""
+        out = []
+        for i, f in enumerate(fns):
+            v = first if i == 0 and first is not _MISSING_KEY else f()
+            if isinstance(v, AxisName):
+                out.append(v.geometry)
+            elif isinstance(v, str):
+                out.append(v.upper())
+            elif v is None or v is UNKNOWN or isinstance(v, FrameValue):
+                raise EvalError("NC104", "system variable index is not a number or a name")
+            else:
+                out.append(int(round(v)))
+        return tuple(out)
+
     def _num_key(self, var: n.Var, fns) -> int:
         if fns:
             (k,) = self._indices(fns[:1])
@@ -628,18 +670,23 @@ class Evaluator:
         if space == "system":
             name = str(var.key).upper()
             axis = _axis_index(var)
-            if axis is not None:
+            if axis is not None and name not in self.system_writers:
                 return lambda: self.read_axis_system(name, axis)
-            if len(fns) == 1:
-                (f1,) = fns
+            if not fns:
+                return lambda: self.read_system(name, None)
+            kfns = self._system_index_fns(var)
+            if len(fns) == 1 and name not in self.system_writers:
+                (f1,) = kfns
 
                 def read_indexed():
                     ix = f1()
+                    if isinstance(ix, str) and AXIS_NAME.match(ix):
+                        ix = AxisName(ix)             # $AA_IM[X1]: an axis named as written
                     if isinstance(ix, AxisName):      # $AA_IM[AXNAME], AXNAME an AXIS variable
                         return self.read_axis_system(name, ix.geometry)
-                    return self.read_system(name, self._indices(fns))
+                    return self.read_system(name, self._system_key(kfns, ix))
                 return read_indexed
-            return lambda: self.read_system(name, self._indices(fns) if fns else None)
+            return lambda: self.read_system(name, self._system_key(kfns))
         if space == "arg":
             key = str(var.key).upper()
             return lambda: self.scope.args.get(key)
@@ -735,7 +782,12 @@ class Evaluator:
         f = self.meanings.get(f"{meaning}.{axis}") if meaning is not None and axis in _AXES else None
         if f is not None:
             return f()
+        written = self.written_system.get((name, (axis,)), _MISSING)
+        if written is not _MISSING:
+            return written
         self.unknown_used = True
+        if meaning is None and self.on_unmodelled_read is not None:
+            self.on_unmodelled_read(name)
         return UNKNOWN
 
     def read_system(self, name: str, idx: Optional[tuple]) -> Any:
@@ -746,10 +798,15 @@ class Evaluator:
                 if v is UNKNOWN:
                     self.unknown_used = True
                 return v
+        written = self.written_system.get((name, idx or ()), _MISSING)
+        if written is not _MISSING:
+            return written
         f = self._system_reader(name)
         if f is not None:
             return f()
         self.unknown_used = True
+        if system_meaning(name) is None and self.on_unmodelled_read is not None:
+            self.on_unmodelled_read(name)
         return UNKNOWN
 
     def declare(self, decl: n.VarDecl, scope: Optional[str] = None) -> None:
@@ -931,19 +988,38 @@ class Evaluator:
             component = self.frame_component_setters.get(name)
             if component is not None and var.indices:
                 return lambda v, ix=var.indices: component(ix, v)
+            kfns = self._system_index_fns(var)
 
-            def set_sys(v):        # writable system data: kept so later reads see the value
+            def set_sys(v):
+                writer = self.system_writers.get(name)
+                if writer is not None:
+                    writer(self._system_key(kfns), v)
+                    return
                 setter = self._system_setter(name)
                 if setter is not None and fns:
                     # $P_PFRAME[X,TR]=25: component writes are not modelled; keep the frame
-                    raise EvalError("NC107", f"{name}[..] component write is not analysed; the "
-                                    "frame is kept as it was", "info")
+                    raise EvalError("NC237", f"{name}[..] component write is not modelled; the "
+                                    "frame is kept as it was", "warning")
                 if setter is not None:
                     setter(v)
-                else:
-                    self.system[name] = lambda: v
+                    return
+                self._write_unmodelled(name, self._system_key(kfns) if kfns else (), v)
             return set_sys
         return lambda v: (_ for _ in ()).throw(EvalError("NC104", f"cannot assign to {space}"))
+
+
+    def _write_unmodelled(self, name: str, key: tuple, v: Any) -> None:
+        """A write to a system variable nothing models: refused when the control only lets it
+        be read (NC228: later reads keep the machine's value), else kept for later reads, and
+        reported unless the table says it has no effect on motion (NC237)."""
+        policy = self.write_policy(name)
+        if policy == "read_only":
+            raise EvalError("NC228", f"{name} is a read-only system variable: the control refuses "
+                            "the write with an alarm; the analysis goes on without it")
+        self.written_system[(name, key)] = v
+        if policy != "no_effect":
+            raise EvalError("NC237", f"write to system variable {name} is not modelled: what it "
+                            "changes on the control is not in the analysed toolpath", "warning")
 
 
 def _concat(a: Any, b: Any) -> str:

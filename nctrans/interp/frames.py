@@ -88,7 +88,7 @@ class ProgrammableFrame:
     """The frame between program and work coordinates."""
 
     __slots__ = ("local", "mirror", "mirror_axes", "scale", "rot", "extra", "extra_trans",
-                 "affine", "inverse", "identity", "mirror_swap")
+                 "affine", "inverse", "identity", "mirror_swap", "settable")
 
     def __init__(self) -> None:
         self.local: dict[str, float] = {}                   # G52 / TRANS, every axis
@@ -99,6 +99,10 @@ class ProgrammableFrame:
         self.extra: Affine = ID_AFFINE                      # additive ops, applied first
         self.extra_trans: dict[str, float] = {}            # additive shifts of non-XYZ axes
         self.mirror_swap = False
+        # rotation, scale and mirror of the active settable frame (Sinumerik G54 with RT/SC/MI):
+        # applied after the programmable frame, about the work origin; its translation is the
+        # work offset (nctrans.interp.settable_frames). Kept when the programmable frame clears.
+        self.settable: Optional[Matrix] = None
         self._rebuild()
 
     # ---------------------------------------------------------------- edits
@@ -149,7 +153,15 @@ class ProgrammableFrame:
         self._rebuild()
 
     def clear(self) -> None:
+        """The neutral programmable frame; the settable frame's part stays."""
+        keep = self.settable
         self.__init__()
+        if keep is not None:
+            self.set_settable(keep)
+
+    def set_settable(self, m: Optional[Matrix]) -> None:
+        self.settable = None if m is None or m == IDENT else m
+        self._rebuild()
 
     # ---------------------------------------------------------------- use
     def _rebuild(self) -> None:
@@ -158,6 +170,8 @@ class ProgrammableFrame:
             if part is not None:
                 aff = compose(aff, part)
         aff = compose(aff, self.extra)
+        if self.settable is not None:
+            aff = compose((self.settable, (0.0, 0.0, 0.0)), aff)
         self.affine = aff
         self.identity = aff == ID_AFFINE and not any(
             v for a, v in self.local.items() if a not in _IDX) and not self.extra_trans

@@ -44,7 +44,7 @@ from typing import Any, Iterator, Optional
 
 from nctrans import plainrun
 from nctrans.diagnostics import at_span
-from nctrans.interp import edge_data, ggroups, settable_frames, sysvars
+from nctrans.interp import edge_data, ggroups, settable_frames, sysvars, tool_edges
 from nctrans.interp.evaluate import AxisName, EvalError, Evaluator, FrameValue
 from nctrans.interp.frames import Offsets, PLANE_AXES, ProgrammableFrame
 from nctrans.interp.lathe import LatheMixin
@@ -122,6 +122,8 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.frame = ProgrammableFrame()
         self.off = Offsets()
         self.travel_limits: Optional[ProgrammedLimits] = None     # set by the first TravelLimit
+        self.settable = None            # settable_frames.SettableFrames where the dialect has them
+        self.edges = None               # tool_edges.ToolEdges where D numbers are cutting edges
         if self.st.work_offset:
             self.off.set_work(self._work_offset(self.st.work_offset))
         # machine position (last emitted end) and the same point in program coordinates
@@ -226,7 +228,11 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
             sysv[str(name).upper()] = lambda value=value: float(value)
         sysvars.register(self, self.program.dialect)
         settable_frames.register(self)
+        tool_edges.register(self)      # [t, d] edges first: edge_data adds the flat [d] form
         edge_data.register(self)
+        self.ev.on_unmodelled_read = lambda name: self.diag(
+            "NC236", "warning", f"system variable {name} is not modelled: its value is unknown to "
+            "the analysis (what it drives is left out)")
         gg = ggroups.index_reader(self.program.dialect, st.groups, self.spelt_codes,
                                   lambda: self.unmodelled_motion)
         if gg is not None:

@@ -697,6 +697,9 @@ def _tool_radius(interp) -> Optional[float]:
     edge = st.radius_index or (interp.default_edge if st.tool else None)
     if not edge:
         return None                      # no D, and no tool to bring its default edge D1
+    if interp.edges is not None and st.tool:     # the edge's data, written or from the tool table
+        r = interp.edges.radius(int(st.tool), int(edge))
+        return r if r > 0 else None
     tool = interp.machine.tool(int(st.tool)) if st.tool else None
     r = tool.radius if tool is not None and tool.radius > 0 else interp.machine.radius_offset(int(edge))
     return r if r > 0 else None

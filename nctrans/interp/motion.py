@@ -152,6 +152,9 @@ class MotionMixin:
         _, center, radius, turns, _, _, via, aperture = d
         st = self.st
         motion = st.motion
+        if motion in ("rapid", "linear") and (radius is not None or turns is not None or via
+                                              or aperture is not None or center):
+            self._arc_words_unused(d)
         if motion == "rapid":
             if vals:
                 self._move("rapid", self._target(vals))
@@ -184,6 +187,19 @@ class MotionMixin:
             return
         if vals:
             self.diag("NC207", "error", "axis words while no motion mode is active")
+
+    def _arc_words_unused(self, d) -> None:
+        """A circle's words on a straight move (Sinumerik `G1 X10 CR=5`): the straight move runs
+        and the word does nothing, which the programmer did not mean (NC238)."""
+        _, center, radius, turns, _, _, via, aperture = d
+        what = [name for name, v in (("arc centre", center), ("arc radius", radius),
+                                     ("opening angle", aperture), ("extra turns", turns),
+                                     ("intermediate point", via)) if v]
+        if radius is not None and "arc radius" not in what:
+            what.append("arc radius")
+        self.diag("NC238", "warning", f"{' and '.join(what)} on a straight move "
+                  f"({'G0' if self.st.motion == 'rapid' else 'G1'}): only circles use it, so it has "
+                  "no effect here; the straight move is analysed")
 
     def _need_feed(self) -> None:
         st = self.st

@@ -76,7 +76,9 @@ class OffsetsMixin:
 
     def _apply_length(self) -> None:
         st = self.st
-        if st.length_mode == "off":
+        if self.edges is not None:              # the active cutting edge's length (tool_edges)
+            z = self.edges.active_length()
+        elif st.length_mode == "off":
             z = 0.0
         else:
             idx = st.length_index if st.length_index is not None else st.tool
@@ -101,6 +103,8 @@ class OffsetsMixin:
             self.st.length_index = i
             if self.st.length_mode != "off":
                 self._apply_length()
+        elif self.edges is not None:            # an edge of the active tool (tool_edges)
+            self.edges.select(i)
         else:
             self.st.radius_index = i
             self.comp_radius = self.machine.radius_offset(i) if i else 0.0
@@ -258,7 +262,9 @@ class OffsetsMixin:
         for step in value.steps:
             op, vals = step
             if op == "state":
+                settable = self.frame.settable       # the settable frame is not the programmable one
                 copy_frame(vals, self.frame)
+                self.frame.set_settable(settable)
             else:
                 self._h_frame(n.FrameOp(op, {a: n.Num(v) for a, v in vals}, additive=not first))
             first = False

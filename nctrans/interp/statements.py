@@ -57,6 +57,8 @@ class StatementsMixin:
         elif g == "work_offset":
             st.set(g, v)
             self.off.set_work(self._work_offset(v))
+            if self.settable is not None:        # its rotation, scale, mirror (settable_frames)
+                self.settable.selected(v)
             self._resync()
         elif g == "tool_length":
             st.set(g, v)
@@ -163,6 +165,8 @@ class StatementsMixin:
             self.diag("NC105", "warning", "tool change without a selected tool")
         st.tool = st.tool_selected
         self._record("tool_change", tool=st.tool)
+        if self.edges is not None:              # the new tool's edge D1 (tool_edges)
+            self.edges.tool_changed()
 
     def _c_dwell(self, s: n.Dwell):
         sec = None if s.seconds is None else self.ev.compile(s.seconds)

@@ -43,6 +43,7 @@ def register(interp, dialect: str) -> None:
     """Publish every mapped number in `interp.ev.system` (callables read at evaluation time), and
     the read-only and running (timer) numbers the evaluator's writes check."""
     system = interp.ev.system
+    interp.ev.write_policy = write_policy(dialect)
     interp.ev.read_only_numbers = _ranges(dialect, "read_only_numbers")
     interp.ev.running_numbers = _ranges(dialect, "running_numbers")
     _register_indexed(interp, dialect)
@@ -62,6 +63,37 @@ def register(interp, dialect: str) -> None:
             w = _writer(interp, e, k - first, wear)
             if w is not None:
                 setters.setdefault(k, w)
+
+
+# meanings whose spellings a program may only read (the control's alarm on a write: NC228)
+READ_ONLY_MEANINGS = frozenset((
+    "axis_position_work", "axis_position_machine", "active_tool", "active_tool_edge", "feed",
+    "spindle_speed", "plane_axis_1", "plane_axis_2", "plane_axis_3", "programmed_tool",
+    "argument_programmed", "settable_frame_number"))
+
+
+def write_policy(dialect: str) -> Callable[[str], str]:
+    """What writing a named system variable nothing models is (`[options.system_variable_writes]`
+    of the rules table): "read_only" (the control refuses it, NC228), "no_effect" (stored, quiet)
+    or "unmodelled" (stored, NC237)."""
+    try:
+        from nctrans.rules import load_table, system_meaning
+        spec = load_table(dialect).options.get("system_variable_writes", {}) or {}
+    except Exception:            # no table for this dialect
+        return lambda name: "unmodelled"
+
+    def match(names) -> Callable[[str], bool]:
+        exact = {str(x).upper() for x in names if not str(x).endswith("*")}
+        prefixes = tuple(str(x).upper()[:-1] for x in names if str(x).endswith("*"))
+        return lambda name: name in exact or (bool(prefixes) and name.startswith(prefixes))
+    read_only, quiet = match(spec.get("read_only", ())), match(spec.get("no_motion_effect", ()))
+
+    def policy(name: str) -> str:
+        up = name.upper()
+        if read_only(up) or system_meaning(up) in READ_ONLY_MEANINGS:
+            return "read_only"
+        return "no_effect" if quiet(up) else "unmodelled"
+    return policy
 
 
 def _register_indexed(interp, dialect: str) -> None:

@@ -66,6 +66,14 @@ SYSTEM_VARIABLES = (
     "parts_required",            # cannot know (reads are unknown)
     "argument_programmed",       # indexed by parameter position: whether the call of the running
                                  # procedure wrote that parameter (TRUE) or left it out (FALSE)
+    "settable_frame_data",       # indexed [n] or [n, axis, component]: the settable frame n (work
+                                 # offset G54.. and its rotation, scale, mirror), active at its selection
+    "settable_frame",            # the active settable frame (writable: acts at once)
+    "settable_frame_number",     # index of the active settable frame (0: none)
+    "edge_length",               # indexed [tool, edge]: cutting-edge data the D number applies:
+    "edge_radius",               # length along the tool axis, radius,
+    "edge_length_wear",          # and their wear (added)
+    "edge_radius_wear",
 )
 AXIS_MEANINGS = ("axis_position_work", "axis_position_machine", "probe_position_work",
                  "probe_position_machine")
