@@ -62,6 +62,7 @@ class CycleTime:
     change_s: float = 0.0
     untimed: int = 0                     # feed moves with no usable feed
     _pending: Optional[tuple] = None     # (record, length, speed mm/s, accel, entry speed)
+    _tool: Optional[int] = None          # the tool in the spindle (a dwell record names none)
 
     def __post_init__(self) -> None:
         axes = self.machine.axes
@@ -79,12 +80,14 @@ class CycleTime:
 
     def add(self, r: ToolpathRecord) -> None:
         kind = r.kind
+        if r.tool is not None:
+            self._tool = r.tool
         if kind in ("rapid", "linear", "arc") and r.start is not None and r.end is not None:
             self._move(r)
             return
         if kind == "dwell" and r.dwell_s:
             self._flush(None)
-            self._charge(r.tool, r.dwell_s, "dwell_s")
+            self._charge(self._tool, r.dwell_s, "dwell_s")     # the tool that dwells
         elif kind == "tool_change":
             self._flush(None)
             if self.machine.tool_change_s:

@@ -17,7 +17,7 @@ from nctrans.interp.evaluate import EvalError, Scope
 from nctrans.interp.offsets import copy_frame
 from nctrans.ir import nodes as n
 
-SHARED_SCOPE_CALLS = frozenset(("m98", "shared"))
+SHARED_SCOPE_CALLS = frozenset(("m98", "m97", "shared"))   # m97: Haas local subprogram
 
 # Modal groups a SAVE subprogram does not restore: not G codes (spindle, coolant, tool length),
 # or state whose restoring mid-path would need its own approach (cutter compensation, cycles).

@@ -222,6 +222,8 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         # F as programmed, in the feed unit in force (G700 inch/min; G70 keeps mm/min)
         values["feed"] = lambda: (st.feed or 0.0) / (st.feed_scale if st.feed_mode != "inverse_time" else 1.0)
         values["spindle_speed"] = lambda: st.spindle_speed or 0.0
+        for flag in ("block_search_active", "simulation_active", "dry_run_active"):
+            values[flag] = lambda: 0.0          # a normal run from the start (vocabulary)
         for i in range(3):      # geometry axes of the plane: abscissa, ordinate, applicate
             values[f"plane_axis_{i + 1}"] = (lambda i=i: AxisName(PLANE_AXES[st.plane][i]))
         for name, value in (getattr(self.machine, "variables", None) or {}).items():

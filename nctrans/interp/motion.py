@@ -21,6 +21,20 @@ from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
 from nctrans.toolpath import ToolpathRecord
 
+# which of a block's circle words each motion mode uses (the rest: NC238); modes not listed
+# (tapping, threads with their own words) are not checked
+ARC_WORDS_USED = {
+    "rapid": frozenset(), "linear": frozenset(),
+    "arc_cw": frozenset(("center", "radius", "turns", "aperture")),
+    "arc_ccw": frozenset(("center", "radius", "turns", "aperture")),
+    "arc_3point": frozenset(("via", "turns")),
+    "arc_tangent": frozenset(("turns",)),
+}
+MODE_NAMES = {"rapid": "rapid (G0)", "linear": "straight feed (G1)", "arc_cw": "circle (G2)",
+              "arc_ccw": "circle (G3)", "arc_3point": "three-point circle",
+              "arc_tangent": "tangential circle"}
+
+
 class MotionMixin:
     """Motion words to program-coordinate moves."""
 
@@ -128,6 +142,9 @@ class MotionMixin:
         if self.unmodelled_motion is not None:
             if self._unmodelled_at is self.span:
                 return                  # the code's own block: reported with the code
+            if self.__dict__.get("unmodelled_one_block"):
+                self.unmodelled_motion = None       # a non-modal code (G31): its block is over
+                return self._h_motion(d)
             self.diag("NC220", "warning", f"motion under {self.unmodelled_motion} is not modelled: "
                       "this block's axis words move nothing in the analysed toolpath")
             return
@@ -152,9 +169,12 @@ class MotionMixin:
         _, center, radius, turns, _, _, via, aperture = d
         st = self.st
         motion = st.motion
-        if motion in ("rapid", "linear") and (radius is not None or turns is not None or via
-                                              or aperture is not None or center):
-            self._arc_words_unused(d)
+        used = ARC_WORDS_USED.get(motion)
+        if used is not None and (
+                (radius is not None and "radius" not in used) or (via and "via" not in used)
+                or (turns is not None and "turns" not in used) or (center and "center" not in used)
+                or (aperture is not None and "aperture" not in used)):
+            self._arc_words_unused(d, used)
         if motion == "rapid":
             if vals:
                 self._move("rapid", self._target(vals))
@@ -188,18 +208,19 @@ class MotionMixin:
         if vals:
             self.diag("NC207", "error", "axis words while no motion mode is active")
 
-    def _arc_words_unused(self, d) -> None:
-        """A circle's words on a straight move (Sinumerik `G1 X10 CR=5`): the straight move runs
-        and the word does nothing, which the programmer did not mean (NC238)."""
+    def _arc_words_unused(self, d, used: frozenset) -> None:
+        """A circle's words where the motion mode does not use them (Sinumerik `G1 X10 CR=5`,
+        `CIP .. CR=`, `G2 .. I1=`): the move runs as its mode says and the word does nothing,
+        which the programmer did not mean (NC238)."""
         _, center, radius, turns, _, _, via, aperture = d
-        what = [name for name, v in (("arc centre", center), ("arc radius", radius),
-                                     ("opening angle", aperture), ("extra turns", turns),
-                                     ("intermediate point", via)) if v]
-        if radius is not None and "arc radius" not in what:
-            what.append("arc radius")
-        self.diag("NC238", "warning", f"{' and '.join(what)} on a straight move "
-                  f"({'G0' if self.st.motion == 'rapid' else 'G1'}): only circles use it, so it has "
-                  "no effect here; the straight move is analysed")
+        what = [name for key, name, v in (
+            ("center", "arc centre", center), ("radius", "arc radius", radius is not None),
+            ("aperture", "opening angle", aperture is not None),
+            ("turns", "extra turns", turns is not None), ("via", "intermediate point", via))
+            if v and key not in used]
+        mode = MODE_NAMES.get(self.st.motion, self.st.motion)
+        self.diag("NC238", "warning", f"{' and '.join(what)} in a {mode} block: that motion does "
+                  "not use it, so it has no effect here; the move is analysed as programmed")
 
     def _need_feed(self) -> None:
         st = self.st

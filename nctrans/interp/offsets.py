@@ -142,10 +142,22 @@ class OffsetsMixin:
             m.offsets[name] = cur
             self._work_offset_changed(name)
         elif s.kind.startswith("tool_"):
+            # the register holds geometry + wear (as sysvars' #2001../#2201.. writes): L10/L12 set
+            # the geometry and keep the wear, L11/L13 set the wear and keep the geometry (before,
+            # a wear write replaced the whole offset: G10 L13 R.02 left a radius of .02)
             v = vals.get("VALUE", 0.0) * self.st.scale
-            store = m.length_offsets if "length" in s.kind else m.radius_offsets
-            old = store.get(idx, m.length_offset(idx) if "length" in s.kind else m.radius_offset(idx))
-            store[idx] = old + v if inc else v
+            kind = "length" if "length" in s.kind else "radius"
+            store = m.length_offsets if kind == "length" else m.radius_offsets
+            read = m.length_offset if kind == "length" else m.radius_offset
+            wear = self.__dict__.setdefault("offset_wear", {})
+            old_wear = wear.get((kind, idx), 0.0)
+            if s.kind.endswith("_wear"):
+                new_wear = old_wear + v if inc else v
+                store[idx] = read(idx) - old_wear + new_wear
+                wear[(kind, idx)] = new_wear
+            else:
+                geometry = read(idx) - old_wear
+                store[idx] = (geometry + v if inc else v) + old_wear
 
     def _h_setpos(self, s: n.SetPosition):
         vals = self._eval_words(self._words(s.target))

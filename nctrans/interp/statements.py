@@ -225,8 +225,15 @@ class StatementsMixin:
     def _h_unmodelled(self, d):
         s, code = d
         what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
-        if code is not None:
+        if code is not None and code in unmodelled.one_block_codes(s.dialect):
+            self.unmodelled_motion = code       # this block only (motion.py clears it after)
+            self.unmodelled_one_block = True
+            self._unmodelled_at = self.span
+            self.diag("NC220", "warning", f"{what} is not modelled: its axis words move nothing in "
+                      "the analysed toolpath (the blocks after it move with the modal motion code)")
+        elif code is not None:
             self.unmodelled_motion = code
+            self.unmodelled_one_block = False
             self._unmodelled_at = self.span
             self.diag("NC220", "warning", f"{what} is not modelled: its axis words, and those of "
                       "the blocks after it until the next motion code, move nothing in the analysed "

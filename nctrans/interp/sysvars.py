@@ -48,7 +48,8 @@ def register(interp, dialect: str) -> None:
     interp.ev.running_numbers = _ranges(dialect, "running_numbers")
     _register_indexed(interp, dialect)
     setters = interp.ev.system_setters
-    wear: dict[tuple[str, int], float] = {}          # (kind, offset number) -> wear written
+    # (kind, offset number) -> wear written; shared with G10 L11/L13 (offsets._h_data)
+    wear: dict[tuple[str, int], float] = interp.__dict__.setdefault("offset_wear", {})
     for e in entries(dialect):
         if not isinstance(e, dict) or "first" not in e:
             continue

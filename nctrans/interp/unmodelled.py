@@ -71,6 +71,20 @@ def leading_word(text: str) -> str:
 
 
 @lru_cache(maxsize=None)
+def one_block_codes(dialect: str) -> frozenset[str]:
+    """Non-modal codes of `dialect` that take over their own block's motion only
+    (`[options.unmodelled_motion] one_block`: ISO G31)."""
+    try:
+        from nctrans.rules import load_table
+        t = load_table(dialect) if dialect else None
+    except Exception:           # a dialect without a table of its own
+        return frozenset()
+    if t is None:
+        return frozenset()
+    return frozenset(str(c).upper() for c in t.options.get("unmodelled_motion", {}).get("one_block", ()))
+
+
+@lru_cache(maxsize=None)
 def motion_codes(dialect: str) -> frozenset[str]:
     """Codes of `dialect` that take over the block's motion when the interpreter does not model
     them: the table's `unmodelled_motion` list plus its motion-group codes kept as passthrough."""
@@ -82,6 +96,7 @@ def motion_codes(dialect: str) -> frozenset[str]:
     except Exception:           # a dialect without a table of its own
         return frozenset()
     out = {str(c).upper() for c in t.options.get("unmodelled_motion", {}).get("codes", ())}
+    out |= one_block_codes(dialect)
     for c in t.codes:
         if c.group == "passthrough" and str(c.dialect_group) == "1":
             out.add(c.code.upper())

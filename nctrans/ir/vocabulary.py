@@ -74,6 +74,9 @@ SYSTEM_VARIABLES = (
     "edge_radius",               # length along the tool axis, radius,
     "edge_length_wear",          # and their wear (added)
     "edge_radius_wear",
+    "block_search_active",       # how the program runs: block search, simulation, dry run; the
+    "simulation_active",         # analysis is a normal run from the start, so each reads FALSE
+    "dry_run_active",
 )
 AXIS_MEANINGS = ("axis_position_work", "axis_position_machine", "probe_position_work",
                  "probe_position_machine")

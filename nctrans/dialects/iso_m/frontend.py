@@ -22,11 +22,11 @@ from nctrans import limits, plainrun
 from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.ir.nodes import (
     Alarm, Assign, AxisValue, Binary, Block, CycleParams, DataSetting, Dwell, Feed, FrameOp, Goto,
-    HomeReturn, If, Loop, ModalCallOff, ModeChange, Motion, Num, OffsetSelect, Passthrough,
+    HomeReturn, If, Loop, Message, ModalCallOff, ModeChange, Motion, Num, OffsetSelect, Passthrough,
     Program, ProgramEnd, ResetSetPosition, Return, SetPosition, Span, SpindleSpeed, Stop,
     Str, SubCall, Subprogram, ToolChange, ToolSelect, TravelLimit, Var, While,
 )
-from nctrans.rules import load_table, normalise_code
+from nctrans.rules import CodeRule, load_table, normalise_code
 
 from .fastpath import PLAIN, WORD
 from .prelex import clean, strip_comments
@@ -64,7 +64,9 @@ ANGLE_LETTERS = frozenset("ABC")
 
 _G_IN_TEXT = re.compile(r"G(\d+(?:\.\d+)?)")
 _LEAD_N = re.compile(r"^\s*(?:/\d?\s*)?(?:[Nn]\s*\d+)?\s*")
+LOCAL_CALL = "m97"              # call kind of a control profile's local subprogram call (Haas M97)
 ALARM_VARIABLE = 3000          # Fanuc macro B: #3000=n (message) raises alarm n
+STOP_MESSAGE_VARIABLE = 3006   # Fanuc macro B: #3006=n (message) stops as M00 and shows the message
 _EXTERNAL_OUTPUT = re.compile(r"^(?:N\d+\s*)?(?:POPEN|PCLOS|[DB]PRNT\s*\[.*\])\s*$")
 _O_WORDS = re.compile(r"O(\d+)(?=$|[A-Z][-+.\d#\[]|[,#\[/])")
 _O_NAME = re.compile(r"O([0-9A-Z_.]*)$")
@@ -163,6 +165,8 @@ class Lowering:
         self.standard = opts.get("decimal_mode", "pocket") == "standard"
         self.factors = opts.get("standard_factors", {}).get(opts.get("increment_system", "IS-B"), {})
         self.prog8 = bool(opts.get("prog_number_8digit", False))
+        self.local_call_code = ""       # the profile's local subprogram call (Haas M97), if any
+        self.local_calls: set[int] = set()      # N numbers it calls (_local_subprograms)
         self.dwell_unit = float(opts.get("dwell_p_unit", 0.001))
         self.dwell_div = round(1 / self.dwell_unit) if self.dwell_unit else 1000
         defaults = self.table.defaults()
@@ -211,6 +215,9 @@ class Lowering:
                 rule = self.table.lookup(normalise_code(letter, text.lstrip("+")))
             except ValueError:
                 rule = None
+            if rule is not None and rule.code == self.local_call_code:
+                rule = CodeRule(rule.code, "call", LOCAL_CALL, modal=False,
+                                meaning="local subprogram call (control profile)")
             self._codes[key] = rule
             return rule
 
@@ -382,7 +389,7 @@ class Lowering:
         lclass = _digits(vals.get("L"))
         p = vals.get("P")
         kinds = {"2": ("work_offset", False), "20": ("work_offset", True),
-                 "10": ("tool_length", False), "1": ("tool_length_wear", False),
+                 "10": ("tool_length", False), "1": ("tool_length", False),
                  "11": ("tool_length_wear", False), "12": ("tool_radius", False),
                  "13": ("tool_radius_wear", False)}
         kind = kinds.get(str(int(lclass))) if lclass else None
@@ -467,6 +474,9 @@ class Lowering:
         if rule.value == "m98":
             b.call = "m98"
             return
+        if rule.value == LOCAL_CALL:
+            b.call = LOCAL_CALL
+            return
         p = b.vals.pop("P", None)
         if self.in_sub:
             b.out.append((B_END, Return(_digits(p) if p is not None else None)))
@@ -491,6 +501,9 @@ class Lowering:
                     repeat = Num(float(int(d[:-4])), None)
                 d = d[-4:]
             name = f"O{int(d)}"
+            if b.call == LOCAL_CALL:            # Haas M97 P<n>: the blocks from N<n> (local_calls)
+                name = f"N{int(d)}"
+                self.local_calls.add(int(d))
         elif p is not None:
             named["P"] = _ex(p)             # program number by expression: resolved at run time
         else:
@@ -645,6 +658,8 @@ class Lowering:
             if tag == "=":
                 if type(it[1]) is Var and it[1].space == "num" and it[1].key == ALARM_VARIABLE:
                     out.append((B_END, Alarm(it[2])))     # #3000=n (MESSAGE): the control stops
+                elif _is_stop_message(it[1]):
+                    out.append((B_END, Stop()))           # #3006=n (MESSAGE): M00 with a message
                 else:
                     out.append((B_ASSIGN, Assign(it[1], it[2])))
             elif tag == "GOTO":
@@ -1046,6 +1061,9 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     if "profiles" in opts and not meta.get("profile"):
         from nctrans.dialects.iso_m.profiles import detect
         meta["profile"] = detect(text, opts)
+    if meta.get("profile"):
+        low.local_call_code = str((opts.get("profiles") or {}).get(meta["profile"], {})
+                                  .get("local_call", "")).upper()
     name = None
     subprograms: dict[str, Subprogram] = program.subprograms
     cur = main
@@ -1266,6 +1284,10 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                     if type(st) is Alarm and st.text is None and comment:
                         st.text = Str(comment)      # the alarm message is the block's comment
                         comment = None
+                if comment and any(type(st) is Stop for st in body) and any(
+                        _is_stop_message(it[1]) for it in items if it[0] == "=" and len(it) > 2):
+                    body.insert(0, Message(Str(comment)))   # #3006=n (MESSAGE): shown, then the stop
+                    comment = None
                 cur.append(Block(span, body, number, None, skip, comment))
             comment = None
             for it in structure:
@@ -1273,7 +1295,8 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 if tag == "IFTHEN":
                     # #3000=n after THEN raises the alarm as it does alone on a line
                     message = next((Str(a[1]) for a in it[2] if a[0] == "comment"), None)
-                    then = [Alarm(a[2], message) if _is_alarm(a[1]) else Assign(a[1], a[2])
+                    then = [Alarm(a[2], message) if _is_alarm(a[1]) else
+                            Stop() if _is_stop_message(a[1]) else Assign(a[1], a[2])
                             for a in it[2] if a[0] != "comment"]
                     cur.append(If(span, it[1], [Block(span, then, skip=skip)]))
                 elif tag in ("WHILE", "DO"):
@@ -1315,6 +1338,8 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                                 file, fr.line))
     if not main and not main_seen and not subprograms:
         diags.append(Diagnostic("NC004", "error", "the file holds no NC blocks", file, 1))
+    if low.local_calls:
+        _local_subprograms(main, subprograms, low.local_calls, diags, file)
     if stream and main:
         yield from main
         main.clear()
@@ -1331,6 +1356,48 @@ def _unknown_g(low: Lowering, code: str) -> Optional[str]:
         if low.code("G", m.group(1)) is None:
             return "G" + m.group(1)
     return None
+
+
+def _local_subprograms(main: list, subprograms: dict, numbers: set[int], diags: list,
+                       file: str) -> None:
+    """Haas M97 P<n>: the blocks of the main program from the one numbered n up to the first M99
+    (a restart in a main program, a return here) become subprogram "N<n>". Blocks after the
+    program end belong to the local subprograms only; one before it stays in the main body too."""
+    def end_index(i: int) -> Optional[int]:
+        for j in range(i, len(main)):
+            node = main[j]
+            if type(node) is Block and any(type(s) is ProgramEnd and s.kind == "restart"
+                                           for s in node.body):
+                return j
+        return None
+    ended = next((i for i, node in enumerate(main) if type(node) is Block and any(
+        type(s) is ProgramEnd and s.kind != "restart" for s in node.body)), len(main))
+    taken: list[tuple[int, int]] = []
+    for num in sorted(numbers):
+        start = next((i for i, node in enumerate(main) if type(node) is Block
+                      and node.number is not None and node.number.isdigit()
+                      and int(node.number) == num), None)
+        stop = end_index(start) if start is not None else None
+        if start is None or stop is None:
+            continue          # the call stays unresolved: NC103 at the M97
+        body = []
+        for node in main[start:stop + 1]:
+            if type(node) is Block and any(type(s) is ProgramEnd and s.kind == "restart"
+                                           for s in node.body):
+                node = Block(node.span, [Return(None) if type(s) is ProgramEnd else s
+                                         for s in node.body], node.number, node.label, node.skip,
+                             node.comment)
+            body.append(node)
+        subprograms[f"N{num}"] = Subprogram(f"N{num}", main[start].span, body)
+        if start > ended:
+            taken.append((start, stop))
+    for start, stop in sorted(taken, reverse=True):
+        del main[start:stop + 1]
+
+
+def _is_stop_message(target) -> bool:
+    """An assignment to #3006 (Fanuc macro B: stop with a message, as M00)."""
+    return type(target) is Var and target.space == "num" and target.key == STOP_MESSAGE_VARIABLE
 
 
 def _is_alarm(target) -> bool:
