@@ -16,7 +16,7 @@ from nctrans.machine import Machine, Tool
 from nctrans.source import from_text
 
 CONTOUR = "ANF: G1 X10 Y10\nX50\nY30\nENDE: X10\n"
-MACHINE = Machine(name="t", tools=[Tool(number=1, radius=3.0, length=50.0)])
+MACHINE = Machine(name="t", tools=[Tool(number=1, radius=3.0, length=0.0)])   # the cycle path, not the tool length (tests of D length: test_system_data_writes)
 
 
 def _text(call: str, contour: str = CONTOUR) -> str:

@@ -18,7 +18,8 @@ from nctrans.source import from_text
 
 
 def _machine(radius: float) -> Machine:
-    return Machine(name="t", tools=[Tool(number=1, radius=radius, length=50.0)])
+    # length 0: these are hand paths of the cycle (the D length: tests/test_system_data_writes.py)
+    return Machine(name="t", tools=[Tool(number=1, radius=radius, length=0.0)])
 
 
 def _run(body: str, radius: float | None = 3.0):

@@ -4,15 +4,15 @@
 Edge (t, d) has a length along the tool axis and a radius, plus their wear (neutral meanings
 "edge_length", "edge_radius", "edge_length_wear", "edge_radius_wear"; Sinumerik $TC_DP3, $TC_DP6,
 $TC_DP12, $TC_DP15 [t,d]). A program may write them; otherwise edge 1 of a tool is the machine
-file's tool (length, radius) and any other edge has no data (0, said once when the machine knows
-the tool). D0 switches length and radius off.
+file's tool (length, radius) and any other edge D<d> the machine file's offset register d
+(radius_offsets / length_offsets, else tool d). D0 switches length and radius off.
 
 When they act (general knowledge of the Siemens Fundamentals manual [GK]): the edge applies its
 length and radius from its selection by D, or by the tool change, which brings edge D1
 (`default_cutting_edge`) unless the same block programs a D. Data written for the active edge acts
 at the next D or tool change, as on the control. Length is applied along Z (the tool axis of a
 3-axis mill under G17; under G18/G19 the control applies it along Y/X, which the model does not:
-said at the selection).
+said at the selection); on a lathe it is not applied (said, NC220), as ISO lathe geometry offsets.
 """
 from __future__ import annotations
 
@@ -51,7 +51,6 @@ class ToolEdges:
         self.it = interp
         self.data: dict[tuple[int, int], dict[str, float]] = {}
         self.d_span = None              # the block whose D word selected the active edge
-        self.told: set = set()
 
     def _value(self, t: int, d: int, field: str) -> float:
         own = self.data.get((t, d), {})
@@ -59,17 +58,14 @@ class ToolEdges:
             return own[field]
         if field.endswith("_wear"):
             return 0.0
-        tool = self.it.machine.tool(t) if t else None
-        if tool is None:
-            return 0.0
-        if d == 1:
+        m = self.it.machine
+        tool = m.tool(t) if t else None
+        if d == 1 and tool is not None:
             return float(getattr(tool, field) or 0.0)
-        if (t, d) not in self.told:
-            self.told.add((t, d))
-            self.it.diag("NC107", "warning", f"cutting edge D{d} of tool {t} has no data in the "
-                         "machine file (one edge per tool) nor written by the program: analysed "
-                         "with length and radius 0")
-        return 0.0
+        # no data of its own: the machine file's offset register of the D number (radius_offsets /
+        # length_offsets, else tool d), as every D read before edges were modelled; conversions
+        # between ISO offset numbers and D numbers rely on it (ISO T0102 -> T1 D2)
+        return float(m.length_offset(d) if field == "length" else m.radius_offset(d))
 
     def length(self, t: int, d: int) -> float:
         return self._value(t, d, "length") + self._value(t, d, "length_wear")
@@ -105,7 +101,13 @@ class ToolEdges:
     def active_length(self) -> float:
         t, d = self.active()
         z = self.length(t, d) if t and d else 0.0
-        if z and self.it.st.plane != "XY" and getattr(self.it.machine, "kind", "mill") == "mill":
+        if z and getattr(self.it.machine, "kind", "mill") == "lathe":
+            # a turning tool's lengths act in X and Z by its type (not modelled, as ISO lathe
+            # geometry offsets): the tip path is analysed as programmed
+            self.it.diag("NC220", "warning", f"tool length {z:g} mm of a lathe tool is not modelled: "
+                         "the analysed toolpath is the programmed tip path")
+            return 0.0
+        if z and self.it.st.plane != "XY":
             self.it.diag("NC220", "warning", f"tool length {z:g} mm under plane {self.it.st.plane}: "
                          "the control applies it along the axis normal to the plane, the analysis "
                          "along Z")
