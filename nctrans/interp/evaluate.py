@@ -632,7 +632,10 @@ class Evaluator:
                 out.append(v.geometry)
             elif isinstance(v, str):
                 out.append(v.upper())
-            elif v is None or v is UNKNOWN or isinstance(v, FrameValue):
+            elif v is UNKNOWN:
+                raise EvalError("NC107", "system variable index is not known to the analysis: the "
+                                "variable is not read or written here", "warning")
+            elif v is None or isinstance(v, FrameValue):
                 raise EvalError("NC104", "system variable index is not a number or a name")
             else:
                 out.append(int(round(v)))

@@ -59,6 +59,9 @@ class ToolEdges:
         if field.endswith("_wear"):
             return 0.0
         m = self.it.machine
+        registers = m.length_offsets if field == "length" else m.radius_offsets
+        if d in registers:          # a flat D number's data ($TC_DP3[d], nctrans.interp.edge_data)
+            return float(registers[d])
         tool = m.tool(t) if t else None
         if d == 1 and tool is not None:
             return float(getattr(tool, field) or 0.0)
@@ -95,12 +98,12 @@ class ToolEdges:
     def _apply(self) -> None:
         it = self.it
         t, d = self.active()
-        it.comp_radius = self.radius(t, d) if t and d else 0.0
+        it.comp_radius = self.radius(t, d) if d else 0.0      # a flat D number needs no tool
         it._apply_length()
 
     def active_length(self) -> float:
         t, d = self.active()
-        z = self.length(t, d) if t and d else 0.0
+        z = self.length(t, d) if d else 0.0
         if z and getattr(self.it.machine, "kind", "mill") == "lathe":
             # a turning tool's lengths act in X and Z by its type (not modelled, as ISO lathe
             # geometry offsets): the tip path is analysed as programmed
