@@ -333,3 +333,37 @@ def test_gud_file_of_the_real_corpus_runs_its_rep_initialisers():
     # macros _SC_NO_VAL/_SC_A_NO_VAL, and NO_AXIS, which the seed does not document)
     undefined = {d.message.split()[1] for d in diags if d.rule == "NC101"}
     assert undefined == {"_SC_NO_VAL", "_SC_A_NO_VAL", "NO_AXIS"}
+
+
+# --------------------------------------------------------------------------- ROT about several axes
+
+def _rx(a, p):
+    c, s = math.cos(math.radians(a)), math.sin(math.radians(a))
+    return (p[0], c * p[1] - s * p[2], s * p[1] + c * p[2])
+
+
+def _ry(b, p):
+    c, s = math.cos(math.radians(b)), math.sin(math.radians(b))
+    return (c * p[0] + s * p[2], p[1], -s * p[0] + c * p[2])
+
+
+def _rz(c_, p):
+    c, s = math.cos(math.radians(c_)), math.sin(math.radians(c_))
+    return (c * p[0] - s * p[1], s * p[0] + c * p[1], p[2])
+
+
+@pytest.mark.parametrize("spelling", ["ROT X30 Y20 Z10", "ROT Z10 Y20 X30", "ROT Y20 X30 Z10",
+                                      "$P_PFRAME=CROT(X,30,Y,20,Z,10)",
+                                      "$P_PFRAME=CROT(Z,10,X,30,Y,20)"])
+def test_rotation_about_several_axes_is_rpy_whatever_the_written_order(spelling):
+    # spec sinumerik.md (ROT X a Y b Z c): R = Rz(c)·Ry(b)·Rx(a), the written order does not matter
+    recs, diags = run(f"{spelling}\nG0 X3 Y10 Z1\nM30")
+    assert not errors(diags)
+    want = _rz(10, _ry(20, _rx(30, (3.0, 10.0, 1.0))))
+    assert ends(recs) == [tuple(round(v, 4) for v in want)]
+
+
+def test_additive_rotation_about_several_axes_chains_rpy_in_the_rotated_system():
+    # ROT Z90 then AROT X90 Y90: Rz(90)·Ry(90)·Rx(90); program (3, 10, 1) -> (1, 10, -3) by hand
+    recs, _ = run("ROT Z90\nAROT X90 Y90\nG0 X3 Y10 Z1\nM30")
+    assert ends(recs) == [(1.0, 10.0, -3.0)]

@@ -50,6 +50,19 @@ def mat_inv(m: Matrix) -> Optional[Matrix]:
     return tuple(tuple(r) for r in inv)  # type: ignore
 
 
+# A rotation about several axes in one instruction (ROT X.. Y.. Z.., CROT(..), a frame's RT
+# components) is roll-pitch-yaw: R = Rz(c)·Ry(b)·Rx(a) whatever order the axes are written in,
+# i.e. the chain Z, then Y about the new Y, then X about the new X.
+RPY_ORDER = ("Z", "Y", "X")
+
+
+def rpy_ordered(pairs):
+    """(axis, angle) pairs in the order the RPY chain applies them; other axes keep their place
+    after the geometry axes."""
+    rank = {a: i for i, a in enumerate(RPY_ORDER)}
+    return sorted(pairs, key=lambda kv: rank.get(str(kv[0]).upper(), len(RPY_ORDER)))
+
+
 def rotation(axis: str, deg: float) -> Matrix:
     """Rotation by `deg` about `axis` (counter-clockwise looking down the axis)."""
     c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))

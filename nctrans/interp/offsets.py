@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
-from nctrans.interp.frames import PLANE_AXES, ProgrammableFrame
+from nctrans.interp.frames import PLANE_AXES, ProgrammableFrame, rpy_ordered
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
 
@@ -233,7 +233,7 @@ class OffsetsMixin:
                     fr.set_rotation(axis, ang, piv, additive=s.additive)
                 else:
                     first = True
-                    for a, e in s.values.items():
+                    for a, e in rpy_ordered(s.values.items()):
                         ang = num(e, f"{a} rotation", False)
                         if ang is not None:
                             fr.set_rotation(a.upper(), ang, center(),

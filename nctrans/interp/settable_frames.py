@@ -22,13 +22,12 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
-from nctrans.interp.frames import IDENT, Matrix, compose, mat_mul, rotation
+from nctrans.interp.frames import IDENT, RPY_ORDER, Matrix, compose, mat_mul, rotation, rpy_ordered
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
 
 COMPONENTS = ("TR", "FI", "RT", "SC", "MI")
 GEOMETRY = ("X", "Y", "Z")
-RPY_ORDER = ("Z", "Y", "X")        # R = Rz(c)·Ry(b)·Rx(a): written as the chain Z, then Y, then X
 
 
 def _table(dialect: str):
@@ -131,7 +130,7 @@ def decompose(value: Any, what: str) -> tuple[dict[str, float], dict]:
                 if a not in GEOMETRY:
                     other[a] = other.get(a, 0.0) + v
         elif op == "rot":
-            for a, v in vals:
+            for a, v in rpy_ordered(vals):
                 if a not in GEOMETRY:
                     raise EvalError("NC104", f"{what}: rotation about {a}, not a geometry axis")
                 aff = compose(aff, (rotation(a, v), (0.0, 0.0, 0.0)))
