@@ -813,6 +813,20 @@ def run_steps(interp, steps, a1: str, a2: str, ax: str) -> None:
 # ---------------------------------------------------------------------------------------------
 # CYCLE97: thread cutting on a lathe (X radius, Z along the axis)
 
+def _thread_pass_depths(vari: int, nrc: int, tdep: float, fal: float, nid: int) -> list[float]:
+    """The depth below the crest of each pass of CYCLE97/CYCLE98: NRC roughing cuts to TDEP - FAL,
+    of equal infeed (VARI 1/2) or equal chip section (VARI 3/4: depth ~ sqrt(k)), the finishing
+    cut at TDEP when FAL > 0, then NID idle passes at TDEP."""
+    rough = tdep - fal
+    if vari in (1, 2):
+        depths = [rough * k / nrc for k in range(1, nrc + 1)]
+    else:
+        depths = [rough * math.sqrt(k / nrc) for k in range(1, nrc + 1)]
+    if fal > 0:
+        depths.append(tdep)
+    return depths + [tdep] * max(0, nid)
+
+
 def thread_turn_steps(p: dict[str, float], start: tuple[float, float]) -> list[Step]:
     """CYCLE97 passes from `start` = (X radius, Z): ("rapid", (x, z)) | ("thread", (x, z), lead).
 
@@ -860,17 +874,10 @@ def thread_turn_steps(p: dict[str, float], start: tuple[float, float]) -> list[S
     crest = (lambda z: nominal(z)) if external else (lambda z: nominal(z) - tdep)
     vrt = abs(p.get("VRT", 0.0)) or 1.0
     clear = (max(crest(z0), crest(z1)) + vrt) if external else (min(crest(z0), crest(z1)) - vrt)
-    rough = tdep - fal
-    if vari in (1, 2):
-        depths = [rough * k / nrc for k in range(1, nrc + 1)]
-    else:
-        depths = [rough * math.sqrt(k / nrc) for k in range(1, nrc + 1)]
-    if fal > 0:
-        depths.append(tdep)
     nid = int(p.get("NID", 0) or 0)
     if nid > MAX_PASSES:
         raise _impossible(f"with more than {MAX_PASSES} idle passes")
-    depths += [tdep] * max(0, nid)
+    depths = _thread_pass_depths(vari, nrc, tdep, fal, nid)
     iang = p.get("IANG", 0.0)
     tan = math.tan(math.radians(abs(iang))) if iang else 0.0
 
@@ -938,14 +945,7 @@ def thread_chain_steps(p: dict[str, float], start: tuple[float, float]) -> list[
     crest = [(r if external else r - tdep, z) for r, z in chain]
     vrt = abs(p.get("VRT", 0.0)) or 1.0
     clear = (max(r for r, _ in crest) + vrt) if external else (min(r for r, _ in crest) - vrt)
-    rough = tdep - fal
-    if vari in (1, 2):
-        depths = [rough * k / nrc for k in range(1, nrc + 1)]
-    else:
-        depths = [rough * math.sqrt(k / nrc) for k in range(1, nrc + 1)]
-    if fal > 0:
-        depths.append(tdep)
-    depths += [tdep] * max(0, nid)
+    depths = _thread_pass_depths(vari, nrc, tdep, fal, nid)
     iang = p.get("IANG", 0.0)
     tan = math.tan(math.radians(abs(iang))) if iang else 0.0
     steps: list[Step] = []
