@@ -41,7 +41,7 @@ def test_construct_the_target_lacks_is_lowered_alone_with_a_located_info():
     assert [(d.line, d.severity) for d in infos] == [(7, "info")]
     assert "lines 5-9" in infos[0].message
     lines = res.text.splitlines()
-    assert "#100=2" in lines and "N20 T1 M6" in lines and "N80 G0 Z5." in lines   # kept as written
+    assert "#100=2" in lines and "N20 T1 M6 G43 H1" in lines and "N80 G0 Z5." in lines   # kept as written
     assert "GOTO" not in res.text                    # the loop itself was run out
     out = get("iso-m").parse(res.text, "p.nc").program
     assert equiv.compare(_records(program), _records(out)) is None

@@ -178,7 +178,8 @@ def test_what_iso_cannot_say_exactly_is_lowered_alone(key):
     notes = [d.message for d in res.diagnostics if d.rule == "NC401" and CONSTRUCT_NOTE in d.message]
     assert notes and all(lines in m for m in notes), notes
     assert any(d.rule == "NC402" for d in get("iso-m").emit(program).diagnostics)
-    assert "G17 G90 G21 T1 D1 M6" in res.text.splitlines()[:4]          # the rest as written
+    # the rest as written, the edge's length as ISO G43 H of the tool (tool_edges)
+    assert "G17 G90 G21 T1 D1 M6 G43 H1" in res.text.splitlines()[:4]
     back = get("iso-m").parse(res.text, "p.nc").program
     assert equiv.compare(_records(program), _records(back)) is None
 

@@ -173,11 +173,83 @@ def test_lathe_tool_length_is_said_not_applied_along_z():
     assert [(d.line, d.rule) for d in diags] == [(1, "NC220")]
 
 
-@pytest.mark.xfail(reason="left for the conversion: the ISO output of a Sinumerik D writes no G43 H, so a "
-                          "tool length the D applies is lost in the ISO program", strict=True)
-def test_sinumerik_d_length_survives_conversion_to_iso():
+# --------------------------------------------------------------------------- edge length in ISO
+
+def to_iso(text, m):
+    """Sinumerik -> ISO: the ISO text, its diagnostics and the ISO program's toolpath on `m`."""
     from nctrans import api
-    m = mill(Tool(number=1, length=100.0, radius=5.0))
-    text = "T1 D1 M6\nG0 X0 Y0 Z10\nM30\n"
     conv = api.transpile(text, "sinumerik", "iso-m", machine=m)
+    recs, _ = run(conv.text, m, "iso-m")
     assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m", machine=m)
+    return conv.text, conv.diagnostics, recs
+
+
+def iso_lines(text):
+    return [ln for ln in text.splitlines() if ln and ln[0] not in "%("]
+
+
+LENGTHS = (Tool(number=1, length=100.0, radius=5.0), Tool(number=2, length=50.0, radius=3.0),
+           Tool(number=3, length=30.0, radius=1.0))
+
+
+def test_sinumerik_d_length_survives_conversion_to_iso():
+    # T1 D1: edge 1 of tool 1 = tool 1's length 100 -> ISO G43 H1; Z10 -> spindle at 110
+    text, diags, recs = to_iso("T1 D1 M6\nG0 X0 Y0 Z10\nM30\n", mill(*LENGTHS))
+    assert iso_lines(text)[0].split() == ["T1", "D1", "M6", "G43", "H1"]
+    assert ends(recs) == [(0, 0, 110)]
+    assert [d.rule for d in diags] == ["NC401"]
+
+
+def test_d0_mid_program_is_g49():
+    # T2 (50): Z10 -> 60; D0: no length, Z5 -> 5
+    text, _, recs = to_iso("T2 M6\nG0 X0 Y0 Z10\nD0\nG0 Z5\nM30\n", mill(*LENGTHS))
+    assert iso_lines(text)[0].split() == ["T2", "M6", "G43", "H2"]
+    assert iso_lines(text)[2].split() == ["D0", "G49"]
+    assert ends(recs) == [(0, 0, 60), (0, 0, 5)]
+
+
+def test_d_change_without_tool_change_takes_the_register_of_its_number():
+    # tool 1 (100): Z0 -> 100; D3 without data of its own: offset register 3 = tool 3's 30 -> 30;
+    # D1 again: tool 1's own 100 -> 101
+    text, _, recs = to_iso("T1 M6\nG0 X0 Y0 Z0\nD3\nG0 Z0\nD1\nG0 Z1\nM30\n", mill(*LENGTHS))
+    assert iso_lines(text)[2].split() == ["D3", "G43", "H3"]
+    assert iso_lines(text)[4].split() == ["D1", "G43", "H1"]
+    assert ends(recs) == [(0, 0, 100), (0, 0, 30), (0, 0, 101)]
+
+
+def test_tool_change_without_d_brings_d1_of_the_new_tool():
+    # T2 selected while tool 1 (100) cuts: Z0 -> 100; M6: D1 of tool 2 (50) -> H2, Z0 -> 50
+    text, _, recs = to_iso("T1 M6\nG0 X0 Y0 Z0\nT2\nG0 Z0\nM6\nG0 Z0\nD1\nG0 Z2\nM30\n",
+                           mill(*LENGTHS))
+    assert iso_lines(text)[0].split() == ["T1", "M6", "G43", "H1"]
+    assert iso_lines(text)[4].split() == ["M6", "G43", "H2"]
+    assert iso_lines(text)[6].split() == ["D1"]     # D1 of tool 2: H2 is in effect already
+    assert ends(recs) == [(0, 0, 100), (0, 0, 100), (0, 0, 50), (0, 0, 52)]
+
+
+def test_length_under_g18_is_said_at_its_line():
+    _, diags, _ = to_iso("G18\nT1 M6\nG0 X0 Z10\nM30\n", mill(*LENGTHS))
+    said = [(d.line, d.rule) for d in diags if "normal to plane ZX" in d.message]
+    assert said == [(2, "NC401")]
+
+
+def test_d1_in_a_subprogram_is_said_at_its_line_and_flattened():
+    # the subprogram's D1 is the caller's tool's edge, not known where its O block is written:
+    # said at line 5, and the conversion falls back to plain motion (tool 1: Z5 -> 105)
+    from nctrans import api
+    m = mill(*LENGTHS)
+    text = "T1 M6\nSUB1\nM30\nPROC SUB1\nD1\nG0 Z5\nRET\n"
+    conv = api.transpile(text, "sinumerik", "iso-m", machine=m)
+    assert [d.line for d in conv.diagnostics if "edge D1 of a tool not known" in d.message] == [5]
+    assert ends(run(conv.text, m, "iso-m")[0]) == [(0, 0, 105)]
+    assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m", machine=m)
+
+
+def test_iso_length_survives_conversion_to_sinumerik():
+    # ISO T2 G43 H2 -> Sinumerik T2 M6 (D1 of tool 2): 50 either way, Z10 -> 60
+    from nctrans import api
+    m = mill(*LENGTHS)
+    text = "T2 M6 G43 H2\nG0 X0 Y0 Z10\nM30\n"
+    conv = api.transpile(text, "iso-m", "sinumerik", machine=m)
+    assert ends(run(conv.text, m)[0]) == [(0, 0, 60)]
+    assert api.equiv(text, conv.text, read_a="iso-m", read_b="sinumerik", machine=m)

@@ -37,6 +37,7 @@ from nctrans.ir import walk
 from nctrans.ir.walk import constant
 
 from . import plan as pl
+from .edge_length import EdgeLengths, edge_offsets
 from .cycles import CycleRefused, IsoCycle, iso_cycle, pattern_positions
 
 __all__ = ["IsoEmitter", "IsoSpelling", "NotExpressible", "format_number", "format_expr",
@@ -148,6 +149,8 @@ class IsoEmitter(IsoSpelling, Emitter):
     table_name = "iso-m"
     target_text = "ISO milling"          # NC402 wording: "<target_text> cannot express ..."
     lowered_for = "ISO"
+    # a milling control applies a tool length along Z (G43 H); a lathe's is not (iso-t)
+    writes_edge_lengths: bool = True
 
     def __init__(self, program: n.Program):
         super().__init__(program)
@@ -198,6 +201,16 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.motion_mode: Optional[str] = None
         self.units_mm = True
         self.feed_expr = None
+        # a source's cutting-edge D (Sinumerik) applies a tool length: written as G43 H / G49
+        # (not in a flattened program: its coordinates hold the length already)
+        self.edge_lengths = (EdgeLengths(self) if self.writes_edge_lengths
+                             and program.dialect != self.dialect and edge_offsets(program.dialect)
+                             and not (program.meta or {}).get("flattened_from") else None)
+
+    def forget(self) -> None:
+        super().forget()
+        if getattr(self, "edge_lengths", None) is not None:
+            self.edge_lengths.reached_from_elsewhere()
 
     def _lay_out_globals(self, program: n.Program) -> None:
         uses = pl.undeclared_arrays(program)
@@ -477,6 +490,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         """A subprogram's body after its O word: the spill frame pushed, the body, M99."""
         self.unit = key
         self.forget()
+        if self.edge_lengths is not None:
+            self.edge_lengths.unknown()
         self.span = sub.span
         unit = self.plans[key]
         if unit.refusal:
@@ -812,6 +827,15 @@ class IsoEmitter(IsoSpelling, Emitter):
             # ISO reads F before G20/G21 (in the units before the switch): an F the source reads
             # after its units switch goes on the next line
             if any(k in line.used for k in keys) or (type(s) is n.Feed and "units" in line.used):
+                line = _Line()
+                lines.append(line)
+            line.words.extend(w for _, w in words)
+            line.used.update(keys)
+        if self.edge_lengths is not None:
+            words = self.edge_lengths.block_words(body)
+            keys = [k for k, _ in words if k]
+            line = lines[-1]
+            if any(k in line.used for k in keys):
                 line = _Line()
                 lines.append(line)
             line.words.extend(w for _, w in words)

@@ -18,6 +18,7 @@ class TurningEmitter(iso.IsoEmitter):
     table_name = "iso-t"
     target_text = "ISO turning"
     lowered_for = "ISO"
+    writes_edge_lengths = False     # a lathe's tool length is not applied along Z (tool_edges)
 
     def __init__(self, program: n.Program):
         super().__init__(program)
