@@ -280,6 +280,25 @@ class Emitter(Spelling):
             raise NotExpressible(f"mode {group}={value}")
         return rule.spelling or rule.code
 
+    def power_on_codes(self, groups: tuple[str, ...]) -> list[str]:
+        """The codes that select, in this dialect, the source controller's power-on modes of
+        `groups` where this dialect's own power-on modes differ: a program relies on its
+        controller's (an ISO lathe feeds per revolution, a mill per minute), so the converted
+        program must say them. Empty for a program already in this dialect."""
+        p = self.program
+        meta = p.meta or {}
+        if p.dialect == self.dialect or meta.get("flattened_from"):
+            return []                   # a flattened program selects its modes in its first block
+        source = meta.get("defaults") or {}
+        mine = self.table.defaults()
+        codes = []
+        for group in groups:
+            value = source.get(group)
+            if value is None or mine.get(group) == value:
+                continue
+            codes.append(self.code_for(group, value))
+        return codes
+
     def code_word(self, group: str, value: str = "") -> tuple[str, str]:
         """(modal-group key, code) of a meaning: two codes of one group of the dialect's manual
         cannot share a block, so the key makes the second start a new line."""

@@ -151,6 +151,8 @@ class IsoEmitter(IsoSpelling, Emitter):
     lowered_for = "ISO"
     # a milling control applies a tool length along Z (G43 H); a lathe's is not (iso-t)
     writes_edge_lengths: bool = True
+    # power-on modes a program from another control relies on, written out where ours differ
+    power_on_groups: tuple[str, ...] = ("feed_mode",)
 
     def __init__(self, program: n.Program):
         super().__init__(program)
@@ -435,6 +437,7 @@ class IsoEmitter(IsoSpelling, Emitter):
             title = meta.get("title")
             self.out.append(head + (f" {self._comment(str(title))}" if title is not None else ""))
         names_at = len(self.out)
+        self._power_on()
         self.nodes(p.body)
         for key, sub in p.subprograms.items():
             self.span = sub.span
@@ -452,6 +455,19 @@ class IsoEmitter(IsoSpelling, Emitter):
         if percent:
             self.out.append("%")
         return "\n".join(self.out) + "\n"
+
+    def _power_on(self) -> None:
+        """The source's power-on feed mode where this control's differs (a lathe's G99 per
+        revolution, a mill's G94 per minute), written before the body."""
+        self.span = n.Span(self.program.file, 1)
+        try:
+            codes = self.power_on_codes(self.power_on_groups)
+        except NotExpressible as e:
+            self.refuse(f"the power-on {e}")
+            return
+        if codes:
+            self.lowered(f"power-on modes of {self.program.dialect} written out: {' '.join(codes)}")
+            self.out.append(" ".join(codes))
 
     def _name_table(self) -> list[str]:
         """Comment lines naming where each variable of the source lives (ISO has numbers only):
