@@ -813,6 +813,18 @@ def run_steps(interp, steps, a1: str, a2: str, ax: str) -> None:
 # ---------------------------------------------------------------------------------------------
 # CYCLE97: thread cutting on a lathe (X radius, Z along the axis)
 
+def _thread_variant(p: dict[str, float], starts: str) -> int:
+    """VARI of CYCLE97/CYCLE98 (1/3 external, 2/4 internal), after the checks both share: finite
+    values, a known VARI, a single thread start (`starts`: the cycle's name for the count)."""
+    _finite(p)
+    vari = int(p.get("VARI", 1))
+    if vari not in (1, 2, 3, 4):
+        raise _impossible(f"with VARI {vari} (1/3 external, 2/4 internal thread)")
+    if int(p.get(starts, 1) or 1) > 1:
+        raise _unmodelled(f"with several thread starts {starts}: not modelled")
+    return vari
+
+
 def _thread_pass_depths(vari: int, nrc: int, tdep: float, fal: float, nid: int) -> list[float]:
     """The depth below the crest of each pass of CYCLE97/CYCLE98: NRC roughing cuts to TDEP - FAL,
     of equal infeed (VARI 1/2) or equal chip section (VARI 3/4: depth ~ sqrt(k)), the finishing
@@ -839,12 +851,7 @@ def thread_turn_steps(p: dict[str, float], start: tuple[float, float]) -> list[S
     and internal threads; the tool retracts _VRT (1 mm when 0) beyond the crest and goes back to
     the thread's start with G0 after each pass; flank infeed puts each cut (TDEP - depth) x
     tan(IANG) earlier along the thread, the last at the programmed start."""
-    _finite(p)
-    vari = int(p.get("VARI", 1))
-    if vari not in (1, 2, 3, 4):
-        raise _impossible(f"with VARI {vari} (1/3 external, 2/4 internal thread)")
-    if int(p.get("NUMT", 1) or 1) > 1:
-        raise _unmodelled("with several thread starts NUMT: not modelled")
+    vari = _thread_variant(p, "NUMT")
     lead = abs(p.get("PIT", 0.0))
     if not lead and p.get("MPIT"):
         from nctrans.interp.cycles import coarse_pitch
@@ -908,12 +915,7 @@ def thread_chain_steps(p: dict[str, float], start: tuple[float, float]) -> list[
     each pass keeps its depth below the crest at every chain point; the sections must run one way
     along Z and be threads, not faces (each at most 45 degrees steep): a chain that turns back or
     a face section is not modelled (NC224)."""
-    _finite(p)
-    vari = int(p.get("VARI", 1))
-    if vari not in (1, 2, 3, 4):
-        raise _impossible(f"with VARI {vari} (1/3 external, 2/4 internal thread)")
-    if int(p.get("NUMTH", 1) or 1) > 1:
-        raise _unmodelled("with several thread starts NUMTH: not modelled")
+    vari = _thread_variant(p, "NUMTH")
     zs = [p.get(f"PO{k}", 0.0) for k in range(1, 5)]
     ds = [p.get(f"DM{k}", 0.0) for k in range(1, 5)]
     leads = [abs(p.get(f"PP{k}", 0.0)) for k in range(1, 4)]
