@@ -213,6 +213,22 @@ class SettableFrames:
             raise EvalError("NC104", f"{what} needs a number")
         return float(v)
 
+    def _set_component(self, trans: dict, comps: dict, axis: str, comp: str, value: float) -> bool:
+        """One component write into (translation per axis, components): TR replaces the coarse
+        translation and FI the fine one (the axis's translation is coarse + fine); RT, SC and MI
+        are kept as components. True when the translation changed."""
+        if comp not in ("TR", "FI"):
+            comps.setdefault(comp, {})[axis] = value
+            return False
+        fine = comps.setdefault("FI", {})
+        coarse = trans.get(axis, 0.0) - fine.get(axis, 0.0) * self._lin(axis)
+        if comp == "TR":
+            coarse = value * self._lin(axis)
+        else:
+            fine[axis] = value
+        trans[axis] = coarse + fine.get(axis, 0.0) * self._lin(axis)
+        return True
+
     def _split(self, key: tuple, what: str) -> tuple[str, str]:
         if len(key) != 2 or not all(isinstance(k, str) for k in key) or key[1] not in COMPONENTS:
             raise EvalError("NC104", f"{what}[..]: a component is [axis, TR|FI|RT|SC|MI]")
@@ -264,17 +280,8 @@ class SettableFrames:
             value = self._number(v, f"settable frame {index} [{axis},{comp}]")
             comps = self.comps.setdefault(index, {})
             cur = dict(m.offsets.get(name, {}))
-            if comp in ("TR", "FI"):
-                fine = comps.setdefault("FI", {})
-                coarse = cur.get(axis, 0.0) - fine.get(axis, 0.0) * self._lin(axis)
-                if comp == "TR":
-                    coarse = value * self._lin(axis)
-                else:
-                    fine[axis] = value
-                cur[axis] = coarse + fine.get(axis, 0.0) * self._lin(axis)
+            if self._set_component(cur, comps, axis, comp, value):
                 m.offsets[name] = cur
-            else:
-                comps.setdefault(comp, {})[axis] = value
         if name == "G53" and (any(m.offsets.get(name, {}).values())
                               or linear_part(self.comps.get(index, {})) is not None):
             raise EvalError("NC237", "settable frame 0 (G500) written with a non-zero value: not "
@@ -312,16 +319,7 @@ class SettableFrames:
         else:
             axis, comp = self._split(key, "active settable frame")
             value = self._number(v, f"active settable frame [{axis},{comp}]")
-            if comp in ("TR", "FI"):
-                fine = self.active_comps.setdefault("FI", {})
-                coarse = trans.get(axis, 0.0) - fine.get(axis, 0.0) * self._lin(axis)
-                if comp == "TR":
-                    coarse = value * self._lin(axis)
-                else:
-                    fine[axis] = value
-                trans[axis] = coarse + fine.get(axis, 0.0) * self._lin(axis)
-            else:
-                self.active_comps.setdefault(comp, {})[axis] = value
+            self._set_component(trans, self.active_comps, axis, comp, value)
         ext = self.it.machine.work_offset("EXT")
         self.it.off.set_work({a: trans.get(a, 0.0) + ext.get(a, 0.0) for a in {**trans, **ext}})
         self.it.frame.set_settable(linear_part(self.active_comps))
