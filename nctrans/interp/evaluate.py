@@ -531,7 +531,7 @@ class Evaluator:
         args = []
         for a in e.args:
             if name == "AXSTRING" and type(a) is n.Var and a.space == "name" and not a.indices:
-                args.append(lambda k=str(a.key): k)
+                args.append(self._axis_or_variable(a))
             else:
                 args.append(self.compile(a))
 
@@ -546,6 +546,17 @@ class Evaluator:
             except ValueError as ex:
                 raise EvalError("NC104", str(ex)) from None
         return call
+
+    def _axis_or_variable(self, a: n.Var) -> Callable[[], Any]:
+        """AXSTRING's argument: an AXIS variable's value (_A=AXNAME("Y")), else the axis name as
+        written (AXSTRING(X), AXSTRING(SPINDLE1))."""
+        read, key = self.compile(a), str(a.key)
+
+        def value():
+            if self._lookup_name(key.upper()) is None and self._lookup_name(key) is None:
+                return key
+            return read()
+        return value
 
     # ---------------------------------------------------------------- frames
     def _compile_frame(self, e: n.Func) -> Callable[[], Any]:

@@ -1,5 +1,5 @@
 """Sinumerik string functions (spec 4.5, seed L2106-2578): STRLEN, INDEX, RINDEX, MINDEX, MATCH,
-SUBSTR, TOUPPER, TOLOWER, NUMBER, ISNUMBER, AXSTRING, ISAXIS.
+SUBSTR, TOUPPER, TOLOWER, NUMBER, ISNUMBER, AXSTRING, AXNAME, ISAXIS.
 
 Each takes the evaluated arguments (str, float or an axis name) and returns a str, a float, or
 raises ValueError with what the control would alarm on (the evaluator reports it as NC104).
@@ -65,6 +65,17 @@ def _isnumber(s):
     return 1.0 if isinstance(s, str) and _REAL.fullmatch(s) else 0.0
 
 
+def _axname(s):
+    """AXNAME("X") -> the axis identifier X (seed L2217-2238: "an alarm is output if the string
+    cannot be assigned to any configured axis identifier"): the axis letters X Y Z A B C U V W,
+    optionally numbered (X1), as nctrans knows axis identifiers everywhere else."""
+    from nctrans.interp.evaluate import AXIS_NAME, AxisName
+    name = _text(s, "AXNAME").strip().upper()
+    if not AXIS_NAME.match(name):
+        raise ValueError(f"AXNAME: {name!r} is not an axis identifier (the control stops with an alarm)")
+    return AxisName(name)
+
+
 def _isaxis(n):
     return 1.0 if n in (1.0, 2.0, 3.0) else 0.0       # geometry axes 1..3 of a mill or a lathe
 
@@ -81,5 +92,6 @@ FUNCTIONS: dict[str, Callable[..., Any]] = {
     "NUMBER": _number,
     "ISNUMBER": _isnumber,
     "AXSTRING": lambda a: str(a).upper(),
+    "AXNAME": _axname,
     "ISAXIS": _isaxis,
 }
