@@ -398,7 +398,7 @@ class MillingCycle:
     name: str
     shape: Literal["rect_pocket", "circ_pocket", "rect_pocket3", "circ_pocket4", "rect_spigot", "circ_spigot", "slots_circle",
                    "arc_slots", "long_holes", "face", "thread_mill", "thread_turn", "stock_removal", "contour_mill", "groove",
-                   "thread_chain"]
+                   "thread_chain", "undercut", "thread_undercut"]
     params: list[str]
     meaning: str = ""
 
@@ -408,6 +408,40 @@ class MillingParam:
     __pydantic_config__ = {"extra": "forbid"}
     unit: Literal["length", "feed", "angle", "code", "count", "speed", "time", "name"]
     meaning: str
+
+
+@dataclass
+class Din509Row:
+    """One row of the DIN 509 undercut table (form E/F), by the largest finished diameter."""
+    __pydantic_config__ = {"extra": "forbid"}
+    max_diameter: float
+    depth: float
+    width: float
+    radius: float
+    face_depth: float
+
+
+@dataclass
+class Din76Row:
+    """One row of the DIN 76 external thread undercut table, by the pitch."""
+    __pydantic_config__ = {"extra": "forbid"}
+    pitch: float
+    diameter_less: float          # nominal diameter - undercut diameter
+    width_normal: float           # form A
+    width_short: float            # form B
+    radius: float
+
+
+@dataclass
+class UndercutTables:
+    """rules/cycles.toml [undercut]: the CYCLE94 / CYCLE96 tables (nctrans.interp.undercuts)."""
+    __pydantic_config__ = {"extra": "forbid"}
+    din509_run_out: float = 15.0
+    din509_face_angle: float = 8.0
+    din76_run_out: float = 30.0
+    clearance: float = 1.0
+    din509: list[Din509Row] = field(default_factory=list)
+    din76: list[Din76Row] = field(default_factory=list)
 
 
 @dataclass
@@ -426,6 +460,7 @@ class CycleTable:
     milling: list[MillingCycle] = field(default_factory=list)
     milling_param: dict[str, MillingParam] = field(default_factory=dict)
     milling_model: dict[str, float] = field(default_factory=dict)
+    undercut: UndercutTables = field(default_factory=UndercutTables)
 
     @classmethod
     def from_data(cls, d: dict) -> "CycleTable":
@@ -443,7 +478,8 @@ class CycleTable:
                    metric_coarse_pitch=dict(d.get("metric_coarse_pitch", {})),
                    milling=[MillingCycle(**m) for m in d.get("milling", [])],
                    milling_param={k: MillingParam(**v) for k, v in d.get("milling_param", {}).items()},
-                   milling_model=dict(d.get("milling_model", {})))
+                   milling_model=dict(d.get("milling_model", {})),
+                   undercut=_undercut_tables(d.get("undercut", {})))
 
     def position_at(self, dialect: str) -> str:
         """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle)."""
@@ -452,6 +488,12 @@ class CycleTable:
     def neutral(self, name: str) -> str:
         """The neutral key of a Siemens parameter name, or its lowercase spelling if it has none."""
         return self.names.get(name, name.lower())
+
+
+def _undercut_tables(d: dict) -> UndercutTables:
+    rows = {k: v for k, v in d.items() if k not in ("din509", "din76")}
+    return UndercutTables(**rows, din509=[Din509Row(**r) for r in d.get("din509", [])],
+                          din76=[Din76Row(**r) for r in d.get("din76", [])])
 
 
 @lru_cache(maxsize=1)

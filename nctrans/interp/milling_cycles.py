@@ -755,6 +755,10 @@ def run_milling_cycle(interp, s) -> None:
         from nctrans.interp.grooving import run_cycle93
         run_cycle93(interp, cyc, s)
         return
+    if cyc.shape in ("undercut", "thread_undercut"):    # turning (nctrans.interp.undercuts)
+        from nctrans.interp.undercuts import run_undercut
+        run_undercut(interp, cyc, s)
+        return
     if s.modal:
         select_modal(interp, s)
         return
