@@ -21,7 +21,7 @@ from __future__ import annotations
 from contextvars import ContextVar
 from typing import Any, Callable, Iterator, Optional
 
-from nctrans.interp import unmodelled
+from nctrans.interp import corner_elements, unmodelled
 from nctrans.interp.compiled import (BLOCK, CASE, EXEC, Frame, JFALSE, JUMP, MAX_CALL_DEPTH, PLAIN,
                                      Unit, _Stop, _plain_entry, label_key)
 from nctrans.interp.cycles import unmodelled_cycle
@@ -136,7 +136,7 @@ class FlowMixin:
         for s in block.body:
             c = comp.get(type(s))
             if c is not None:
-                if type(s) is n.Passthrough and unmodelled.takes_motion(s):
+                if type(s) is n.Passthrough and (unmodelled.takes_motion(s) or corner_elements.kind_of(s)):
                     out.insert(0, c(s))      # it owns the block's axis words: before the motion
                     continue
                 out.append(c(s))
@@ -390,6 +390,7 @@ class FlowMixin:
         except _Stop:
             pass
         try:
+            corner_elements.finish(self)    # a move held for a corner element that never came
             self._comp_flush()
             yield from self._release(out)
         except _Stop:

@@ -158,6 +158,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.modal_cycle = None         # CycleCall with modal=True
         self.pole: Optional[tuple[float, float]] = None   # polar pole in the plane (program coords)
         self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
+        self.corner = None              # corner_elements.CornerStage while RND/CHF ... is in play
         self._unmodelled_at = None                          # the span of the block that set it
         self.spelt_codes: dict[str, str] = {}   # neutral group -> the code spelt last ($P_GG)
         self.stack: list[Frame] = []

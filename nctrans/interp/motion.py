@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Optional
 
-from nctrans.interp import arcs, rigid_tap
+from nctrans.interp import arcs, corner_elements, rigid_tap
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
@@ -91,7 +91,8 @@ class MotionMixin:
         if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
                 or self.comp_exit or st.comp_side != "off" or not self.frame.identity
                 or self.unmodelled_motion is not None or st.diameter
-                or self.css_surface is not None or self.spindle_stopped or self.watch):
+                or self.css_surface is not None or self.spindle_stopped or self.watch
+                or self.corner is not None):
             return self._slow(d)
         motion = st.motion
         if motion == "rapid":
@@ -330,6 +331,8 @@ class MotionMixin:
 
     def _machine_move(self, vals) -> None:
         """G53: the words are machine coordinates of the controlled point, this block only."""
+        if self.corner is not None:     # a held move first: G53 starts from where it ends
+            corner_elements.flush(self, "the next move is in machine coordinates (G53)")
         mend = dict(self.mpos)
         for a, v, _ in vals:
             mend[a] = v

@@ -52,7 +52,8 @@ class NativeLaneMixin:
                 or self.comp is not None or self.comp_exit or st.comp_side != "off"
                 or not self.frame.identity or self.modal_call is not None or self.hook is not None
                 or st.feed_mode not in ("per_min", "per_rev") or self.out
-                or self.unmodelled_motion is not None or self.spindle_stopped or self.watch):
+                or self.unmodelled_motion is not None or self.spindle_stopped or self.watch
+                or self.corner is not None):
             return False
         axes = "".join(self.pos)
         return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)

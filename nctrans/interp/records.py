@@ -8,6 +8,7 @@ A mixin of Interpreter.
 """
 from __future__ import annotations
 
+from nctrans.interp import corner_elements
 from nctrans.interp.cutter_comp import PlannedMove
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.toolpath import ToolpathRecord
@@ -18,6 +19,11 @@ class RecordsMixin:
     def _record(self, kind: str, **kw) -> None:
         rec = ToolpathRecord(0, self.span.file if self.span else self.program.file,
                              self.span.line if self.span else 1, kind, **kw)
+        if self.corner is not None and corner_elements.record(self, rec):
+            return                      # waits behind a move that leads to a corner element
+        self._push_record(rec)
+
+    def _push_record(self, rec) -> None:
         if self.comp is not None:
             self._comp_out(self.comp.push(rec))
         else:
@@ -38,16 +44,23 @@ class RecordsMixin:
             self._css_move(end)
         self.last_from = start
         self.last_arc = (center, cw) if kind == "arc" else None
+        if self.corner is not None:         # a corner element is programmed or held
+            corner_elements.move(self, kind, start, end, center, cw, turns, self._payload())
+            return
+        self._emit_move(kind, start, end, center, cw, turns, self._payload())
+
+    def _emit_move(self, kind, start, end, center, cw, turns, payload) -> None:
+        """A move of the programmed contour on to cutter compensation and the records."""
         if self.comp_exit or self.comp is not None or (
                 self.st.comp_side != "off" and self.comp_radius):
-            if self._comp_move(kind, start, end, center, cw, turns):
+            if self._comp_move(kind, start, end, center, cw, turns, payload):
                 return
         elif self.st.comp_side != "off" and not self.st.radius_index:
-            self._comp_without_offset(kind, start, end, center, cw, turns)
+            self._comp_without_offset(kind, start, end, center, cw, turns, payload)
             return
-        self._finish_move(kind, start, end, center, cw, turns, self._payload())
+        self._finish_move(kind, start, end, center, cw, turns, payload)
 
-    def _comp_without_offset(self, kind, start, end, center, cw, turns) -> None:
+    def _comp_without_offset(self, kind, start, end, center, cw, turns, payload) -> None:
         """G41/G42 on with no D word. Where the dialect's table names the cutting edge a tool
         brings by default (options.default_cutting_edge, Sinumerik D1), compensate with it as if
         written; else the controller compensates by zero: NC208, and the move runs as programmed."""
@@ -56,13 +69,13 @@ class RecordsMixin:
             self.st.radius_index = edge
             self.comp_radius = self.machine.radius_offset(edge)
             if self.comp_radius and self._comp_move(
-                    kind, start, end, center, cw, turns):
+                    kind, start, end, center, cw, turns, payload):
                 return
         elif not self.comp_d_reported:
             self.comp_d_reported = True
             self.diag("NC208", "error", f"cutter compensation ({self.st.comp_side}) is on but no D word "
                       "selects a radius offset: the tool runs on the programmed contour uncompensated")
-        self._finish_move(kind, start, end, center, cw, turns, self._payload())
+        self._finish_move(kind, start, end, center, cw, turns, payload)
 
     def _payload(self) -> tuple:
         sp = self.span
@@ -105,11 +118,11 @@ class RecordsMixin:
             wc = None if mc is None else {a: v - tot.get(a, 0.0) for a, v in mc.items()}
             self._hookq.append((work, wc))
 
-    def _comp_move(self, kind, start, end, center, cw, turns) -> bool:
+    def _comp_move(self, kind, start, end, center, cw, turns, payload=None) -> bool:
         pm = PlannedMove(kind=kind, start=start, end=end,
                          center=None if center is None else self._center_dict(center, end),
                          direction=None if cw is None else ("cw" if cw else "ccw"),
-                         turns=turns, payload=self._payload())
+                         turns=turns, payload=payload or self._payload())
         if self.comp_exit:
             comp, self.comp, self.comp_exit = self.comp, None, False
             if comp is not None:

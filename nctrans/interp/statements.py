@@ -6,7 +6,7 @@ A mixin of Interpreter. Spindle speed limits (SpindleLimit) are handled in lathe
 """
 from __future__ import annotations
 
-from nctrans.interp import computed_g, indirect_g, rigid_tap, unmodelled
+from nctrans.interp import computed_g, corner_elements, indirect_g, rigid_tap, unmodelled
 from nctrans.interp.evaluate import constant
 from nctrans.interp.offsets import NORMAL
 from nctrans.interp.travel_limits import ProgrammedLimits
@@ -211,6 +211,8 @@ class StatementsMixin:
     def _c_passthrough(self, s: n.Passthrough):
         if computed_g.is_computed_g(s):
             return (computed_g.select, (self, s, self.ev.compile(s.value)))
+        if corner_elements.kind_of(s):
+            return corner_elements.compile_word(self, s)
         if s.reason == rigid_tap.COMPENSATING_CHUCK:
             return (rigid_tap.compensating_chuck, self)
         if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")) or \

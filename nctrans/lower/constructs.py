@@ -29,6 +29,7 @@ from typing import Callable, Optional
 
 from nctrans import limits
 from nctrans.diagnostics import Diagnostic
+from nctrans.interp import corner_elements
 from nctrans.interp.interpreter import Interpreter
 from nctrans.lower.flatten import ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Walker
 from nctrans.ir import nodes as n
@@ -122,12 +123,53 @@ class _ModalRuns:
             self.start = None
 
 
+class _CornerRuns:
+    """(first, last) top-level indices of each chain of corner elements (Sinumerik RND, CHF, RNDM,
+    ISO ,R ,C): from a node whose block leads to a rounding or chamfer to the next node that moves
+    without leading to one. The element joins two blocks (interp/corner_elements.py), so lowered
+    apart one of them would lose it. Fed one node at a time (see _ModalRuns)."""
+
+    def __init__(self, closed: Callable[[int, int], None]):
+        self.closed = closed
+        self.start: Optional[int] = None
+        self.modal = False                  # RNDM in force (a computed value counts as on)
+
+    def feed(self, i: int, node) -> None:
+        moves = leads = False
+        for x in walk([node]):
+            if type(x) is not n.Block:
+                continue
+            for s in x.body:
+                t = type(s)
+                if t is n.Motion and (s.target or s.indirect or s.polar):
+                    moves = True
+                elif t is n.Passthrough and (kind := corner_elements.kind_of(s)):
+                    if kind == "round_modal":
+                        self.modal = not (type(s.value) is n.Num and s.value.value == 0)
+                    elif kind in ("round", "chamfer_leg", "chamfer_length"):
+                        leads = True
+        leads = leads or (self.modal and moves)
+        if self.start is not None and moves and not leads:
+            self.closed(self.start, i)
+            self.start = None
+        elif self.start is None and leads:
+            self.start = i
+
+    def end(self, last: int) -> None:
+        if self.start is not None:
+            self.closed(self.start, last)
+            self.start = None
+
+
 def _modal_runs(body: list) -> list[tuple[int, int]]:
     runs: list[tuple[int, int]] = []
     scan = _ModalRuns(lambda a, b: runs.append((a, b)))
+    corner_scan = _CornerRuns(lambda a, b: runs.append((a, b)))
     for i, node in enumerate(body):
         scan.feed(i, node)
+        corner_scan.feed(i, node)
     scan.end(len(body) - 1)
+    corner_scan.end(len(body) - 1)
     return runs
 
 

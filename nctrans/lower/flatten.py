@@ -42,6 +42,7 @@ from typing import Any, Callable, Iterator, Optional
 
 from nctrans.convert import HELD_LIMIT_NOTE as HELD_LIMIT
 from nctrans.diagnostics import Diagnostic, at_span
+from nctrans.interp import corner_elements
 from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.rigid_tap import COMPENSATING_CHUCK
@@ -197,6 +198,9 @@ class _Walker:
             self.diags.append(at_span("NC401", "info", f"--flatten writes {s.text} (tapping with a "
                                       "compensating chuck) as the block's G1 feed move it is; the "
                                       "feed override hold at 100 % is not written", span))
+        elif corner_elements.kind_of(s):
+            self.diags.append(at_span("NC401", "info", f"--flatten writes {what} as the arc or line "
+                                      "it inserts at the corner (interp/corner_elements)", span))
         elif no_motion_effect(s.reason, self.machine_kind):
             self.diags.append(at_span("NC401", "info", f"--flatten leaves out {what}: no effect on "
                                       "the motion", span))

@@ -39,7 +39,7 @@ from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks
 from nctrans.lower.constructs import (
     OFFSET_DATA_WHY, STRETCH_MODES, Segment, SegmentHook, _AllRefused, _local, _local_names, _marker, _ModalRuns,
-    _restore, _sets, _StretchRuns, _variables_reason, _vars, _written, lowered_notes, refused)
+    _restore, _sets, _StretchRuns, _CornerRuns, _variables_reason, _vars, _written, lowered_notes, refused)
 from nctrans.lower.flatten import _Walker
 
 
@@ -106,6 +106,7 @@ def _survey(nodes: Iterable, file: str, refusals: list[Diagnostic]) -> _Survey:
     # run, or inside a stretch of another group (the widening's own order)
     relevant: set[int] = set()
     modal_scan = _ModalRuns(modal_closed)
+    corner_scan = _CornerRuns(modal_closed)
     stretch_scan = _StretchRuns(keep=relevant.__contains__)
     last = -1
     for i, node in enumerate(nodes):
@@ -118,11 +119,13 @@ def _survey(nodes: Iterable, file: str, refusals: list[Diagnostic]) -> _Survey:
         open_before = modal_scan.start is not None or any(
             s is not None for s in stretch_scan.start.values())
         modal_scan.feed(i, node)
+        corner_scan.feed(i, node)
         stretch_scan.feed(i, node)
         if i in stretch_scan.start.values() and (
                 open_before or modal_scan.start is not None or (refused_at and refused_at[-1] == i)):
             relevant.add(i)
     modal_scan.end(last)
+    corner_scan.end(last)
     stretch = stretch_scan.end(last)
     found: list[Segment] = []
     outside: list[Diagnostic] = []

@@ -31,6 +31,7 @@ import math
 from typing import Any, Optional
 
 from nctrans.diagnostics import at_span
+from nctrans.interp import corner_elements
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, format_number, rewrites
 from nctrans.ir import nodes as n
 from nctrans.ir import walk
@@ -856,7 +857,8 @@ class IsoEmitter(IsoSpelling, Emitter):
                 lines.append(line)
             line.words.extend(w for _, w in words)
             line.used.update(keys)
-        return [ln.words for ln in lines if ln.words]
+        # the chamfer / corner rounding words `,C` `,R` end their block (seed L3962-3967)
+        return [sorted(ln.words, key=lambda w: w.startswith(",")) for ln in lines if ln.words]
 
     def _g(self, group: str, value: str, code: str = "") -> tuple[str, str]:
         rule = self.table.lookup(code) if code else None
@@ -1676,6 +1678,8 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def w_Passthrough(self, s: n.Passthrough):
         self.forget()
+        if s.dialect not in ("", self.dialect) and corner_elements.kind_of(s):
+            return [("", self._corner_word(s))]
         if s.dialect not in ("", self.dialect):
             from nctrans.interp.unmodelled import no_motion_effect
             if self._same_in_target(s):
@@ -1688,6 +1692,17 @@ class IsoEmitter(IsoSpelling, Emitter):
                 return [("", self._comment(s.text.strip()))]
             raise NotConvertible(f"{s.dialect} text {s.text!r}", s.text.strip())
         return [("", s.text)]
+
+    def _corner_word(self, s: n.Passthrough) -> str:
+        """Another dialect's rounding or chamfer as this dialect's `,R` / `,C` where it has the same
+        element (rules options.corner_elements); else refused, and lowered to the arc or line."""
+        kind = corner_elements.kind_of(s)
+        own = {v: k for k, v in corner_elements.settings(self.dialect).get("words", {}).items()}
+        word = own.get(kind)
+        if word is None:
+            raise NotConvertible(f"{s.dialect} {s.reason} {s.text.strip()!r} (no {self.dialect} word for "
+                                 "it: the corner is written as the arc or line it inserts)", s.text.strip())
+        return "," + self.addr(word.lstrip(","), s.value)
 
     def _same_in_target(self, s: n.Passthrough) -> bool:
         """Text of another dialect that this dialect's own front end reads as the same construct

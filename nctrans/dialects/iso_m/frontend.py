@@ -163,6 +163,7 @@ class Lowering:
         self.raw = ""                   # the current line, comments blanked (set by the parser)
         self._dup_line = 0
         self.standard = opts.get("decimal_mode", "pocket") == "standard"
+        self.corner_words = opts.get("corner_elements", {}).get("words", {})
         self.factors = opts.get("standard_factors", {}).get(opts.get("increment_system", "IS-B"), {})
         self.prog8 = bool(opts.get("prog_number_8digit", False))
         self.local_call_code = ""       # the profile's local subprogram call (Haas M97), if any
@@ -766,6 +767,10 @@ class Lowering:
 
         for k, v in vals.items():       # words nothing above gave a meaning
             text = _word_text(k, v)
+            if k in self.corner_words:  # ,R / ,C: interp/corner_elements.py
+                out.append((B_NONMODAL, Passthrough(text, self.corner_words[k], self.dialect,
+                                                    address=k, value=self.num(k, v))))
+                continue
             self.warn_once("word:" + k, "NC403", "warning",
                            f"{text}: address {k.lstrip(',')} has no meaning in this block; kept verbatim", line)
             out.append((B_NONMODAL, self._pass(text, f"address {k} without an IR meaning here")))

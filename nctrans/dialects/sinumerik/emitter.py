@@ -45,6 +45,7 @@ from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import computed_g, macro_procs, modal_numbers
 from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
+from nctrans.interp import corner_elements
 from nctrans.interp.settable_frames import external_frame_variable
 from nctrans.interp.unmodelled import FRAME_NOT_MODELLED
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
@@ -535,6 +536,13 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def w_Passthrough(self, s: ir.Passthrough, out: "_Line") -> None:
         if s.dialect in (DIALECT, "") or s.reason == "ISO dialect section":
             out.words.append(s.text)        # (an unparsed G291 section is ISO text in place)
+        elif corner_elements.kind_of(s):
+            # another dialect's rounding or chamfer (ISO ,R / ,C): the Sinumerik word of that element
+            own = {v: k for k, v in corner_elements.settings(DIALECT).get("words", {}).items()}
+            word = own.get(corner_elements.kind_of(s))
+            if word is None:
+                raise NotExpressible(f"{s.dialect} {s.reason} {s.text.strip()!r}")
+            out.words.append(f"{word}={self.expr(s.value)}")
         elif computed_g.is_computed_g(s):
             self.computed_g(s, out)
         elif s.address and s.value is not None and s.address in _COMPUTED_WORDS:

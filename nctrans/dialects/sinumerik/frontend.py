@@ -375,6 +375,7 @@ class Lowerer:
         self.via = t.options.get("via_words", {})
         self.motion_words = t.options.get("motion_words", {})
         self.pass_words = t.options.get("passthrough_words", {})
+        self.corner_words = t.options.get("corner_elements", {}).get("words", {})
         self.commands = t.options.get("machine_commands", {})
         self.whole_block = set(t.options.get("whole_block_commands", []))
         self.unsupported = t.options.get("unsupported_functions", {})
@@ -497,6 +498,9 @@ class Lowerer:
             w.out.append(ir.Assign(ir.Var("R", int(name[1:])), value))
         elif name == "LIMS":                                  # the clamp of G96 (lathe.py)
             w.out.append(ir.SpindleLimit(value))
+        elif name in self.corner_words:     # RND=, CHF= ...: interp/corner_elements.py
+            w.out.append(ir.Passthrough(_t(text), self.pass_words.get(name, "corner element"), DIALECT,
+                                        address=name, value=value))
         elif name in self.pass_words:
             w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
         elif re.fullmatch(r"M\d+", name) and name == "M1" and isinstance(value, ir.Num) and \

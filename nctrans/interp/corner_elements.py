@@ -1,0 +1,304 @@
+"""Contour corner elements as motion: Sinumerik RND/RNDM/CHF/CHR with FRC/FRCM, ISO `,R`/`,C`.
+
+The word sits in the block that leads to the corner; the control inserts the rounding arc or the
+chamfer between that block and the next contour block. The interpreter therefore holds back the
+one move that carries a corner element (the *pending* move, in program coordinates, before cutter
+compensation: the control rounds the programmed contour) until the next move is known; records
+of blocks between them (M functions) wait with it. Memory stays flat: at most one move and a few
+records are held.
+
+Which words exist, what they mean and what the control does when no contour element follows are
+data: `[options.corner_elements]` of the dialect's rules table (words -> round, round_modal,
+chamfer_length, chamfer_leg, feed, feed_modal; `missing_next` "alarm" (ISO seed L4000-4004) or
+"none" (Sinumerik [GK]: no element is inserted); `dummy_blocks`, the blocks without motion that
+may stand between; `feed_from`). The geometry is corners.py.
+
+Not inserted, said at the line of the word (NC217 warning, NC218 error where the control alarms):
+the next move is not G1/G2/G3 in the same plane, or moves outside the plane, the plane, the frame
+or the cutter compensation changes between the two blocks, an element is a full circle or helix,
+or the element does not fit (the Sinumerik control then shrinks it [GK]; that is not modelled).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+from typing import Optional
+
+from nctrans.interp import corners
+from nctrans.interp.frames import PLANE_AXES
+from nctrans.ir import nodes as n
+
+CONTOUR_KINDS = ("linear", "arc")
+_NOUN = {"round": "rounding", "round_modal": "modal rounding", "chamfer_length": "chamfer",
+         "chamfer_leg": "chamfer"}
+
+
+@lru_cache(maxsize=None)
+def settings(dialect: str) -> dict:
+    """The dialect's `[options.corner_elements]` table ({} when it has none)."""
+    try:
+        from nctrans.rules import load_table
+        return dict(load_table(dialect).options.get("corner_elements", {}) or {})
+    except Exception:           # a dialect without a table of its own
+        return {}
+
+
+def kind_of(s: n.Passthrough) -> Optional[str]:
+    """The corner-element meaning of a Passthrough (round, chamfer_leg, feed ...), or None."""
+    if not s.address or s.value is None:
+        return None
+    return settings(s.dialect).get("words", {}).get(s.address.upper())
+
+
+@dataclass
+class Move:
+    """A move as records.py's _move had it, in program coordinates."""
+    kind: str
+    start: dict
+    end: dict
+    center: Optional[tuple]
+    cw: Optional[bool]
+    turns: Optional[int]
+    payload: tuple
+    span: Optional[n.Span] = None
+    probe: tuple = ()
+    corner: tuple = ()              # (kind, value, feed or None, dialect) it carries
+
+
+@dataclass
+class CornerStage:
+    """The interpreter's corner state; exists only while something is programmed or held."""
+    block: Optional[tuple] = None           # (kind, value, span, dialect) of this block's word
+    block_feed: Optional[tuple] = None      # (FRC value, span)
+    modal_round: Optional[tuple] = None     # (RNDM radius, dialect)
+    modal_feed: Optional[float] = None      # FRCM
+    pending: Optional[Move] = None
+    queued: list = field(default_factory=list)
+
+
+def compile_word(it, s: n.Passthrough):
+    """(handler, data) of a corner word: evaluated where the block runs, before its motion."""
+    return (_h_word, (it, kind_of(s), it.ev.compile(s.value), s))
+
+
+def _h_word(d) -> None:
+    it, kind, f, s = d
+    if it.capture is not None:          # reading a turning cycle's contour (lathe.py)
+        it.diag("NC220", "warning", f"{s.text.strip()!r} ({s.reason}) in a turning cycle's contour "
+                "is not modelled: the cycle's toolpath leaves it out")
+        return
+    v = it._value(f, s.text.strip())
+    if v is None:
+        return
+    v = float(v)
+    if kind in ("round", "round_modal", "chamfer_length", "chamfer_leg"):
+        v *= it.st.scale
+    if v < 0 or (v == 0 and kind == "feed"):
+        it.diag("NC120", "error", f"{s.text.strip()} must be {'greater than 0' if kind == 'feed' else 'a length without sign'}: "
+                "the control refuses it; nothing is inserted")
+        return
+    cs = it.corner or CornerStage()
+    it.corner = cs
+    if kind == "round_modal":
+        cs.modal_round = (v, s.dialect) if v > 0 else None
+    elif kind == "feed_modal":
+        cs.modal_feed = v if v > 0 else None
+    elif kind == "feed":
+        cs.block_feed = (v, it.span)
+    else:
+        _stale(it, cs)
+        cs.block = (kind, v, it.span, s.dialect) if v > 0 else None
+    _idle(it)
+
+
+def _stale(it, cs: CornerStage) -> None:
+    """A block word left from a block that had no move: the corner has nothing to follow."""
+    b = cs.block
+    if b is not None and b[2] is not it.span:
+        cs.block = None
+        it.diag("NC217", "warning", f"the {_NOUN[b[0]]} is not inserted: its block moves nothing "
+                "to a corner", b[2])
+
+
+def _idle(it) -> None:
+    cs = it.corner
+    if (cs is not None and cs.block is None and cs.block_feed is None and cs.modal_round is None
+            and cs.modal_feed is None and cs.pending is None and not cs.queued):
+        it.corner = None
+
+
+def _carried(it, cs: CornerStage, kind: str) -> tuple:
+    """The corner element this move leads to: (kind, value, feed, dialect), or ()."""
+    feed = None
+    bf = cs.block_feed
+    if bf is not None:
+        cs.block_feed = None
+        if bf[1] is it.span:
+            feed = bf[0]
+    if feed is None:                    # FRCM in force where the element is programmed
+        feed = cs.modal_feed
+    b = cs.block
+    if b is not None and b[2] is it.span:
+        cs.block = None
+        return (b[0], b[1], feed, b[3])
+    _stale(it, cs)
+    if cs.modal_round is not None and kind in CONTOUR_KINDS:
+        return ("round", cs.modal_round[0], feed, cs.modal_round[1])
+    return ()
+
+
+def _probe(it, m: Move) -> tuple:
+    """The machine points of three program points at the corner: equal at both blocks when the
+    frame, offsets and tool length have not changed between them."""
+    a1, _, _ = PLANE_AXES[m.payload[6]]
+    shifted = dict(m.end)
+    shifted[a1] = shifted.get(a1, 0.0) + 1.0
+    return (it._to_machine(m.start), it._to_machine(m.end), it._to_machine(shifted),
+            it.st.comp_side, it.comp_radius, it.comp is None, it.comp_exit)
+
+
+def move(it, kind, start, end, center, cw, turns, payload) -> None:
+    """records._move with a corner stage: hold, join or pass on the move."""
+    cs = it.corner
+    new = Move(kind, start, end, center, cw, turns, payload, it.span)
+    new.corner = _carried(it, cs, kind)
+    p = cs.pending
+    if p is not None:
+        cs.pending = None
+        new = _join(it, p, new)
+    if new.corner:
+        if kind in CONTOUR_KINDS:
+            new.probe = _probe(it, new)
+            cs.pending = new
+            _idle(it)
+            return
+        _not_inserted(it, new, "its block is not a contour move (G1, G2, G3)")
+    _emit(it, new)
+    _idle(it)
+
+
+def record(it, rec) -> bool:
+    """A non-motion record while a move is held: it waits (True), unless too many blocks without
+    motion in the plane stand between (the corner then goes, uninserted)."""
+    cs = it.corner
+    if cs is None or cs.pending is None:
+        return False
+    cs.queued.append(rec)
+    p = cs.pending
+    allowed = int(settings(p.corner[3]).get("dummy_blocks", 0))
+    lines = {(r.file, r.line) for r in cs.queued}
+    if len(lines) > allowed:
+        flush(it, f"{'a block' if not allowed else f'more than {allowed} blocks'} without motion "
+              "in the plane stands between it and the next contour move")
+    return True
+
+
+def flush(it, why: str = "no contour move follows it") -> None:
+    """Let the held move go as programmed (no corner element), then what waited behind it."""
+    cs = it.corner
+    if cs is None:
+        return
+    _stale(it, cs)
+    p = cs.pending
+    if p is not None:
+        cs.pending = None
+        _not_inserted(it, p, why)
+        _emit(it, p)
+    _replay(it, cs)
+    _idle(it)
+
+
+def finish(it) -> None:
+    """The program ended: what is held goes, and a word whose block never moved is said."""
+    cs = it.corner
+    if cs is not None and cs.block is not None:
+        b, cs.block = cs.block, None
+        it.diag("NC217", "warning", f"the {_NOUN[b[0]]} is not inserted: its block moves nothing "
+                "to a corner", b[2])
+    flush(it)
+
+
+def _replay(it, cs: CornerStage) -> None:
+    queued, cs.queued = cs.queued, []
+    for rec in queued:
+        it._push_record(rec)
+
+
+def _emit(it, m: Move) -> None:
+    it._emit_move(m.kind, m.start, m.end, m.center, m.cw, m.turns, m.payload)
+
+
+def _not_inserted(it, m: Move, why: str) -> None:
+    kind, value, _, dialect = m.corner
+    alarm = settings(dialect).get("missing_next") == "alarm"
+    control = "the control stops with an alarm" if alarm else "the control inserts none"
+    it.diag("NC218" if alarm else "NC217", "error" if alarm else "warning",
+            f"the {_NOUN[kind]} ({value:g}) is not inserted: {why} ({control}; the analysed "
+            "toolpath runs the corner sharp)", m.span)
+
+
+def _in_plane(m: Move, a1: str, a2: str) -> bool:
+    keys = set(m.start) | set(m.end)
+    return all(abs(m.end.get(a, 0.0) - m.start.get(a, 0.0)) < 1e-9 for a in keys if a not in (a1, a2))
+
+
+def _element(m: Move, a1: str, a2: str) -> corners.Element:
+    return corners.Element(m.kind, (m.start[a1], m.start[a2]), (m.end[a1], m.end[a2]),
+                           m.center, m.cw)
+
+
+def _join(it, p: Move, new: Move) -> Move:
+    """Emit the held move `p` and the corner element between it and `new`; return `new`, its
+    start moved to the element's end (unchanged when nothing is inserted)."""
+    plane = p.payload[6]
+    a1, a2, _ = PLANE_AXES[plane]
+    why = ""
+    if new.kind not in CONTOUR_KINDS:
+        why = "the next move is not a contour move (G1, G2, G3)"
+    elif new.payload[6] != plane:
+        why = "the plane changes before the next move"
+    elif not (_in_plane(p, a1, a2) and _in_plane(new, a1, a2)):
+        why = "a move leaves the plane"
+    elif any(m.kind == "arc" and (m.turns or (m.start.get(a1), m.start.get(a2)) ==
+                                  (m.end.get(a1), m.end.get(a2))) for m in (p, new)):
+        why = "an element is a full circle"
+    elif _probe(it, p) != p.probe:
+        why = "the frame, an offset or cutter compensation changes before the next move"
+    if why:
+        _not_inserted(it, p, why)
+        _emit(it, p)
+        _replay(it, it.corner)
+        return new
+    first, second = _element(p, a1, a2), _element(new, a1, a2)
+    kind, value, feed, dialect = p.corner
+    corner = None
+    if not corners.is_tangent(first, second):
+        if kind in ("round", "round_modal"):
+            corner, why = corners.rounding(first, second, value)
+        elif kind == "chamfer_leg":
+            corner, why = corners.chamfer_legs(first, second, value)
+        else:
+            corner, why = corners.chamfer_length(first, second, value)
+        if corner is None:
+            if settings(dialect).get("too_large") == "reduced":
+                why += " (the control shrinks it to fit; nctrans does not model how)"
+            _not_inserted(it, p, why)
+    if corner is None:
+        _emit(it, p)
+        _replay(it, it.corner)
+        return new
+
+    def at(point, like):
+        out = dict(like)
+        out[a1], out[a2] = point
+        return out
+    t1 = at(corner.first_end, p.end)
+    t2 = at(corner.second_start, p.end)
+    _emit(it, replace(p, end=t1))
+    cs = it.corner
+    pay = new.payload
+    file, line = p.payload[0], p.payload[1]
+    element_payload = (file, line, feed if feed is not None else pay[2], pay[3], pay[4], pay[5], plane)
+    it._emit_move(corner.kind, t1, t2, corner.center, corner.cw, None, element_payload)
+    _replay(it, cs)
+    return replace(new, start=t2)
