@@ -6,6 +6,8 @@ files) converted to ISO milling. Each conversion is one of:
 - structural: converted with the program's structure kept (at most single constructs lowered to
   plain motion, each an NC401 at its line) and the output reads back in the target with no error;
 - flattened: converted only as plain motion for the whole program;
+  Constructs of a subprogram file ISO has no counterpart for are written as an alarm at their
+  place (NC412; counted per file with -v): the file is structural, but stops there until ported;
 - refused: not converted (NC4xx or other errors name why), or the output does not read back clean.
 `structure_share()` is what tests/test_structure_share.py asserts the issue's thresholds on.
 Not timed; no assertions here.
@@ -33,6 +35,7 @@ class Outcome:
     state: str                      # structural | flattened | refused
     why: str = ""
     lowered_constructs: int = 0     # per-construct lowerings to plain motion (NC401 "lowered to plain motion")
+    refused_in_place: int = 0       # constructs written as an alarm at their place (NC412, subprogram files)
 
 
 @dataclass
@@ -78,7 +81,8 @@ def classify(path: Path, source: str, target: str) -> Outcome:
         return Outcome(path.name, "refused", f"output does not read back: line {errs[0].line} "
                        f"[{errs[0].rule}] {errs[0].message}"[:200])
     constructs = sum(1 for d in conv.diagnostics if CONSTRUCT_NOTE in d.message)
-    return Outcome(path.name, "structural", lowered_constructs=constructs)
+    in_place = sum(1 for d in conv.diagnostics if d.rule == "NC412")
+    return Outcome(path.name, "structural", lowered_constructs=constructs, refused_in_place=in_place)
 
 
 def structure_share(corpus: Path = CORPUS) -> list[Share]:
@@ -97,17 +101,22 @@ def main() -> int:
         return 0
     print("Structural conversion share on the shared corpus")
     print(f"{'direction':<24}{'files':>7}{'structural':>12}{'flattened':>11}{'refused':>9}"
-          f"{'share':>8}{'constructs lowered':>20}")
+          f"{'share':>8}{'constructs lowered':>20}{'refused in place':>18}")
     shares = structure_share()
     for s in shares:
         lowered = sum(o.lowered_constructs for o in s.outcomes)
+        in_place = sum(o.refused_in_place for o in s.outcomes)
         print(f"{s.source + ' -> ' + s.target:<24}{len(s.outcomes):>7}{s.count('structural'):>12}"
-              f"{s.count('flattened'):>11}{s.count('refused'):>9}{100 * s.share:>7.0f}%{lowered:>20}")
+              f"{s.count('flattened'):>11}{s.count('refused'):>9}{100 * s.share:>7.0f}%{lowered:>20}"
+              f"{in_place:>18}")
     if "-v" in sys.argv[1:]:
         for s in shares:
             for o in s.outcomes:
                 if o.state != "structural":
                     print(f"  {s.source}->{s.target} {o.state:<10} {o.file}: {o.why}")
+                elif o.refused_in_place:
+                    print(f"  {s.source}->{s.target} structural {o.file}: {o.refused_in_place} "
+                          "constructs refused in place (NC412 alarm lines)")
     return 0
 
 

@@ -21,7 +21,7 @@ from functools import lru_cache
 from typing import Optional
 
 from nctrans.ir import nodes as n
-from nctrans.ir.vocabulary import MILL_ONLY, NO_EFFECT_PREFIX, NO_MOTION_EFFECT
+from nctrans.ir.vocabulary import MILL_ONLY, NO_EFFECT_ELSEWHERE, NO_EFFECT_PREFIX, NO_MOTION_EFFECT
 _CODE = re.compile(r"\s*([A-Za-z_$][A-Za-z_0-9.]*)")
 
 
@@ -61,6 +61,30 @@ def no_motion_effect(reason: str, machine_kind: str = "mill") -> bool:
     if reason.startswith(MILL_ONLY):
         return machine_kind == "mill"
     return reason.startswith(NO_EFFECT_PREFIX)
+
+
+def harmless_elsewhere(s: n.Passthrough, machine_kind: str = "mill") -> bool:
+    """True when a construct with no motion effect, written on another control as a comment, leaves
+    nothing undone that its own control does (NO_EFFECT_ELSEWHERE reasons, the source table's
+    `[options.no_motion_effect] harmless_elsewhere` words, a mill-only word on a mill)."""
+    if s.reason in NO_EFFECT_ELSEWHERE:
+        return True
+    if s.reason.startswith(MILL_ONLY):
+        return machine_kind == "mill"
+    return leading_word(s.text) in _harmless_words(s.dialect)
+
+
+@lru_cache(maxsize=None)
+def _harmless_words(dialect: str) -> frozenset[str]:
+    try:
+        from nctrans.rules import load_table
+        t = load_table(dialect) if dialect else None
+    except Exception:           # a dialect without a table of its own
+        return frozenset()
+    if t is None:
+        return frozenset()
+    words = t.options.get("no_motion_effect", {}).get("harmless_elsewhere", ())
+    return frozenset(str(w).upper() for w in words)
 
 
 def leading_word(text: str) -> str:

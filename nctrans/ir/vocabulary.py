@@ -100,6 +100,16 @@ NO_MOTION_EFFECT = frozenset((
 ))
 NO_EFFECT_PREFIX = "no motion effect"
 MILL_ONLY = "no motion effect on a mill"
+# Of those, the reasons whose construct does nothing another control would miss when it is written
+# there as a comment (a declaration, an attribute, the source's own dialect switch, a preprocessing
+# stop: the target reads its program its own way). Every other construct with no motion effect has
+# an effect on its own control (an acceleration profile, single-block suppression, a workpiece
+# counter, machine data) that a comment does not do: NC413. Words of a source's rules table
+# `[options.no_motion_effect] harmless_elsewhere` are of the first kind too.
+NO_EFFECT_ELSEWHERE = frozenset((
+    "ISO dialect mode", "native dialect mode", "preprocessing stop", "data attribute",
+    "macro definition", "declaration", "program attribute",
+))
 
 # Passthrough reasons of constructs that switch travel limits the interpreter does not model
 # (Sinumerik NPROT/CPROT protection zones): besides NC220, the toolpath gets a `limits` record with

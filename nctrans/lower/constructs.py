@@ -181,6 +181,9 @@ STRETCH_MODES = {
     "units": frozenset(("inch_geometry",)),
     # Sinumerik G331/G332, Fagor G63: every later block with axis words taps or retracts
     "motion": frozenset(("tap_rigid", "tap_rigid_retract", "tap_interp")),
+    # Sinumerik G500 (no settable offset): every later position is in the basic frame, not the
+    # G54 an ISO control keeps, until another offset is selected
+    "work_offset": frozenset(("G53",)),
 }
 
 

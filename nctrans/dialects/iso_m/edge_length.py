@@ -77,7 +77,11 @@ class EdgeLengths:
         em = self.em
         d = _const(d_expr) if d_expr is not None else 1
         if d is None:
-            em.refuse("the tool length of a computed cutting edge D (G43 H left out)")
+            what = "the tool length of a computed cutting edge D (G43 H left out)"
+            if em.in_place:
+                from .emitter import NotConvertible
+                raise NotConvertible(what, "D=..")
+            em.refuse(what)
             return []
         if d == 0:
             if self.written == "G49":

@@ -215,6 +215,17 @@ class IsoEmitter(IsoSpelling, Emitter):
         if getattr(self, "edge_lengths", None) is not None:
             self.edge_lengths.reached_from_elsewhere()
 
+    # A string or a function ISO has no counterpart for (SPRINT, GETT, ...) is another control's
+    # facility, not a spelling gap: in a subprogram file it is refused at its place (NC412).
+    def string(self, e: n.Str) -> str:
+        raise NotConvertible(f"the string value {e.value!r} (ISO variables hold numbers only)",
+                             f'"{e.value}"')
+
+    def call(self, e: n.Func) -> str:
+        if e.name.lower() not in self.syntax.functions:
+            raise NotConvertible(f"function {e.name.upper()}", f"{e.name.upper()}(..)")
+        return super().call(e)
+
     def _lay_out_globals(self, program: n.Program) -> None:
         uses = pl.undeclared_arrays(program)
         declared = sum(math.prod(s.dims) for b in walk.blocks(program.body) for s in b.body
@@ -348,8 +359,9 @@ class IsoEmitter(IsoSpelling, Emitter):
         computed at run time has no place to go."""
         idx = [constant(e) for e in v.indices]
         if any(c is None or c != int(c) or c < 0 for c in idx):
-            raise NotExpressible(f"the array {v.key} indexed by an expression: it is not declared in "
-                                 "this program, so its dimensions (the element's place) are unknown")
+            raise NotConvertible(f"the array {v.key} indexed by an expression: it is not declared in "
+                                 "this program, so its dimensions (the element's place) are unknown",
+                                 f"{v.key}[..]")
         element = f"{key}[{','.join(str(int(c)) for c in idx)}]"
         number = self.var_map.get(("element", element))
         if number is None:
@@ -849,7 +861,13 @@ class IsoEmitter(IsoSpelling, Emitter):
             line.words.extend(w for _, w in words)
             line.used.update(keys)
         if self.edge_lengths is not None:
-            words = self.edge_lengths.block_words(body)
+            try:
+                words = self.edge_lengths.block_words(body)
+            except NotConvertible as err:       # raised only in a subprogram file
+                lines.append(_Line())
+                lines[-1].words.append(self._refused_in_place(err, "OffsetSelect"))
+                lines.append(_Line())
+                words = []
             keys = [k for k, _ in words if k]
             line = lines[-1]
             if any(k in line.used for k in keys):
@@ -861,12 +879,15 @@ class IsoEmitter(IsoSpelling, Emitter):
         return [sorted(ln.words, key=lambda w: w.startswith(",")) for ln in lines if ln.words]
 
     def _g(self, group: str, value: str, code: str = "") -> tuple[str, str]:
+        written = code
         rule = self.table.lookup(code) if code else None
         if rule is None or (rule.group, rule.value) != (group, value):
             rule = self.table.code_for(group, value)
             code = rule.code if rule is not None else ""
         if rule is None:
-            raise NotExpressible(f"mode {group}={value}")
+            # a mode this control has no code for (a mill's diameter programming): another
+            # control's facility
+            raise NotConvertible(f"mode {group}={value}", written or f"{group}={value}")
         key = f"{code[0]}:{rule.dialect_group}" if rule.modal and rule.dialect_group is not None else ""
         return key, code
 
@@ -892,8 +913,9 @@ class IsoEmitter(IsoSpelling, Emitter):
             if self.cip_mode:
                 return []                   # written as G2/G3 by the CIP block itself
         if s.group == "work_offset" and s.value == "G53":
-            raise NotExpressible(f"work offset {s.code or 'G53'} (no settable offset): ISO has no modal "
-                                 "'no work offset', and G54 is the same only when its offset is zero")
+            raise NotConvertible(f"work offset {s.code or 'G53'} (no settable offset): ISO has no modal "
+                                 "'no work offset', and G54 is the same only when its offset is zero",
+                                 s.code or "G500")
         if s.group == "work_offset" and s.value.startswith("G54.1P"):
             if self.table.code_for("work_offset", "G54.1") is None:
                 raise NotExpressible(f"work offset {s.value}")
@@ -913,7 +935,10 @@ class IsoEmitter(IsoSpelling, Emitter):
                 # a machine's own axis name (XV, C1): which ISO letter drives it is the machine's
                 raise NotConvertible(f"the axis {k} (ISO axes are the letters {AXES})", f"axis {k}")
             if av.mode not in (None,):
-                raise NotExpressible(f"per-word {av.mode} coordinate on {k}")
+                # ISO's distance mode is one for all axes (G90/G91), and it has no rotary-axis
+                # direction of approach (Sinumerik DC/ACP/ACN)
+                raise NotConvertible(f"per-word {av.mode} coordinate on {k}",
+                                     f"{k}={'IC' if av.mode == 'inc' else 'AC/DC'}(..)")
             words.append((k, self.addr(k, av.value)))
         return words
 
@@ -1624,7 +1649,8 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def w_VarDecl(self, s: n.VarDecl):
         if s.type in ("STRING", "CHAR", "FRAME", "AXIS"):
-            raise NotExpressible(f"a {s.type} variable {s.name}")
+            raise NotConvertible(f"a {s.type} variable {s.name} (ISO variables hold numbers only)",
+                                 f"DEF {s.type} {s.name}")
         if s.dims:
             return self._array(s)
         var = n.Var("name", s.name)
@@ -1648,7 +1674,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         them to their initial values or 0; commons keep old values across runs)."""
         dims = list(s.dims)
         if not dims or any(not isinstance(d, int) or d <= 0 for d in dims):
-            raise NotExpressible(f"the array {s.name} without constant dimensions")
+            raise NotConvertible(f"the array {s.name} without constant dimensions (its block of "
+                                 "common variables is laid out before the program runs)", f"DEF {s.name}[..]")
         size = 1
         for d in dims:
             size *= d
@@ -1664,6 +1691,10 @@ class IsoEmitter(IsoSpelling, Emitter):
                      f"#{base}..#{base + size - 1}")
         return _Lines([[("#", f"#{base + i}={self.expr(init[i] if i < len(init) else n.Num(0.0))}")]
                        for i in range(size)])
+
+    def w_ModeSelect(self, s: n.ModeSelect):
+        raise NotConvertible(f"a G code of group {s.family} selected by a value computed as the program "
+                             "runs (indirect G)", f"G[{s.family}]=..")
 
     def w_PolarPole(self, s: n.PolarPole):
         raise NotExpressible(f"a polar pole ({s.code or 'G111'}): ISO polar coordinates turn about "
@@ -1685,6 +1716,12 @@ class IsoEmitter(IsoSpelling, Emitter):
             if self._same_in_target(s):
                 return [("", s.text)]
             if no_motion_effect(s.reason):
+                from nctrans.dialects.base import get
+                from nctrans.interp.unmodelled import harmless_elsewhere
+                if not harmless_elsewhere(s, get(self.dialect).machine_kind):
+                    # an acceleration profile, single-block suppression, a workpiece counter ...:
+                    # the path is the same, but what it does on its own control is not done
+                    return [("", self._comment(self.foreign_function_comment(s)))]
                 # a declaration, preprocessing stop, attribute ...: nothing to do on an ISO control,
                 # kept in sight as a comment
                 self.lowered(f"{s.dialect} {s.reason} {s.text.strip()!r} kept as a comment (no effect on "
