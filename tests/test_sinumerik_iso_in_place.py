@@ -23,6 +23,8 @@ CONSTRUCTS = [
     ("G1 C=DC(180) F100", "C=AC/DC[..])"),
     ("G500", "G500)"),
     ("DIAMON", "DIAMON)"),
+    # more than the 500 common variables #500-#999 hold
+    ("DEF REAL BIG[600]", "DEF BIG[..])"),
 ]
 
 

@@ -81,6 +81,41 @@ def plan(program: ir.Program) -> dict[str, MacroProc]:
     return out
 
 
+@dataclass
+class Standalone:
+    """A macro file (an O-number program that reads G65 arguments and returns with M99) written
+    as a procedure: `proc` has every argument letter as a parameter, in the order a converted
+    caller passes them (nctrans.calls.LETTER_LOCALS), so a caller converted on its own agrees
+    with it; `bare`: arguments the body uses as a whole value, which a caller must pass (vacant
+    drops a word in ISO, an unprogrammed parameter reads 0), checked on entry."""
+    proc: MacroProc
+    bare: set[int] = field(default_factory=set)
+
+
+def standalone(program: ir.Program) -> tuple[Standalone | None, str]:
+    """The procedure a macro file becomes, or (None, why it cannot)."""
+    from nctrans.calls import LETTER_LOCALS
+    letters = ((program.meta or {}).get("options") or {}).get("macro_arguments") or {}
+    by_local = {int(k): str(letter) for letter, k in letters.items()}
+    body = program.body
+    if not by_local or type(body) is not list:
+        return None, "its arguments have no letters in the source dialect"
+    found = _locals_used(body)
+    if found is None:
+        return None, "it reaches variables by a computed number (#[expr]), which may be its locals"
+    if any(c.kind != "g65" for c in _calls(body)):
+        return None, "it calls subprograms that share its locals (M98)"
+    used, written, bare, _ = found
+    order = [k for k in LETTER_LOCALS if k in by_local]
+    use = local_use(body)
+    if use is None or use.left_out(set(order))[1]:
+        return None, "a local without an argument letter is read while vacant (a PROC's DEF reads 0)"
+    arguments = {k for k in used - written if k in by_local}
+    proc = MacroProc([(k, by_local[k]) for k in order], sorted(k for k in used if k not in by_local),
+                     arguments)
+    return Standalone(proc, arguments & bare), ""
+
+
 def _calls(body: list):
     for b in walk.blocks(body):
         for s in b.body:

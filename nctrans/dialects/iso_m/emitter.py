@@ -366,7 +366,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         number = self.var_map.get(("element", element))
         if number is None:
             if self.next_array > pl.COMMON_END:
-                raise NotExpressible(f"the array element {element}: no room left in #500-#{pl.COMMON_END}")
+                raise NotConvertible(f"the array element {element}: no room left in #500-#{pl.COMMON_END}",
+                                     element)
             number = self.var_map[("element", element)] = self.next_array
             self.next_array += 1
             if key not in self.undeclared:
@@ -1681,7 +1682,8 @@ class IsoEmitter(IsoSpelling, Emitter):
             size *= d
         base = self.next_array
         if base + size - 1 > pl.COMMON_END:
-            raise NotExpressible(f"the array {s.name} ({size} elements): no room left in #500-#999")
+            raise NotConvertible(f"the array {s.name} ({size} elements): no room left in #500-#999",
+                                 f"DEF {s.name}[..]")
         init = list(s.init or [])
         if len(init) > size:
             raise NotExpressible(f"{len(init)} initial values for the array {s.name} of {size}")

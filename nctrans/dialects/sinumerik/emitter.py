@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 from typing import Any, Optional
 
 from nctrans.diagnostics import Diagnostic, at_span
+from nctrans.calls import call_arguments
 from nctrans.dialects.base import EmitResult
 from nctrans.dialects.emit import Emitter, NotExpressible, rewrites
 from nctrans.dialects.sinumerik.spelling import SinumerikSpelling
@@ -55,6 +56,9 @@ EXTERNAL_FRAME = external_frame_variable(DIALECT)
 _DRILL_AXIS = {"XY": "Z", "ZX": "Y", "YZ": "X"}
 # the cycle alarm a computed ISO jump raises when its value names no block of the unit
 COMPUTED_GOTO_ALARM = 65000
+# a converted ISO macro file called without an argument it uses as a whole value (ISO: the word
+# is dropped when vacant; a PROC parameter not programmed would read 0)
+ARGUMENT_MISSING_ALARM = 65001
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
 # address letters whose value may be an expression written `M=R501` (seed "Indirect programming":
@@ -120,6 +124,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                                if program.dialect != DIALECT else ())
         self.local_names: dict[int, str] = {}
         self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
+        self.macro_file = None                 # an ISO macro file written as a PROC (run())
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -854,6 +859,18 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         if proc is not None:
             out.words.append(f"{name}({self.proc_args(proc, c)})")
             return
+        if c.kind in ("g65", "g66") and self.p.dialect != DIALECT and c.name and not self._defined(c.name) \
+                and not c.args:
+            # a macro file converted on its own is the PROC with every letter a parameter, in
+            # this order (standalone_macro): the same call, however each side was converted
+            self.info("g65-external", "G65/G66 call of a macro not in this program passed as PROC "
+                                      "parameters by letter order (A B C D E F H M Q R S T U V W X Y Z I J K)")
+            args = call_arguments(c)
+            text = f"{name}({', '.join('' if a is None else self.expr(a) for a in args)})"
+            if c.repeat is not None:
+                text += " " + self.word("P", c.repeat)
+            out.words.append(("MCALL " if c.modal != "none" else "") + text)
+            return
         if c.bindings or (c.kind == "g65" and self._defined(c.name)):
             self.info("g65", "macro call arguments passed in R parameters (global: a nested call can "
                              "overwrite them)")
@@ -1157,6 +1174,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             self.lines.append(" ".join(codes))
 
     def run(self) -> str:
+        self.macro_file = self.standalone_macro()
         self.head()
         self.unit(self.restart_as_loop(self.p.body))
         self.subprograms()
@@ -1188,18 +1206,72 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         return [ir.Loop(body[0].span if body else b.span, inner)] + body[last + 1:]
 
     def head(self) -> None:
-        """What comes before the main body: archive header, path, power-on modes."""
+        """What comes before the main body: archive header, path, power-on modes (a macro file:
+        its PROC line instead of the power-on modes, which are its caller's)."""
         meta = self.p.meta or {}
         if meta.get("header"):
             self.lines.append(f"%{meta['header']}")
         if meta.get("path"):
             self.lines.append(f";$PATH={meta['path']}")
+        if self.macro_file is not None:
+            self.macro_proc_head(self.macro_file)
         for found in self.indirect_g.values():        # DEF before the first executable block
             self.lines.append(f"DEF INT {found.variable}")
         if self.call_variables:
             self.lines.append(f"DEF INT {self.call_variables[0]}")
             self.lines.append(f"DEF STRING[32] {self.call_variables[1]}")
+        if self.macro_file is not None:
+            self.argument_checks(self.macro_file)
+            return
         self.prologue(meta.get("defaults") or {})
+
+    def standalone_macro(self) -> "Optional[macro_procs.Standalone]":
+        """An ISO macro file (it reads G65 arguments it never sets and returns with M99) as the
+        PROC its converted callers call: every argument letter a parameter, in the order a caller
+        converted on its own passes them (nctrans.calls.LETTER_LOCALS); None for any other
+        program. A macro file that cannot be such a PROC is written as before, reading its
+        arguments from R parameters, with NC414: its converted callers pass PROC parameters, which
+        the control refuses for a program without them (a refusal, not a lowering: a macro file has
+        no toolpath of its own to lower to)."""
+        body = self.p.body
+        if self.p.dialect == DIALECT or type(body) is not list or not _ends_with_restart(body) \
+                or not _reads_arguments(body):
+            return None
+        found, why = macro_procs.standalone(self.p)
+        if found is None or not self.p.name:
+            self.diags.append(at_span(
+                "NC414", "warning", f"the macro file {self.p.name or self.p.file} is written reading its "
+                f"arguments from R parameters, not as a PROC with its argument letters as parameters: "
+                f"{why or 'it has no program number to name the PROC'}; G65 calls converted by nctrans "
+                "pass PROC parameters, so they do not call it until it is ported by hand",
+                ir.Span(self.p.file, 1)))
+            return None
+        return found
+
+    def macro_proc_head(self, macro: "macro_procs.Standalone") -> None:
+        proc = macro.proc
+        name = self.subname(self.p.name)
+        self.info("macro-file", f"macro file {self.p.name} written as PROC {name} with its argument "
+                                "letters as parameters in the order a converted G65 call passes them "
+                                "(A B C D E F H M Q R S T U V W X Y Z I J K; #n -> ARG_<letter>, locals "
+                                "without a letter -> LOC<n>)")
+        self.local_names = {k: f"ARG_{letter}" for k, letter in proc.params}
+        self.local_names.update({k: f"LOC{k}" for k in proc.plain_locals})
+        self.vacancy = {k: proc.position(k) for k in proc.vacancy_tested}
+        self.lines.append(f"PROC {name}(" + ", ".join(f"REAL ARG_{letter}" for _, letter in proc.params) + ")")
+        if proc.plain_locals:
+            self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
+
+    def argument_checks(self, macro: "macro_procs.Standalone") -> None:
+        """An argument the macro uses as a whole value (X#24: ISO drops the word when the call
+        leaves it out) must be passed: an alarm on entry where it is not, never a move to 0."""
+        for k in sorted(macro.bare, key=macro.proc.position):
+            letter = dict(macro.proc.params)[k]
+            self.info("macro-bare", "an argument the macro uses as a whole value must be passed: "
+                                    f"checked on entry ($P_SUBPAR, alarm {ARGUMENT_MISSING_ALARM})")
+            self.lines.append(f"IF NOT $P_SUBPAR[{macro.proc.position(k)}]")
+            self.lines.append(f'  SETAL({ARGUMENT_MISSING_ALARM}, "ARGUMENT {letter} NOT PASSED")')
+            self.lines.append("ENDIF")
 
     def flush(self, write) -> None:
         """Hand the lines written so far to `write` (a streamed conversion) and forget them."""
@@ -1243,6 +1315,12 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             self.pos, self.distance = {}, "absolute"
             self.unit(sub.body)
             self.local_names, self.vacancy = {}, {}
+
+
+def _ends_with_restart(body: list) -> bool:
+    """Whether the last block with statements ends the program with M99 (ISO: return or restart)."""
+    last = next((b for b in reversed(body) if isinstance(b, ir.Block) and b.body), None)
+    return last is not None and any(isinstance(s, ir.ProgramEnd) and s.kind == "restart" for s in last.body)
 
 
 def _reads_arguments(body: list) -> bool:
