@@ -194,8 +194,13 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
         elif k == "spindle":
             if r.spindle is not None and changed("spindle_speed", r.spindle):
                 yield ("E", "spindle_speed", r.spindle, r)
-            if r.spindle_dir is not None and changed("spindle_dir", r.spindle_dir):
-                yield ("E", "spindle_dir", r.spindle_dir, r)
+            # a positioned spindle compares with its angle: M19 (no angle) positions at the
+            # control's setting, 0 degrees by default (SD 43240 M19_SPOS), as SPOS=0 does
+            where = r.spindle_dir
+            if where == "orient" and r.spindle_angle:
+                where = f"orient {r.spindle_angle:.3f}"
+            if r.spindle_dir is not None and changed("spindle_dir", where):
+                yield ("E", "spindle_dir", where, r)
         elif k == "coolant":
             if changed("coolant", r.coolant):
                 yield ("E", "coolant", r.coolant, r)

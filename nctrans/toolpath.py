@@ -54,6 +54,9 @@ class ToolpathRecord:
     zone: Optional[str] = None             # limits records: "inside" (a forbidden box), "unmodelled"
     call: Optional[str] = None
     args: Optional[list] = None
+    # spindle events positioning the spindle (M19, Sinumerik SPOS/SPOSA): the angle in degrees, 0..360;
+    # absent for M19, which positions at the control's setting (SD 43240 M19_SPOS, 0 by default)
+    spindle_angle: Optional[float] = None
 
     def to_dict(self) -> dict:
         out = {}

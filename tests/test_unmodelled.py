@@ -14,7 +14,7 @@ import pytest
 
 from nctrans import pipeline
 from nctrans.dialects import base
-from nctrans.interp import corner_elements
+from nctrans.interp import corner_elements, spindle_position
 from nctrans.interp.unmodelled import no_motion_effect
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import MODAL_GROUPS, UNMODELLED_MODES
@@ -249,7 +249,8 @@ def _silently_unmodelled(dialect: str, kind: str, construct: str) -> str | None:
     # corner elements (RND, RNDM, FRC ...) are modelled (interp/corner_elements.py): a modal one
     # alone rounds nothing and rightly says nothing
     unmodelled = [s for s in stmts if isinstance(s, n.Passthrough)
-                  and not no_motion_effect(s.reason) and not corner_elements.kind_of(s)]
+                  and not no_motion_effect(s.reason) and not corner_elements.kind_of(s)
+                  and not spindle_position.is_modelled(s)]
     unmodelled += [s for s in stmts if isinstance(s, n.ModeChange)
                    and (s.group, s.value) in UNMODELLED_MODES]
     # a ModeChange outside the neutral vocabulary is a mode the interpreter cannot know

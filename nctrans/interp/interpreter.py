@@ -146,6 +146,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         # flagged. Moves then take the Python path, which reports the first feed move once.
         self.spindle_stopped = False
         self.spindle_reported = False
+        self.spindle_angle = None         # where SPOS/M19 left the spindle (spindle_position.py)
         self.comp_d_reported = False      # NC208 once per G41/G42 without a D word
         self.last_from: Optional[dict] = None     # previous move (tangent of Sinumerik CT)
         self.last_arc = None

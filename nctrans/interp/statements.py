@@ -6,7 +6,7 @@ A mixin of Interpreter. Spindle speed limits (SpindleLimit) are handled in lathe
 """
 from __future__ import annotations
 
-from nctrans.interp import computed_g, corner_elements, indirect_g, rigid_tap, unmodelled
+from nctrans.interp import computed_g, corner_elements, indirect_g, rigid_tap, spindle_position, unmodelled
 from nctrans.interp.evaluate import constant
 from nctrans.interp.offsets import NORMAL
 from nctrans.interp.travel_limits import ProgrammedLimits
@@ -76,6 +76,8 @@ class StatementsMixin:
         elif g == "spindle":
             st.set(g, v)
             self.spindle_stopped = v == "off"
+            # M19 positions at SD 43240 M19_SPOS, 0 degrees by default (spindle_position.py)
+            self.spindle_angle = 0.0 if v == "orient" else None
             self.spindle_reported = False
             rigid_tap.spindle_programmed(self)
             self._record("spindle", spindle_dir=v, spindle=st.spindle_speed)
@@ -215,6 +217,8 @@ class StatementsMixin:
             return corner_elements.compile_word(self, s)
         if s.reason == rigid_tap.COMPENSATING_CHUCK:
             return (rigid_tap.compensating_chuck, self)
+        if spindle_position.is_modelled(s):
+            return (spindle_position.position, spindle_position.compile_position(self, s))
         if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")) or \
                 s.reason in unmodelled.REPORTED_AS_ERROR:
             return (self._h_known, None)

@@ -42,7 +42,7 @@ from typing import Any, Callable, Iterator, Optional
 
 from nctrans.convert import HELD_LIMIT_NOTE as HELD_LIMIT
 from nctrans.diagnostics import Diagnostic, at_span
-from nctrans.interp import corner_elements
+from nctrans.interp import corner_elements, spindle_position
 from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.rigid_tap import COMPENSATING_CHUCK
@@ -194,6 +194,8 @@ class _Walker:
             return
         self.dropped.add(key)
         what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
+        if spindle_position.is_modelled(s):
+            return                     # modelled: its spindle record is written (interp/spindle_position.py)
         if s.reason == COMPENSATING_CHUCK:                       # nctrans.interp.rigid_tap
             self.diags.append(at_span("NC401", "info", f"--flatten writes {s.text} (tapping with a "
                                       "compensating chuck) as the block's G1 feed move it is; the "
@@ -316,7 +318,13 @@ class _Flattener:
             if rec.spindle is not None and rec.spindle != self.speed:
                 body.append(n.SpindleSpeed(_num(rec.spindle)))
                 self.speed = rec.spindle
-            if rec.spindle_dir and rec.spindle_dir != self.spindle_dir:
+            if rec.spindle_dir == "orient" and rec.spindle_angle:
+                # SPOS to an angle: no M code says it; the Sinumerik word, which other targets
+                # refuse at this line (interp/spindle_position.py)
+                body.append(n.Passthrough(f"SPOS={rec.spindle_angle:.6g}", spindle_position.REASON,
+                                          "sinumerik", "SPOS", _num(rec.spindle_angle)))
+                self.spindle_dir = "orient at an angle"
+            elif rec.spindle_dir and rec.spindle_dir != self.spindle_dir:
                 body.append(n.ModeChange("spindle", rec.spindle_dir))
                 self.spindle_dir = rec.spindle_dir
             if body:

@@ -1715,6 +1715,9 @@ class IsoEmitter(IsoSpelling, Emitter):
             return [("", self._corner_word(s))]
         if s.dialect not in ("", self.dialect):
             from nctrans.interp.unmodelled import no_motion_effect
+            from nctrans.interp.spindle_position import is_modelled
+            if is_modelled(s):
+                return self._spindle_position(s)
             if self._same_in_target(s):
                 return [("", s.text)]
             if no_motion_effect(s.reason):
@@ -1742,6 +1745,20 @@ class IsoEmitter(IsoSpelling, Emitter):
             raise NotConvertible(f"{s.dialect} {s.reason} {s.text.strip()!r} (no {self.dialect} word for "
                                  "it: the corner is written as the arc or line it inserts)", s.text.strip())
         return "," + self.addr(word.lstrip(","), s.value)
+
+    def _spindle_position(self, s: n.Passthrough) -> list:
+        """Sinumerik SPOS/SPOSA: M19 positions the spindle at setting data 43240 M19_SPOS (ISO seed
+        D.3, 0 degrees by default) and takes no angle, so only an absolute 0 is M19."""
+        v = s.value
+        if type(v) is n.Func and v.name.upper() in ("AC", "DC", "ACP", "ACN") and len(v.args) == 1:
+            v = v.args[0]
+        if type(v) is n.Num and v.value % 360.0 == 0.0:
+            self.lowered(f"{s.text.strip()!r} written as M19 (which positions the spindle at setting data "
+                         "43240 M19_SPOS, 0 degrees by default)")
+            return [self.code_word("spindle", "orient")]
+        raise NotConvertible(f"spindle positioning {s.text.strip()!r}: ISO M19 positions the spindle at "
+                             "one angle only, setting data 43240 M19_SPOS (0 degrees by default), and takes "
+                             "no angle word", s.text.strip())
 
     def _same_in_target(self, s: n.Passthrough) -> bool:
         """Text of another dialect that this dialect's own front end reads as the same construct

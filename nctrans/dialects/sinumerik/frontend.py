@@ -176,6 +176,13 @@ _BINOPS = {"+": "+", "-": "-", "*": "*", "/": "/", "DIV": "div", "MOD": "mod", "
            "=>": ">=", "<<": "concat"}
 _PREFIX = {"-": "-", "+": "+", "NOT": "not", "B_NOT": "bnot"}
 _RPARAM = re.compile(r"R(\d+)$")
+# spindle positioning words the interpreter models for the master spindle (interp/spindle_position.py)
+SPINDLE_POSITIONING = ("SPOS", "SPOSA")
+
+
+def _master_spindle(index: list) -> bool:
+    """SPOS[1]: the index names spindle 1 (a constant)."""
+    return len(index) == 1 and isinstance(index[0], ir.Num) and index[0].value == 1
 _INTEGER_ADDRESSES = frozenset("NGMLTDP")     # spec 2.2 / table: integer values only
 
 
@@ -501,6 +508,8 @@ class Lowerer:
         elif name in self.corner_words:     # RND=, CHF= ...: interp/corner_elements.py
             w.out.append(ir.Passthrough(_t(text), self.pass_words.get(name, "corner element"), DIALECT,
                                         address=name, value=value))
+        elif name in SPINDLE_POSITIONING:                     # SPOS=90 (interp/spindle_position.py)
+            w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT, name, value))
         elif name in self.pass_words:
             w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
         elif re.fullmatch(r"M\d+", name) and name == "M1" and isinstance(value, ir.Num) and \
@@ -623,6 +632,9 @@ class Lowerer:
                         w.indirect.append((_index(idx)[0], _axis_value(value)))
                     elif name == "G" and (select := self.indirect_g(_index(idx), value)) is not None:
                         w.out.append(select)
+                    elif name in SPINDLE_POSITIONING and _master_spindle(_index(idx)):
+                        # SPOS[1]=..: the master spindle (other spindles stay unmodelled, NC220)
+                        w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT, name, value))
                     elif name in self.pass_words:
                         w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
                     elif name == "R":
