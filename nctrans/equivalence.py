@@ -197,7 +197,7 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
             # a positioned spindle compares with its angle: M19 (no angle) positions at the
             # control's setting, 0 degrees by default (SD 43240 M19_SPOS), as SPOS=0 does
             where = r.spindle_dir
-            if where == "orient" and r.spindle_angle:
+            if where == "orient" and r.spindle_angle:          # (NaN: unknown, equal to nothing known)
                 where = f"orient {r.spindle_angle:.3f}"
             if r.spindle_dir is not None and changed("spindle_dir", where):
                 yield ("E", "spindle_dir", where, r)

@@ -4,6 +4,8 @@ M19 where M19 means the same (an absolute 0: SD 43240 M19_SPOS, 0 by default), a
 otherwise. Expected angles worked out by hand in the comments."""
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from nctrans import api, pipeline
@@ -39,8 +41,12 @@ def test_incremental_from_a_turning_spindle_is_said_unknown():
     recs, diags = run(HEAD + "SPOS=IC(45)\nM19\nSPOS=IC(45)\nM30\n")
     # line 4: the spindle was turning: stops, angle unknown (NC220); M19 at 0 (SD 43240 default);
     # then 0 + 45
-    assert spindle_events(recs)[1:] == [(4, "orient", None), (5, "orient", None), (6, "orient", 45.0)]
+    events = spindle_events(recs)[1:]
+    assert math.isnan(events[0][2]) and events[1:] == [(5, "orient", None), (6, "orient", 45.0)]
     assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC220", 4)]
+    conv = api.transpile(HEAD + "SPOS=IC(45)\nM30\n", "sinumerik", "sinumerik", flatten=True)
+    assert conv.text is None and [(d.rule, d.line) for d in conv.diagnostics if d.severity == "error"] == [
+        ("NC402", 4)]
 
 
 def test_other_spindles_stay_said_not_modelled():

@@ -12,10 +12,13 @@ at the line. A feed move after it is not NC209 (as after M5): a positioned spind
 and measuring programs feed with (corpus mojimould-O80000001-main: M19, then G1 with a touch
 probe). An
 IC angle from a spindle that was turning (or whose angle is not known) leaves the angle unknown:
-the event has no angle and NC220 says so. Spindles other than the master (`SPOS[2]=`) stay NC220,
+the event's angle is NaN (null in JSON, compared as unknown by equiv, refused by --flatten) and
+NC220 says so. Spindles other than the master (`SPOS[2]=`) stay NC220,
 not modelled (nctrans models one spindle).
 """
 from __future__ import annotations
+
+import math
 
 from nctrans.ir import nodes as n
 
@@ -55,20 +58,18 @@ def position(d) -> None:
             it.diag("NC220", "warning", f"{s.text.strip()!r} turns the spindle from an angle nctrans does "
                     "not know (it was turning, or never positioned): the spindle stops, its angle is "
                     "unknown in the analysed toolpath")
-            angle = None
+            angle = math.nan
         else:
             angle = before + angle
-    if angle is not None:
-        angle %= 360.0
-    stop_at(it, angle)
+    stop_at(it, angle % 360.0)
 
 
-def stop_at(it, angle) -> None:
-    """The spindle stands positioned (`angle` degrees, None: unknown or the control's setting)."""
+def stop_at(it, angle: float) -> None:
+    """The spindle stands positioned at `angle` degrees (NaN: unknown)."""
     from nctrans.interp import rigid_tap
     it.st.set("spindle", "orient")
     it.spindle_stopped = False         # positioned on purpose: probing moves at feed (NC209 is M5's)
     it.spindle_reported = False
-    it.spindle_angle = angle
+    it.spindle_angle = None if math.isnan(angle) else angle
     rigid_tap.spindle_programmed(it)
     it._record("spindle", spindle_dir="orient", spindle=it.st.spindle_speed, spindle_angle=angle)

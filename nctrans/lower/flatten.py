@@ -318,7 +318,12 @@ class _Flattener:
             if rec.spindle is not None and rec.spindle != self.speed:
                 body.append(n.SpindleSpeed(_num(rec.spindle)))
                 self.speed = rec.spindle
-            if rec.spindle_dir == "orient" and rec.spindle_angle:
+            if rec.spindle_dir == "orient" and rec.spindle_angle is not None and math.isnan(rec.spindle_angle):
+                self.diags.append(at_span("NC402", "error", "--flatten cannot write the spindle "
+                                          "position here: the angle it turns to is not known (IC from "
+                                          "a turning spindle)", span))
+                self.spindle_dir = None
+            elif rec.spindle_dir == "orient" and rec.spindle_angle:
                 # SPOS to an angle: no M code says it; the Sinumerik word, which other targets
                 # refuse at this line (interp/spindle_position.py)
                 body.append(n.Passthrough(f"SPOS={rec.spindle_angle:.6g}", spindle_position.REASON,
