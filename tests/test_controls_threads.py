@@ -49,7 +49,8 @@ TAP = "G17 G90 G0 X10 Y10 Z20 S500 M3\nCYCLE84(10, 0, 2, -10, , , 3, , 1.5)\nM30
 
 @pytest.mark.parametrize("target,dialect,down,up", [
     ("sinumerik", "sinumerik", "G33 Z-10 K1.5", "Z2 K1.5"),
-    ("iso-m", "iso-m", "G33 Z-10. F1.5", "Z2. F1.5"),
+    # flattened ISO is plain motion for LinuxCNC's rs274 (CONTRACT), whose G33 lead word is K
+    ("iso-m", "iso-m", "G33 Z-10. K1.5", "Z2. K1.5"),
 ])
 def test_flattened_tapping_stays_spindle_synchronised(target, dialect, down, up):
     # CYCLE84 (PIT 1.5, S500): G0 to RFP+SDIS = 2, tap to -10, spindle reversed, tap back to 2,
@@ -70,8 +71,8 @@ def test_flattened_iso_g84_keeps_its_lead():
     # G94 F750 S500: lead 750/500 = 1.5 (spec 5 "under G94 the lead is F/S")
     text = "G21 G17 G90 G94 G0 X0 Y0 Z20 S500 M3\nG99 G84 X5 Y5 Z-8 R2 F750\nG80\nG1 X0 F200\nM30\n"
     conv = api.transpile(text, "iso-m", "iso-m", flatten=True)
-    assert "G33 Z-8. F1.5" in conv.text.splitlines()
-    # the feed the source programs after the tapping is written again (F was the lead)
+    assert "G33 Z-8. K1.5" in conv.text.splitlines()
+    assert [d.line for d in conv.lowered if "the lead as K" in d.message] == [2]
     assert any("F200." in ln for ln in conv.text.splitlines())
     src, _ = run(text, "iso-m")
     out, _ = run(conv.text, "iso-m")
@@ -82,7 +83,9 @@ def test_converting_sinumerik_g33_to_iso_writes_the_lead_as_f_and_restores_the_f
     conv = api.transpile("G0 X0 Y0 Z5 S500 M3\nG1 F100 Z3\nG33 Z-10 K1.5\nG1 X5\nM30\n",
                          "sinumerik", "iso-m")
     lines = conv.text.splitlines()
+    # not flattened: ISO's own G33 (seed 4.5), lead as F, the feed written again after it
     assert "G33 Z-10. F1.5" in lines and "G1 F100. X5." in lines
+    assert not [d for d in conv.lowered if "as K" in d.message]
 
 
 def test_m29_rigid_tap_mode_has_no_motion_effect_and_the_tap_keeps_its_lead():

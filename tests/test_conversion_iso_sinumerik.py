@@ -52,10 +52,7 @@ MOTION = ("rapid", "linear", "arc")
 # while every case passes
 KNOWN_ROUND_TRIP: dict[str, str] = {}
 KNOWN_INTERMEDIATE: dict[str, str] = {}
-KNOWN_FLATTEN_RS274: dict[str, str] = {
-    # CYCLE84 flattened to G33 with F as the lead (Fanuc); LinuxCNC's G33 needs K
-    "shop_plate_4711.mpf": "flattened tapping G33 is written with F (Fanuc); rs274 needs K",
-}
+KNOWN_FLATTEN_RS274: dict[str, str] = {}   # (flattened tapping: G33 K, LinuxCNC's lead word)
 
 
 def _split(records):

@@ -190,11 +190,7 @@ M30
 }
 
 # (program, what) -> a bug in someone else's module that makes the property fail (xfail, not strict)
-KNOWN_RS274: dict[str, str] = {
-    # CYCLE84 is flattened to spindle-synchronised G33 moves written with F as the lead (Fanuc);
-    # LinuxCNC's G33 takes the lead as K ("K word missing with g33"): a defect of the ISO output
-    "shop_plate_4711.mpf": "flattened tapping G33 is written with F (Fanuc); rs274 needs K",
-}
+KNOWN_RS274: dict[str, str] = {}   # (flattened tapping: G33 K, LinuxCNC's lead word)
 KNOWN_SINUMERIK: dict[str, str] = {}
 
 ALLOWED_STATEMENTS = (n.ModeChange, n.Motion, n.Feed, n.SpindleSpeed, n.ToolSelect, n.ToolChange,

@@ -313,6 +313,9 @@ class _Flattener:
             # no tool known (the source's T word failed): the change alone, as the source did
             body = [] if rec.tool is None else [n.ToolSelect(n.Num(float(rec.tool)))]
             self.blocks.append(n.Block(span, body + [n.ToolChange()]))
+            # the target's M6 may stop the spindle (LinuxCNC's does: a G33 after it then stops
+            # with "spindle not turning"): the direction the source programs next is written again
+            self.spindle_dir = None
         elif kind == "spindle":
             body = []
             if rec.spindle is not None and rec.spindle != self.speed:
@@ -374,7 +377,9 @@ class _Flattener:
             motion = "thread"
             self.info_once("thread", "--flatten: tapping and threads written as spindle-synchronised "
                            "G33 moves with their lead, the spindle reversed between them as the "
-                           "source's cycle does (first at this line)", span)
+                           "source's cycle does (first at this line); ISO gets the lead as K, the word "
+                           "of LinuxCNC's G33 (Fanuc and Sinumerik ISO mode take F: convert without "
+                           "--flatten for them)", span)
         if motion != self.motion:
             body.append(n.ModeChange("motion", motion))
             self.motion = motion

@@ -195,6 +195,9 @@ class IsoEmitter(IsoSpelling, Emitter):
         # G33: ISO writes the thread lead as F, which is then the modal feed; the feed the source
         # programmed last is written again on the next feed move after the thread
         self.thread_mode = False
+        # ... except in plain motion for rs274 (--flatten --to iso-m, CONTRACT): LinuxCNC's G33 takes
+        # the lead as K and refuses F ("F word used with a g33"); see _thread
+        self.lead_as_k = self.dialect == "iso-m" and bool((program.meta or {}).get("flattened_from"))
         self.last_feed: Optional[str] = None
         self.feed_clobbered = False
         # named cycles written as ISO canned cycles (nctrans.dialects.iso_m.cycles): the modal one
@@ -1062,11 +1065,18 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def _thread(self, s: n.Motion, words: list) -> list:
         """G33 Z.. F<lead> (ISO seed 4.5): the I/J/K lead word of the IR (Sinumerik, flattened
-        tapping) is written as F."""
+        tapping) is written as F. Flattened plain motion is written for LinuxCNC's rs274 (CONTRACT:
+        `--flatten --to iso-m` runs there), whose G33 takes the lead as K and refuses F: there
+        the lead is K (nctrans reads G33 K back as the lead too); flatten's NC401 on threads says
+        that a Fanuc or Sinumerik ISO-mode control wants F, which the conversion without --flatten
+        writes."""
         if len(s.center) != 1:
             raise NotExpressible("a thread with more than one lead word (ISO G33 has one F lead)")
         (av,) = s.center.values()
         words += self._axes(s.target)
+        if self.lead_as_k:                  # (flatten's NC401 on the threads says so)
+            words.append(("K", self.addr("K", av.value)))
+            return words
         words.append(("F", self.addr("F", av.value)))
         self.feed_clobbered = True
         return words
