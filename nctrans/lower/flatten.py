@@ -227,6 +227,7 @@ class _Flattener:
     """Turns the interpreter's records into blocks, tracking what the target's modal state is."""
 
     def __init__(self, program: n.Program, machine, diags: list[Diagnostic]):
+        self.source_dialect = program.dialect
         self.program = program
         self.machine = machine
         self.diags = diags
@@ -327,10 +328,10 @@ class _Flattener:
                                           "a turning spindle)", span))
                 self.spindle_dir = None
             elif rec.spindle_dir == "orient" and rec.spindle_angle:
-                # SPOS to an angle: no M code says it; the Sinumerik word, which other targets
-                # refuse at this line (interp/spindle_position.py)
+                # positioned to an angle: no M code says it; the source's own word (only its
+                # dialect has one), which other targets refuse at this line (interp/spindle_position.py)
                 body.append(n.Passthrough(f"SPOS={rec.spindle_angle:.6g}", spindle_position.REASON,
-                                          "sinumerik", "SPOS", _num(rec.spindle_angle)))
+                                          self.source_dialect, "SPOS", _num(rec.spindle_angle)))
                 self.spindle_dir = "orient at an angle"
             elif rec.spindle_dir and rec.spindle_dir != self.spindle_dir:
                 body.append(n.ModeChange("spindle", rec.spindle_dir))
@@ -377,9 +378,9 @@ class _Flattener:
             motion = "thread"
             self.info_once("thread", "--flatten: tapping and threads written as spindle-synchronised "
                            "G33 moves with their lead, the spindle reversed between them as the "
-                           "source's cycle does (first at this line); ISO gets the lead as K, the word "
-                           "of LinuxCNC's G33 (Fanuc and Sinumerik ISO mode take F: convert without "
-                           "--flatten for them)", span)
+                           "source's cycle does (first at this line); an ISO target gets the lead as K, "
+                           "the word of LinuxCNC's G33 (for controls whose G33 takes the lead as F: "
+                           "convert without --flatten)", span)
         if motion != self.motion:
             body.append(n.ModeChange("motion", motion))
             self.motion = motion
