@@ -232,8 +232,10 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     long it is. On refusal what was written must be discarded (reset() or OutputFile.discard())."""
     _check_dialect(write)
     with _search_path(search_path):
-        # --flatten written as it runs only runs the program: compact when it holds structure
-        ld = _load(text, read, file=file, stream=out is not None, compact=flatten and out is not None)
+        # written as it goes (`out`): a program that holds structure is parsed compact (its plain
+        # stretches held as spans of the text: --flatten runs them, the emitters write them a few
+        # blocks at a time), so memory stays flat in program size
+        ld = _load(text, read, file=file, stream=out is not None, compact=out is not None)
         _set_profile(ld, profile)
         with _api_errors():
             target = pipeline.get_dialect(write)
@@ -288,7 +290,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                 result = convert(program, target, flatten=flatten, strict_mode=strict,
                                  flatten_with=flatten_with, machine=flat_machine,
                                  resolver=pipeline.make_resolver(ld.source_dir, ld.dialect),
-                                 stream_whole=stream_whole)
+                                 stream_whole=stream_whole, whole=lambda: _parsed_whole(ld, profile))
             diags.extend(result.diagnostics)
             out_text = result.text
         elif strict:
@@ -301,6 +303,14 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
         out.write(out_text)
         out_text = ""
     return Conversion(out_text, diags, ld.dialect or "", write)
+
+
+def _parsed_whole(ld: pipeline.Loaded, profile: Optional[str]) -> Program:
+    """The program of `ld` parsed whole (convert's fallback for a compact parse)."""
+    whole = pipeline.load_source(ld.source, ld.path, ld.dialect)
+    _set_profile(whole, profile)
+    assert whole.program is not None        # it parsed before, compact
+    return whole.program
 
 
 def _set_profile(ld: pipeline.Loaded, profile: Optional[str]) -> None:

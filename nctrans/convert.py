@@ -33,6 +33,11 @@ CONSTRUCT_NOTE = "lowered to plain motion here"
 HELD_LIMIT_NOTE = "the most a conversion holds in memory"
 
 
+class NeedsWholeParse(Exception):
+    """Lowering a construct of a compact program (Dialect.parse_compact) would reach into one of
+    its runs of plain blocks (nctrans.lower.constructs): convert() converts it parsed whole."""
+
+
 @dataclass
 class Conversion:
     text: Optional[str]                 # None when the conversion was refused
@@ -130,13 +135,46 @@ def strict(diags: list[Diagnostic]) -> list[Diagnostic]:
 def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callable[[list], Program]],
             flatten: bool = False, strict_mode: bool = False, machine=None,
             resolver: Optional[Callable] = None,
-            stream_whole: Optional[Callable[[list], Optional[Conversion]]] = None) -> Conversion:
+            stream_whole: Optional[Callable[[list], Optional[Conversion]]] = None,
+            whole: Optional[Callable[[], Program]] = None) -> Conversion:
     """Emit `program` in `target`. `flatten_with(diagnostics) -> Program` lowers it to plain motion
     (it closes over the machine and the subprogram resolver); None when lowering is unavailable
     (single constructs are then not lowered either). `machine` and `resolver` serve the run that
     lowers single constructs. `stream_whole(notes)`, when given, lowers the whole program (the last
     resort) written as it runs, not held: a Conversion with `notes` first (its text "" when
-    written, None when refused and the output discarded), or None when the target cannot stream."""
+    written, None when refused and the output discarded), or None when the target cannot stream.
+
+    `program` may be parsed compact (Dialect.parse_compact: its main body's runs of plain blocks
+    held as spans of the text, written a few blocks at a time, so memory stays flat); when a
+    construct's lowering would reach into a run, it is converted again parsed whole: `whole()`
+    (by default its runs expanded in place)."""
+    args = dict(flatten_with=flatten_with, flatten=flatten, strict_mode=strict_mode, machine=machine,
+                resolver=resolver, stream_whole=stream_whole)
+    try:
+        return _convert(program, target, **args)
+    except NeedsWholeParse:
+        return _convert(whole() if whole is not None else expanded(program), target, **args)
+
+
+def expanded(program: Program) -> Program:
+    """A compact program (Dialect.parse_compact) with its runs of plain blocks expanded in place:
+    the program a whole parse gives; any other program as it is."""
+    from nctrans.dialects.base import CompactBody
+    from nctrans.plainrun import PlainRun
+    if type(program.body) is not CompactBody:
+        return program
+    body: list = []
+    for item in program.body.items:
+        if type(item) is PlainRun:
+            body.extend(item.expand())
+        else:
+            body.append(item)
+    return dataclasses.replace(program, body=body)
+
+
+def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callable[[list], Program]],
+             flatten: bool, strict_mode: bool, machine, resolver: Optional[Callable],
+             stream_whole: Optional[Callable[[list], Optional[Conversion]]]) -> Conversion:
     diags: list[Diagnostic] = []
     flattened = False
     library = _library_entry(program)

@@ -194,3 +194,17 @@ class PlainRun:
     def expand(self) -> list:
         """All the run's Blocks: what the front end builds without the kernel."""
         return self.take(self.blocks)[0]
+
+
+# Blocks of a run built at a time when a consumer takes a run block by block (the emitters of a
+# compact body): enough that per-take costs vanish, few enough that memory stays flat.
+RUN_CHUNK = 1024
+
+
+def run_blocks(run: "PlainRun", size: int = RUN_CHUNK):
+    """The Blocks of a run one by one, built `size` at a time (never the whole run at once): how
+    the whole-program emitters write a compact body's runs (base.CompactBody) with flat memory."""
+    while run is not None:
+        blocks, run = run.take(size)
+        yield from blocks
+        del blocks

@@ -35,7 +35,7 @@ from nctrans.lower.flatten import ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Wa
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks, walk
 
-from nctrans.convert import CONSTRUCT_NOTE as NOTE, HELD_LIMIT_NOTE
+from nctrans.convert import CONSTRUCT_NOTE as NOTE, HELD_LIMIT_NOTE, NeedsWholeParse
 
 # run diagnostics inside a segment after which its plain motion would lack what the source does:
 # the --flatten ones plus NC220 (a construct the interpreter does not model: its plain motion would
@@ -50,6 +50,22 @@ class _AllRefused(Exception):
     """Raised from the run's hook once every segment is refused: the rest of the run is moot."""
 
 MARKER_FILE = "<nctrans:segment>"
+
+
+def _compact_check(body: list, refusals: list[Diagnostic], file: str, segments: list[Segment]) -> None:
+    """NeedsWholeParse when the segments of a compact body's items (`body`, runs as PlainRuns)
+    would not be the whole parse's: a run is never inside a segment, never holds a refused line
+    and never holds a label anything jumps to (labels and numbers outside runs are all found)."""
+    from nctrans.plainrun import PlainRun
+    runs = [(i, x) for i, x in enumerate(body) if type(x) is PlainRun]
+    for i, run in runs:
+        first, after = run.line, run.extent().line
+        if any(d.file == file and first <= d.line < after for d in refusals):
+            raise NeedsWholeParse(f"a refusal in the run of plain blocks at line {first}")
+        if any(seg.first <= i <= seg.last for seg in segments):
+            raise NeedsWholeParse(f"a segment over the run of plain blocks at line {first}")
+    if runs and not _jumps(body) <= _labels(body):
+        raise NeedsWholeParse("a jump to a label that may be in a run of plain blocks")
 
 
 @dataclass
@@ -490,13 +506,19 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
                      ) -> tuple[Optional[n.Program], list[Diagnostic], list[Diagnostic]]:
     """(program with each lowerable segment replaced by plain motion or None when none is, NC401/
     NC403 notes, refusals that remain)."""
-    if type(program.body) is not list:
+    from nctrans.dialects.base import CompactBody
+    compact = type(program.body) is CompactBody
+    if compact:             # its items, each run of plain blocks one node (NeedsWholeParse)
+        program = dataclasses.replace(program, body=list(program.body.items))
+    elif type(program.body) is not list:
         return None, [], refusals
     if machine is None:
         from nctrans.machine import default_mill
         machine = default_mill()
     segments, remaining = _segments(program, refusals)
     segments = _widen_over_jumps(program.body, segments)
+    if compact:
+        _compact_check(program.body, refusals, program.file, segments)
     _static_checks(program, segments)
     notes: list[Diagnostic] = []
     for seg in segments:
@@ -540,7 +562,7 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
     if not lowered_any:
         return None, notes, remaining
     new_body.extend(program.body[done:])
-    return dataclasses.replace(program, body=new_body), notes, remaining
+    return dataclasses.replace(program, body=CompactBody(new_body) if compact else new_body), notes, remaining
 
 
 def refused(seg: Segment) -> list[Diagnostic]:
@@ -577,7 +599,10 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
         seg.first_span = _first_span(program, seg)
         done = seg.last + 1
     body.extend(program.body[done:])
-    marked = dataclasses.replace(program, body=body)
+    from nctrans.dialects.base import CompactBody
+    from nctrans.plainrun import PlainRun
+    compact = any(type(x) is PlainRun for x in body)
+    marked = dataclasses.replace(program, body=CompactBody(body) if compact else body)
     homing = {(b.span.file, b.span.line) for seg in segments
               for b in blocks(program.body[seg.first:seg.last + 1])
               if any(type(x) is n.HomeReturn for x in b.body)}

@@ -13,6 +13,7 @@ from typing import Callable, Optional
 
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.ir import nodes as n
+from nctrans.dialects.base import CompactBody
 from nctrans.ir.walk import BODIES
 
 
@@ -61,6 +62,10 @@ def _rewrite(program: n.Program, kind: type, rewrite: Callable[[object], list],
     body = program.body
     if type(body) is list:          # a streamed body runs straight through: no loops in it
         body = nodes(body)
+    elif type(body) is CompactBody:     # its runs are plain blocks: the structures between them
+        items = nodes(body.items)
+        if items is not body.items:
+            body = CompactBody(items)
     subs = {}
     for name, sub in (program.subprograms or {}).items():
         new = nodes(sub.body)

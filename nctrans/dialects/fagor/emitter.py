@@ -22,6 +22,7 @@ from nctrans.dialects.base import EmitResult
 from nctrans.dialects.base import get as get_dialect
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
 from nctrans.ir import nodes as n
+from nctrans.plainrun import PlainRun, run_blocks
 from nctrans.ir import walk as ir_walk
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans.rules import load_table
@@ -280,8 +281,11 @@ class FagorEmitter(FagorSpelling, Emitter):
 
     def nodes(self, nodes: list) -> None:
         for node in nodes:
-            self.span = getattr(node, "span", self.span)
             t = type(node)
+            if t is PlainRun:                   # a compact body's run (base.CompactBody)
+                self.nodes(run_blocks(node))
+                continue
+            self.span = getattr(node, "span", self.span)
             if t is n.Block:
                 self.block(node)
             elif t is n.If:

@@ -36,6 +36,7 @@ from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, format_numb
 from nctrans.ir import nodes as n
 from nctrans.ir import walk
 from nctrans.ir.walk import constant
+from nctrans.plainrun import PlainRun, run_blocks
 
 from . import plan as pl
 from .edge_length import EdgeLengths, edge_offsets
@@ -162,6 +163,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.next_common = 100
         self.next_label = 90000
         self.used_numbers = set()
+        self.unread_runs: list[PlainRun] = []     # runs whose block numbers are not in used_numbers yet
         self.depth = 0
         # distance mode in source order, so a one-block G91 (incremental reference-point
         # approach from other dialects) can be followed by the G90 that restores it
@@ -410,6 +412,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         return letter + self.value(e)
 
     def fresh_label(self) -> str:
+        if self.unread_runs:
+            # the block numbers of a compact body's runs, read only when a fresh number is needed
+            runs, self.unread_runs = self.unread_runs, []
+            for run in runs:
+                self.used_numbers.update(b.number.lstrip("0") or "0" for b in run_blocks(run) if b.number)
         while str(self.next_label) in self.used_numbers:
             self.next_label += 1
         self.next_label += 1
@@ -601,6 +608,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         return None
 
     def _collect_numbers(self, nodes_) -> None:
+        self.unread_runs.extend(x for x in nodes_ if type(x) is PlainRun)
         for b in walk.blocks(nodes_):
             if b.number:
                 self.used_numbers.add(b.number.lstrip("0") or "0")
@@ -608,6 +616,9 @@ class IsoEmitter(IsoSpelling, Emitter):
     # -------------------------------------------------------------- structure
     def nodes(self, nodes_) -> None:
         for node in nodes_:
+            if type(node) is PlainRun:          # a compact body's run (base.CompactBody)
+                self.nodes(run_blocks(node))
+                continue
             self.span = node.span
             structure = type(node) is not n.Block
             if structure:

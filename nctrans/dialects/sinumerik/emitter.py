@@ -44,6 +44,7 @@ from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import computed_g, macro_procs, modal_numbers
+from nctrans.plainrun import PlainRun, run_blocks
 from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp import corner_elements
@@ -1046,6 +1047,9 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         while i < len(ns):
             n = ns[i]
             i += 1
+            if type(n) is PlainRun:             # a compact body's run (base.CompactBody)
+                self.plain_run(n, ind, i < len(ns) and isinstance(ns[i], _STRUCT))
+                continue
             self.span = getattr(n, "span", None)
             if isinstance(n, ir.Block) and _mode_switch(n, "ISO dialect mode"):
                 j = i
@@ -1099,6 +1103,22 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.span = span
                 self.refuse(str(e))
             self.pos = {}
+
+    def plain_run(self, run: PlainRun, ind: str, structure_follows: bool) -> None:
+        """The blocks of a run as nodes() writes them, built a few at a time: its last block,
+        when it holds only a number or comment before a structure, goes on the structure's line."""
+        last = None
+        for b in run_blocks(run):
+            if last is not None:
+                self.block(last, ind)
+            last = b
+        if last is None:
+            return
+        if structure_follows and _deco(last):
+            self.span = last.span
+            self.pending = _deco(last)
+        else:
+            self.block(last, ind)
 
     def ctl(self, ind: str, text: str, deco) -> None:
         """A control-structure line, with the block number / comment of its source line."""
@@ -1176,7 +1196,9 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def run(self) -> str:
         self.macro_file = self.standalone_macro()
         self.head()
-        self.unit(self.restart_as_loop(self.p.body))
+        body = self.p.body
+        # a compact body (base.CompactBody) is written item by item, its runs a few blocks at a time
+        self.unit(self.restart_as_loop(body if type(body) is list else list(body)))
         self.subprograms()
         return "\n".join(self.lines) + "\n"
 
