@@ -11,7 +11,9 @@ the text) and the interpreter's peak is measured above it; the streamed parse + 
 and through the CLI) and the per-file start-up of `nctrans lint` on small ISO and Sinumerik programs.
 Last, the peak resident memory of the CLI's `convert` (to every target, with and without --flatten)
 and `equiv` at 1x and 10x the program, and of the program written as Fagor read back (toolpath,
-lint, convert) (`--peaks` runs only that table). Plain-text table; no assertions.
+lint, convert); the same for the program made structured (loops, calls, a drilling cycle between
+its CAM stretches), as ISO and as Sinumerik (toolpath, lint, convert, equiv): memory must stay flat
+(10x/1x near 1) (`--peaks` runs only that table). Plain-text table; no assertions.
 """
 from __future__ import annotations
 
@@ -181,6 +183,24 @@ def structured(text: str, times: int) -> str:
     """repeated() with STRUCTURE after the body and the subprogram it calls after M30."""
     body = repeated(text, times).removesuffix("\nM30\n%\n")
     return body + "\n" + STRUCTURE + "M30\nO2000\nG91 G1 X1. F100.\nY1.\nG90\nM99\n%\n"
+
+
+# The Sinumerik counterpart (bench `--peaks`, third table): a WHILE loop around a drilling cycle, a
+# FOR loop calling a subprogram of the same file and an IF, in the middle of the CAM body.
+SINUMERIK_STRUCTURE = ("R1=0\nWHILE R1<3\nG0 X=R1*10 Y0 Z5\nCYCLE83(5,0,1,-5,,-2,,1,0.5,0,1,0)\nR1=R1+1\n"
+                       "ENDWHILE\nFOR COUNT=1 TO 2\nL2000\nENDFOR\nIF R1>2\nG0 Z20\nENDIF\n")
+
+
+def structured_sinumerik(text: str) -> str:
+    """A Sinumerik program (the CAM program converted) with SINUMERIK_STRUCTURE in the middle of
+    its body and the subprogram it calls as a second unit of the file after M30."""
+    lines = text.rstrip("\n").split("\n")
+    end = max(i for i, line in enumerate(lines) if re.search(r"\bM(30|2)\b", line))
+    body = [line for line in lines[:end] if not line.startswith(";")]
+    mid = len(body) // 2
+    body = body[:mid] + SINUMERIK_STRUCTURE.rstrip("\n").split("\n") + body[mid:]
+    return ("%_N_PART_MPF\nDEF INT COUNT\n" + "\n".join(body)
+            + "\nM30\n%_N_L2000_SPF\nG91 G1 X1 F100\nY1\nG90\nM17\n")
 
 
 def peaks(text: str, name: str) -> tuple[float, float]:
@@ -478,6 +498,17 @@ PEAK_RUNS = (
     ("equiv iso-m iso-m", ["equiv", "SRC", "SRC", "--from-a", "iso-m", "--from-b", "iso-m"]),
     ("equiv iso-m sinumerik", ["equiv", "SRC", "MPF", "--from-a", "iso-m", "--from-b", "sinumerik"]),
 )
+# The runs of the structured Sinumerik program (SRC: structured_sinumerik() of the straight table's
+# Sinumerik conversion).
+SINUMERIK_PEAK_RUNS = (
+    ("toolpath --from sinumerik", ["toolpath", "SRC", "--from", "sinumerik", "--format", "jsonl"]),
+    ("lint --from sinumerik", ["lint", "SRC", "--from", "sinumerik"]),
+    ("convert --to sinumerik", ["convert", "SRC", "--from", "sinumerik", "--to", "sinumerik", "-o", "OUT"]),
+    ("convert --to iso-m", ["convert", "SRC", "--from", "sinumerik", "--to", "iso-m", "-o", "OUT"]),
+    ("convert --flatten --to iso-m", ["convert", "SRC", "--from", "sinumerik", "--to", "iso-m", "--flatten",
+                                      "-o", "OUT"]),
+    ("equiv sinumerik sinumerik", ["equiv", "SRC", "SRC", "--from-a", "sinumerik", "--from-b", "sinumerik"]),
+)
 
 
 def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
@@ -486,26 +517,36 @@ def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
     holds, 0.6 MB -> 5.7 MB here)."""
     print("CLI peak memory (max RSS of the process, MiB) and wall time at 1x and 10x the program")
     text = read_text(base)
-    for kind in ("straight", "structured"):
+    for kind in ("straight", "structured", "structured sinumerik"):
         _peak_table(kind, base, text, tmp, notes)
 
 
 def _peak_table(kind: str, base: Path, text: str, tmp: Path, notes: list) -> None:
     """cli_peaks of the program as it is (straight) or made structured (structured())."""
     sizes = []
+    runs = PEAK_RUNS
+    stem, ending = kind.replace(" ", "-"), ".mpf" if kind.endswith("sinumerik") else ".nc"
     for times in (1, 10):
-        src = tmp / f"peak-{kind}-x{times}.nc"
-        if kind == "structured":
+        src = tmp / f"peak-{stem}-x{times}{ending}"
+        if kind == "structured sinumerik":
+            # the straight table's conversion to Sinumerik (its first row), made structured
+            straight = tmp / f"peak-straight-x{times}.mpf"
+            if not straight.exists():
+                notes.append(f"{kind}: no Sinumerik conversion of the straight program x{times}")
+                return
+            src.write_text(structured_sinumerik(straight.read_text()))
+            runs = SINUMERIK_PEAK_RUNS
+        elif kind == "structured":
             src.write_text(structured(text, times))
         else:
             src.write_text(repeated(text, times) if times > 1 else text)
         sizes.append(src.stat().st_size / 2**20)
     print(f"{base.name} ({kind}): {sizes[0]:.1f} MB and {sizes[1]:.1f} MB")
     print(f"{'run':34} {'1x MiB':>8} {'10x MiB':>8} {'10x/1x':>7} {'1x s':>7} {'10x s':>7}")
-    for label, cmd in PEAK_RUNS:
+    for label, cmd in runs:
         mem, secs = [], []
         for times in (1, 10):
-            names = {"SRC": tmp / f"peak-{kind}-x{times}.nc", "MPF": tmp / f"peak-{kind}-x{times}.mpf",
+            names = {"SRC": tmp / f"peak-{stem}-x{times}{ending}", "MPF": tmp / f"peak-{kind}-x{times}.mpf",
                      "FAG": tmp / f"peak-{kind}-x{times}-fagor.nc", "OUT": tmp / f"peak-{kind}-out-x{times}.nc"}
             m, s, rc = peak_rss(NCTRANS + [str(names.get(a, a)) for a in cmd])
             if rc >= 2:

@@ -528,7 +528,8 @@ def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], d
             if target is not None:
                 _check_dialect(target)
             for f in files:
-                ld = _load(f, dialect, stream=target is None, file=file, fallback=default_dialect)
+                ld = _load(f, dialect, stream=target is None, file=file, fallback=default_dialect,
+                           compact=True)
                 m = _machine(machine, ld.dialect)
                 if machine is None:
                     diags = linting.lint_loaded(ld, m, target)

@@ -156,14 +156,18 @@ class Dialect:
     opening_lines: ClassVar[str] = r"%"
 
     def with_header(self, text: str, comment: str) -> str:
-        """`text` with the comment line `comment` after its opening lines."""
-        lines = text.split("\n")
+        """`text` with the comment line `comment` after its opening lines (only those are looked
+        at: the text of a long program is not split into lines again)."""
         opening = re.compile(self.opening_lines)
-        i = 0
-        while i < len(lines) and opening.match(lines[i]):
-            i += 1
-        lines.insert(i, self.line_comment.format(comment))
-        return "\n".join(lines)
+        line = self.line_comment.format(comment)
+        pos = 0
+        while True:
+            nl = text.find("\n", pos)
+            if not opening.match(text[pos:] if nl < 0 else text[pos:nl]):
+                return text[:pos] + line + "\n" + text[pos:]
+            if nl < 0:
+                return text + "\n" + line
+            pos = nl + 1
 
     def emit_stream(self, program: Program, chunks, write) -> Optional[list[Diagnostic]]:
         """Emit a program that runs straight through, its body given as `chunks` (lists of Blocks

@@ -20,6 +20,7 @@ from nctrans import pipeline
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks, program_jump_targets, units, walk
+from nctrans.plainrun import PlainRun
 
 # ISO macro variables a program itself must set before reading them (spec: locals are vacant at
 # program start, commons at power-on); #500+ persist across programs and are not flagged.
@@ -268,11 +269,13 @@ def _does_something(b: n.Block) -> bool:
 
 def unreachable(program: n.Program) -> list[Diagnostic]:
     body = program.body
+    if type(body) is not list:      # a compact body (base.CompactBody): its items, runs as they are
+        body = list(body)
     end = next((i for i, node in enumerate(body) if isinstance(node, n.Block) and _ends(node)), None)
     if end is None:
         return []
     targets = _jump_targets(program)
-    rest = body[end + 1:]
+    rest = _expanded(body[end + 1:])
     for i, node in enumerate(rest):
         if isinstance(node, n.Block) and _is_target(node, targets):
             return []
@@ -282,6 +285,17 @@ def unreachable(program: n.Program) -> list[Diagnostic]:
                             f"never runs: {count} block(s) after the program end at line "
                             f"{body[end].span.line}, and no jump reaches them", node.span)]
     return []
+
+
+def _expanded(nodes: list) -> list:
+    """Nodes with their runs of plain blocks (a compact body's PlainRuns) taken apart."""
+    out: list = []
+    for node in nodes:
+        if type(node) is PlainRun:
+            out.extend(node.expand())
+        else:
+            out.append(node)
+    return out
 
 
 class _Tail:

@@ -83,6 +83,10 @@ class Sinumerik(Dialect):
         from nctrans.dialects.sinumerik.frontend import parse_stream
         return parse_stream(text, file)
 
+    def parse_compact(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+        from nctrans.dialects.sinumerik.frontend import parse_compact
+        return parse_compact(text, file)
+
     def emit(self, program) -> EmitResult:
         return _emit(program)
 

@@ -919,6 +919,46 @@ def parse_stream(text: str, file: str = "<stdin>") -> Optional[ParseResult]:
     return ParseResult(fp.program, fp.low.diags)
 
 
+def parse_compact(text: str, file: str = "<stdin>") -> Optional[ParseResult]:
+    """A whole parse whose main body is held compact (base.CompactBody): each run of plain lines
+    at the top level of the main program (outside loops, branches and PROC) is one PlainRun, a
+    span of the text read again when it runs or is written, instead of its Blocks, so a CAM
+    program of millions of lines around a few loops and calls costs little. None when anything
+    may jump to a place in the main body (a GOTO, CASE, REPEAT, contour reference or return
+    there: the interpreter runs a compact body straight through, as a streamed one), when the
+    file holds a PROC or ISO-mode section in its main program, or when nothing would be compacted
+    (without the native kernel there are no runs): parse() then."""
+    from nctrans.dialects.base import CompactBody
+    if plainrun.native is None:
+        return None
+    fp = _FileParse(text, file)
+    for _ in fp.blocks(stream=False, compact=True):
+        pass
+    program = fp.program
+    items = program.body
+    if not any(type(x) is plainrun.PlainRun for x in items) or _jumps_into_main(program) \
+            or fp.program.meta.get("entry") is not None:
+        return None
+    program.body = CompactBody(items)
+    return ParseResult(program, fp.low.diags)
+
+
+def _jumps_into_main(program: ir.Program) -> bool:
+    """Whether anything may jump to a place in the main body, or it holds an ISO-mode section
+    (see parse_compact)."""
+    from nctrans.ir import walk
+    main = [x for x in program.body if type(x) is not plainrun.PlainRun]
+    if walk.jump_targets(main):
+        return True
+    for b in walk.blocks(main):
+        for s in b.body:
+            t = type(s)
+            if t in (ir.Goto, ir.Return, ir.SectionRepeat) or (t is ir.ProgramEnd and s.kind == "restart") \
+                    or (t is ir.Passthrough and s.reason in ("ISO dialect mode", "ISO dialect section")):
+                return True
+    return any(walk.return_targets(sub.body) for sub in program.subprograms.values())
+
+
 # Words after which a program cannot run straight through block after block, or whose meaning the
 # IR analyses of a full parse check (declarations, variables): such a program is parsed whole.
 _NOT_STREAMED = frozenset({
@@ -1027,7 +1067,9 @@ class _FileParse:
             _read_header(self.low.meta, m.group(1))
             self.program.name = self.low.meta.get("program_name")
 
-    def blocks(self, stream: bool):
+    def blocks(self, stream: bool, compact: bool = False):
+        """`compact` (parse_compact): runs of plain lines at the top of the main program are
+        kept in its body as PlainRuns."""
         file, low, prog = self.file, self.low, self.program
         text = self.src.text
         meta = low.meta
@@ -1040,8 +1082,9 @@ class _FileParse:
         seen_code = False
         main = units[0].pre
         # streamed with the native kernel: runs of plain lines become one PlainRun each
-        scan = plainrun.native.scan if stream and plainrun.native is not None else None
+        scan = plainrun.native.scan if (stream or compact) and plainrun.native is not None else None
         motion = meta["defaults"].get("motion")          # the static motion mode (arcs by centre)
+        held = 0            # compact: the main body's nodes whose motion mode has been followed
 
         max_block = limits.setting("MAX_BLOCK_CHARS", limits.MAX_BLOCK_CHARS)
         pos, end, n = 0, len(text), 0
@@ -1060,6 +1103,9 @@ class _FileParse:
                                 motion = st.value
                 yield from main
                 main.clear()
+            if compact and len(main) > held:
+                motion = _static_motion(main, held, motion)
+                held = len(main)
             if len(raw) > max_block:
                 low.error("NC010", f"block of {len(raw)} characters: longer than the {max_block} "
                           "nctrans reads; not analysed", n, 1)
@@ -1072,7 +1118,11 @@ class _FileParse:
                         PLAIN_RUN_MIN)[2] >= PLAIN_RUN_MIN:
                     run = plainrun.PlainRun.open(file, text, start, n, "\n", plain_line, motion, None, False,
                                                  True, max_block)
-                    yield run
+                    if compact:
+                        main.append(run)
+                        held = len(main)
+                    else:
+                        yield run
                     ends = run.extent()
                     pos, n = ends.pos, ends.line - 1
                     motion = ends.motion
@@ -1221,6 +1271,20 @@ def _read_header(meta: dict, name: str) -> None:
     if um:
         meta["program_name"] = um.group(1).upper()
         meta["program_type"] = um.group(2).upper()
+
+
+def _static_motion(nodes: list, start: int, motion: Optional[str]) -> Optional[str]:
+    """The static motion mode after nodes[start:] (a compact parse's main body) given `motion`
+    before them: a block's own motion code sets it; after a structure (a loop or branch may or
+    may not have run its blocks) it is not known (None), so no run starts on centre words alone."""
+    for node in nodes[start:]:
+        if type(node) is ir.Block:
+            for st in node.body:
+                if type(st) is ir.ModeChange and st.group == "motion":
+                    motion = st.value
+        elif type(node) is not plainrun.PlainRun:
+            motion = None
+    return motion
 
 
 # Plain lines in a row before the streamed parse hands them over as one PlainRun.
