@@ -96,6 +96,7 @@ OFFSET_AROUND_RUNS = ("%\nO1001\nG21 G90 G17 G40 G80\nT1 M6\nS8000 M3\nG0 X0 Y0 
 def test_a_structured_program_converts_as_parsed_whole():
     assert _compact(STRUCTURED, "s.nc", "iso-m")
     _same_both_ways(STRUCTURED, "s.nc", "iso-m")
+    _same_runs(STRUCTURED, "s.nc", "iso-m")
 
 
 def test_a_lowering_over_a_run_converts_the_program_parsed_whole():
@@ -166,6 +167,7 @@ def test_generated_structured_programs_convert_as_parsed_whole(text):
     if not _compact(text, "g.nc", "iso-m"):
         return                  # nothing compact to compare (no run, or a jump into the main body)
     _same_both_ways(text, "g.nc", "iso-m")
+    _same_runs(text, "g.nc", "iso-m")
 
 
 # --------------------------------------------------------------------------- corpus
