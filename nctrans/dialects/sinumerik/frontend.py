@@ -1276,12 +1276,15 @@ def _read_header(meta: dict, name: str) -> None:
 def _static_motion(nodes: list, start: int, motion: Optional[str]) -> Optional[str]:
     """The static motion mode after nodes[start:] (a compact parse's main body) given `motion`
     before them: a block's own motion code sets it; after a structure (a loop or branch may or
-    may not have run its blocks) it is not known (None), so no run starts on centre words alone."""
+    may not have run its blocks) or a call (the subprogram or cycle may leave another) it is not
+    known (None), so no run starts on centre words alone."""
     for node in nodes[start:]:
         if type(node) is ir.Block:
             for st in node.body:
                 if type(st) is ir.ModeChange and st.group == "motion":
                     motion = st.value
+                elif type(st) in (ir.SubCall, ir.CycleCall):
+                    motion = None
         elif type(node) is not plainrun.PlainRun:
             motion = None
     return motion
