@@ -22,18 +22,20 @@ class Row:
 
 
 ROWS = [
+    # G43 H<n> with D<n>: a Sinumerik edge D<n> gives length and radius register n together (an
+    # ISO radius without the same length has no edge: tests/test_edge_selection.py)
     Row("radius offset register written (#2402)",
-        "G90 G17 G21\n#2402=2.\nG0 X0 Y0 Z5\nG1 G41 D2 X10 Y0 F100\nY10\nG40 X20\nM30\n",
-        ("$TC_DP6[2]=2.", "F100 G41 D2 G1 X10 Y0")),
+        "G90 G17 G21\n#2402=2.\nG43 H2\nG0 X0 Y0 Z5\nG1 G41 D2 X10 Y0 F100\nY10\nG40 X20\nM30\n",
+        ("$TC_DP6[2]=2.", "D2", "F100 G41 G1 X10 Y0")),
     Row("length offset register written and read (#2001)",
         "G90 G17 G21\n#2001=.004\n#101=#2001*2\nG0 X#101 Y0\nM30\n",
         ("$TC_DP3[1]=.004", "R101=$TC_DP3[1]*2")),
     Row("radius register computed from another (#2403 from #2402)",
-        "G90 G17 G21\n#2402=1.5\n#2403=#2402+.5\nG0 X0 Y0\nG1 G42 D3 X10 F50\nX20\nG40 X30\nM30\n",
-        ("$TC_DP6[2]=1.5", "$TC_DP6[3]=$TC_DP6[2]+.5", "F50 G42 D3 G1 X10")),
+        "G90 G17 G21\n#2402=1.5\n#2403=#2402+.5\nG43 H3\nG0 X0 Y0\nG1 G42 D3 X10 F50\nX20\nG40 X30\nM30\n",
+        ("$TC_DP6[2]=1.5", "$TC_DP6[3]=$TC_DP6[2]+.5", "D3", "F50 G42 G1 X10")),
     # G40/G41/G42 are places 1/2/3 of Sinumerik G group 7: index = #143 - 39
     Row("computed G word of one group (G#143, #143 = 41 or 42)",
-        "G90 G17 G21\n#2402=1.\n#143=42\nIF[#1EQ1]GOTO5\n#143=41\nN5 G0 X0 Y0\n"
+        "G90 G17 G21\n#2402=1.\n#143=42\nG43 H2\nIF[#1EQ1]GOTO5\n#143=41\nN5 G0 X0 Y0\n"
         "G1 G#143 X10 Y0 D2 F100\nY10\nG40 X20\nM30\n",
         ("DEF INT INDEX_G7_143", "R143=42", "R143=41", "INDEX_G7_143=R143-39",
          "G[7]=INDEX_G7_143 G1 X10 Y0")),

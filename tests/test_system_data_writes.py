@@ -195,7 +195,8 @@ LENGTHS = (Tool(number=1, length=100.0, radius=5.0), Tool(number=2, length=50.0,
 def test_sinumerik_d_length_survives_conversion_to_iso():
     # T1 D1: edge 1 of tool 1 = tool 1's length 100 -> ISO G43 H1; Z10 -> spindle at 110
     text, diags, recs = to_iso("T1 D1 M6\nG0 X0 Y0 Z10\nM30\n", mill(*LENGTHS))
-    assert iso_lines(text)[0].split() == ["T1", "D1", "M6", "G43", "H1"]
+    # no D word outside G41/G42: LinuxCNC refuses one ("D word with no G41 ... to use it")
+    assert iso_lines(text)[0].split() == ["T1", "M6", "G43", "H1"]
     assert ends(recs) == [(0, 0, 110)]
     assert [d.rule for d in diags] == ["NC401"]
 
@@ -204,7 +205,7 @@ def test_d0_mid_program_is_g49():
     # T2 (50): Z10 -> 60; D0: no length, Z5 -> 5
     text, _, recs = to_iso("T2 M6\nG0 X0 Y0 Z10\nD0\nG0 Z5\nM30\n", mill(*LENGTHS))
     assert iso_lines(text)[0].split() == ["T2", "M6", "G43", "H2"]
-    assert iso_lines(text)[2].split() == ["D0", "G49"]
+    assert iso_lines(text)[2].split() == ["G49"]
     assert ends(recs) == [(0, 0, 60), (0, 0, 5)]
 
 
@@ -212,8 +213,8 @@ def test_d_change_without_tool_change_takes_the_register_of_its_number():
     # tool 1 (100): Z0 -> 100; D3 without data of its own: offset register 3 = tool 3's 30 -> 30;
     # D1 again: tool 1's own 100 -> 101
     text, _, recs = to_iso("T1 M6\nG0 X0 Y0 Z0\nD3\nG0 Z0\nD1\nG0 Z1\nM30\n", mill(*LENGTHS))
-    assert iso_lines(text)[2].split() == ["D3", "G43", "H3"]
-    assert iso_lines(text)[4].split() == ["D1", "G43", "H1"]
+    assert iso_lines(text)[2].split() == ["G43", "H3"]
+    assert iso_lines(text)[4].split() == ["G43", "H1"]
     assert ends(recs) == [(0, 0, 100), (0, 0, 30), (0, 0, 101)]
 
 
@@ -223,7 +224,7 @@ def test_tool_change_without_d_brings_d1_of_the_new_tool():
                            mill(*LENGTHS))
     assert iso_lines(text)[0].split() == ["T1", "M6", "G43", "H1"]
     assert iso_lines(text)[4].split() == ["M6", "G43", "H2"]
-    assert iso_lines(text)[6].split() == ["D1"]     # D1 of tool 2: H2 is in effect already
+    assert iso_lines(text)[6].split() == ["G0", "Z2."]    # D1 of tool 2: H2 is in effect already
     assert ends(recs) == [(0, 0, 100), (0, 0, 100), (0, 0, 50), (0, 0, 52)]
 
 

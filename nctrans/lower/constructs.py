@@ -79,6 +79,7 @@ class Segment:
     ends: int = 0
     flattener: object = None
     end_state: Optional[dict] = None
+    start_state: Optional[dict] = None  # the source's modes where it starts (the target's too)
     notes: list[Diagnostic] = field(default_factory=list)    # what plain motion leaves out (NC401/NC403)
     diag_mark: int = 0                  # interpreter diagnostics before it started
     first_span: Optional[n.Span] = None  # the span its plain motion's first block takes
@@ -467,9 +468,20 @@ def _mode_state(interp: Interpreter) -> dict:
 
 
 def _restore(seg: Segment, span: n.Span, units_follow: bool) -> n.Block:
-    """The source's modes at the segment's end, where the plain motion left others (`units_follow`:
-    nothing of the main body follows, or the next block selects its own units)."""
+    """The source's modes at the segment's end, where the target after the plain motion is in
+    others (`units_follow`: nothing of the main body follows, or the next block selects its own
+    units). The target is in what the plain motion last wrote, and where it wrote nothing of a
+    group, in the source's mode at the segment's start (the structural part before it kept the
+    source's modes): a mode the segment changed without a move (G49, G18, G55, G95 alone in a
+    lowered block) is set here, or the later structural blocks would run without it."""
     st, fl = seg.end_state, seg.flattener
+    start = seg.start_state or st
+    plane = fl.plane if fl.plane is not None else start["plane"]
+    sel = fl.sel if fl.sel is not None else start["work_offset"]
+    written_length = fl.length if fl.length[0] != "unknown" else (start["length_mode"],
+                                                                   start["length_index"])
+    feed_mode = fl.feed_mode if fl.feed_mode is not None else start["feed_mode"]
+    motion = fl.motion if fl.motion is not None else start["motion"]
     body: list = []
     if st["units"] == "inch" or (st["units"] == "inch_geometry" and not units_follow):
         body.append(n.ModeChange("units", st["units"]))
@@ -477,25 +489,26 @@ def _restore(seg: Segment, span: n.Span, units_follow: bool) -> n.Block:
         body.append(n.ModeChange("distance", "incremental"))
     if st["arc_absolute"]:
         body.append(n.ModeChange("arc_distance", "absolute"))
-    if fl.plane is not None and fl.plane != st["plane"]:
+    if plane != st["plane"]:
         body.append(n.ModeChange("plane", st["plane"]))
     settable = st["work_offset"] in ISO_OFFSETS or str(st["work_offset"]).startswith("G54.1P")
     # no settable offset in the source (Sinumerik G500): the plain motion ran under G54, the
     # target's power-on offset, as the structural part around it does
-    if fl.sel is not None and settable and st["work_offset"] != fl.sel:
+    if sel is not None and settable and st["work_offset"] != sel:
         body.append(n.ModeChange("work_offset", st["work_offset"]))
     length = (st["length_mode"], st["length_index"])
-    if fl.length[0] != "unknown" and (length[0] != fl.length[0]
-                                      or (length[0] != "off" and length[1] != fl.length[1])):
+    if length[0] != written_length[0] or (length[0] != "off" and length[1] != written_length[1]):
         body.append(n.ModeChange("tool_length", length[0]))
         if length[0] != "off" and length[1] is not None:
             body.append(n.OffsetSelect("length", n.Num(float(length[1]))))
-    if fl.feed_mode is not None and st["feed_mode"] != fl.feed_mode:
+    if feed_mode is not None and st["feed_mode"] != feed_mode:
         body.append(n.ModeChange("feed_mode", st["feed_mode"]))
-    if fl.motion is not None and st["motion"] != fl.motion and \
+    if motion is not None and st["motion"] != motion and \
             st["motion"] in ("rapid", "linear", "arc_cw", "arc_ccw"):
         body.append(n.ModeChange("motion", st["motion"]))
-    if st["feed"] is not None and fl.feed is not None and (st["feed"] != fl.feed or st["feed_scale"] != 1.0):
+    feed_differs = (st["feed"] != fl.feed or st["feed_scale"] != 1.0) if fl.feed is not None \
+        else st["feed"] != start["feed"]
+    if st["feed"] is not None and feed_differs:
         scale = st["feed_scale"] if st["feed_mode"] != "inverse_time" else 1.0
         body.append(n.Feed(n.Num(round(st["feed"] / scale, 9))))
     return n.Block(span, body, comment="nctrans: modes of the source restored" if body else None)
@@ -676,6 +689,7 @@ class SegmentHook:
             return
         seg.starts += 1
         seg.diag_mark = len(self.diags)
+        seg.start_state = state
         if seg.starts > 1:
             self.current = None
             self.refuse(seg, "it does not run exactly once")

@@ -12,6 +12,11 @@ G43 H the ISO program would run without the length. This writes, after the block
   which ISO reads as the length register of the tool number; no tool changed yet: H1, the
   register the source reads too.
 
+The edge's radius goes to ISO as the D word of the block that starts cutter compensation (G41/G42),
+the only block LinuxCNC takes a D in ("D word with no G41 ... to use it"): edge d >= 2 as D<d>, D1
+as the tool's register D<t>, D0 as D0. A D that changes the edge while compensation is on is
+refused at its line (ISO would need G40 and a new G41 there).
+
 What ISO cannot express is said at its line: a computed D or tool number (NC402, the length is
 left out), a length under G18/G19 (NC401: ISO G43 acts along Z, the source edge along the axis
 normal to the plane). Edge data a program writes ($TC_DP3[t,d]) is refused where it is written.
@@ -48,11 +53,14 @@ class EdgeLengths:
         # the length words in effect in the text ("G49" or the H word; None: not known here), so
         # a D that keeps the length writes none (LinuxCNC refuses G43 while G41/G42 is on)
         self.written: Optional[str] = "G49"
+        self.edge = None                # the source's active edge expression (None: no D yet)
+        self.comp = "off"               # cutter compensation in the source: off | on | None (unknown)
 
     def unknown(self) -> None:
         """A subprogram body: the active tool is the caller's."""
         self.tool = None
         self.written = None
+        self.edge = self.comp = None
 
     def reached_from_elsewhere(self) -> None:
         """A jump target or structure: the length in effect may be another path's."""
@@ -62,6 +70,7 @@ class EdgeLengths:
         """The words that give the block's edge selection its length (none when it selects none)."""
         d_expr = None
         changed = False
+        comp_before, comp_start = self.comp, False
         for s in body:
             t = type(s)
             if t is n.ToolSelect:
@@ -70,10 +79,39 @@ class EdgeLengths:
                 changed = True
             elif t is n.OffsetSelect and s.kind == "radius":
                 d_expr = s.index
+            elif t is n.ModeChange and s.group == "cutter_comp":
+                self.comp = "off" if s.value == "off" else "on"
+                comp_start = comp_start or s.value != "off"
         if changed:
             self.tool = _const(self.selected) if self.selected is not None else None
+        if d_expr is not None or changed:
+            self.edge = d_expr if d_expr is not None else n.Num(1.0)
+        radius = self._radius_word(comp_start, comp_before, d_expr is not None or changed)
         if d_expr is None and not changed:
+            return radius
+        return self._length_words(d_expr) + radius
+
+    def _radius_word(self, comp_start: bool, comp_before, edge_changed: bool) -> list[tuple[str, str]]:
+        """The D word of a block that starts compensation: the active edge's radius register."""
+        em = self.em
+        if not comp_start:
+            if edge_changed and comp_before == "on" and self.comp == "on":
+                em.refuse("a cutting edge D changed while cutter compensation is on (ISO takes D "
+                          "only with G41/G42)")
             return []
+        if self.edge is None:
+            return []                   # no D yet: as the source, compensation by no radius
+        d = _const(self.edge)
+        if d is None:
+            return [("D", em.addr("D", self.edge))]
+        if d == 1:
+            if self.tool is None:
+                em.refuse("the radius of edge D1 of a tool not known here")
+                return []
+            d = self.tool or 1
+        return [("D", f"D{d}")]
+
+    def _length_words(self, d_expr) -> list[tuple[str, str]]:
         em = self.em
         d = _const(d_expr) if d_expr is not None else 1
         if d is None:

@@ -1112,6 +1112,8 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def w_OffsetSelect(self, s):
         self.pos = {}
+        if self.edge_lengths is not None and s.kind == "radius":
+            return []       # a cutting edge: its G43 H and, with G41/G42, its D (edge_length)
         letter = "H" if s.kind == "length" else "D"
         return [(letter, self.addr(letter, s.index))]
 

@@ -45,6 +45,7 @@ from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import computed_g, macro_procs, modal_numbers
 from nctrans.plainrun import PlainRun, run_blocks
+from nctrans.dialects.sinumerik.edge_selection import EdgeSelection, NoEdge, jump_regions
 from nctrans.rules import load_table, system_meaning, system_spelling
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp import corner_elements
@@ -124,6 +125,11 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.call_variables = (computed_g.call_variables(program)
                                if program.dialect != DIALECT else ())
         self.local_names: dict[int, str] = {}
+        # ISO tool length (G43/G44/G49 H) and radius register D as the cutting edge D
+        # (nctrans.dialects.sinumerik.edge_selection); a Sinumerik source writes its own D words
+        self.edges = EdgeSelection() if program.dialect == "iso-m" else None
+        self.call_comp: dict[str, set] = {}     # callee -> compensation states at its calls
+        self.jump_regions: dict[int, dict] = {}  # per unit: label -> what jumps to it may change
         self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
         self.macro_file = None                 # an ISO macro file written as a PROC (run())
 
@@ -352,8 +358,13 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             self.info("arc_distance", "absolute arc centres written as I=AC(...)")
             return
         if g == "tool_length":
-            self.info("tool_length", "tool length compensation is part of the D cutting edge in "
-                                     "Sinumerik: G43/G44/G49 dropped")
+            if self.edges is None:
+                self.info("tool_length", "tool length compensation is part of the D cutting edge "
+                                         "in Sinumerik: G43/G44/G49 dropped")
+            else:
+                self.info("tool_length", "tool length compensation written as the cutting edge D "
+                                         "(G49 -> D0, G43 H<k> -> D<k>, or D1 where k is the tool "
+                                         "in the spindle)")
             return
         code = self.code_of(s)
         if code is None:
@@ -412,6 +423,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         out.words.append(self.code_for("tool_change"))
 
     def w_OffsetSelect(self, s: ir.OffsetSelect, out: "_Line") -> None:
+        if self.edges is not None:
+            return          # the block's D word comes from edge_selection (block_edge)
         if s.kind == "radius":
             out.words.append(self.word("D", s.index))
         else:
@@ -987,6 +1000,15 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.span = b.span
         if (b.label and b.label in self.targets) or (b.number and b.number in self.targets):
             self.pos = {}            # a jump target: the position depends on the path taken
+            if self.edges is not None:
+                self.edge_step(ind)     # the path falling through arrives in step, as every
+                # jump does (a Goto is written in step); what the unit changes depends on the path
+                regions = self.jump_regions.get(id(self.unit_nodes))
+                if regions is None:
+                    regions = self.jump_regions[id(self.unit_nodes)] = jump_regions(
+                        self.unit_nodes, self.callee_body)
+                self.edges.forget_fields(set().union(
+                    *(regions.get(_jump_key(x), set()) for x in (b.label, b.number) if x)))
         decls = [s for s in b.body if isinstance(s, ir.VarDecl)]
         rest = [s for s in b.body if not isinstance(s, ir.VarDecl)]
         line = _Line(only=len(rest) == 1, join=self.p.dialect == DIALECT)
@@ -1007,7 +1029,15 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.statement(s, line)
             except NotExpressible as e:
                 self.refuse(str(e))
+            if self.edges is not None and isinstance(s, ir.Passthrough) and computed_g.is_computed_g(s):
+                key = s.value.key if type(s.value) is ir.Var else None
+                found = self.indirect_g.get(key) if self.unit_is_main else None
+                self.edges.computed_g(found.codes if found is not None else None)
+            elif self.edges is not None:
+                self.edges.statement(s, self.st.cycle != "off")
         texts = line.finish()
+        if self.edges is not None:
+            texts = self.block_edge(rest, texts)
         head = []
         if b.skip is not None:
             head.append("/" if b.skip == 0 else f"/{b.skip}")
@@ -1027,6 +1057,69 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             text = " ".join(parts)
             if text:
                 self.lines.append(ind + text)
+
+    def block_edge(self, rest: list, texts: list[str]) -> list[str]:
+        """The block's texts with the D word the ISO length / radius state needs (edge_selection):
+        in the block itself where it holds a tool change (a D there overrides the change's D1) or
+        only modes and moves (D acts before the move), else on a line of its own before it (a call,
+        jump or return runs with it). No edge gives the state: NC402 at the block."""
+        try:
+            d = self.edges.block_end()
+        except NoEdge as e:
+            self.refuse(f"the ISO tool length state here: {e}")
+            self.edges.forget()             # said once; what follows is judged afresh
+            return texts
+        self.edge_assumed()
+        for s in rest:
+            if isinstance(s, ir.SubCall):   # the subprogram may change it (in step at its return)
+                self.call_comp.setdefault(macro_procs.key(s.name), set()).add(self.edges.iso.comp)
+                self.edges.forget_changed_by([ir.Block(s.span if hasattr(s, "span") else None, [s])],
+                                             self.callee_body)
+        if d is None:
+            return texts
+        word = f"D{d}"
+        if any(isinstance(s, ir.ToolChange) for s in rest) or all(
+                isinstance(s, (ir.ModeChange, ir.Motion, ir.OffsetSelect, ir.Feed, ir.SpindleSpeed,
+                               ir.ToolSelect)) for s in rest):
+            if texts and texts[-1]:
+                return texts[:-1] + [f"{texts[-1]} {word}"]
+            return texts + [word] if texts else [word]
+        return [word] + texts
+
+    def callee_body(self, name: str) -> Optional[list]:
+        """The body of the program's own subprogram `name` (None: not in this file)."""
+        want = macro_procs.key(name)
+        for sub_name, sub in self.p.subprograms.items():
+            if macro_procs.key(sub_name) == want:
+                return sub.body
+        return None
+
+    def edge_step(self, ind: str) -> None:
+        """Bring the edge in step with the ISO state on a line of its own (before a structure, a
+        jump target, at the end of a structure body); NC402 where no edge gives it."""
+        if self.edges is None:
+            return
+        try:
+            d = self.edges.block_end(sees=True)
+        except NoEdge as e:
+            self.refuse(f"the ISO tool length state here: {e}")
+            self.edges.forget()
+            return
+        self.edge_assumed()
+        if d is not None:
+            self.lines.append(f"{ind}D{d}")
+
+    def edge_assumed(self) -> None:
+        """NC405 where the edge was chosen by the machine's offset values, not by its number."""
+        why, self.edges.assumed = self.edges.assumed, None
+        if why is None:
+            return
+        name = getattr(self.edges._machine, "name", "?")
+        self.diags.append(at_span(
+            "NC405", "warning", f"{why}; the edge written gives the same length and radius on "
+            f"machine {name!r} only (its offset data), so the Sinumerik program is the same where "
+            "the control holds that data: convert with the real machine (--machine) to check",
+            self._where()))
 
     def iso_section(self, ns: list) -> Optional[str]:
         """A G291 ISO-mode section is written by the iso-m emitter (the front end parsed it so)."""
@@ -1071,13 +1164,18 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 continue
             deco, self.pending = self.pending, None
             self.pos = {}            # loops and branches: positions depend on the path taken
+            self.edge_step(ind)      # every path through the structure starts in step
+            if self.edges is not None and not isinstance(n, ir.If):
+                self.edges.forget_changed_by([n])    # a loop's body follows its own last pass
             start, span = len(self.lines), self.span
             try:
                 if isinstance(n, ir.If):
                     self.ctl(ind, f"IF {self.expr(n.cond)}", deco)
+                    before = self.edges.snapshot() if self.edges is not None else None
                     close = self.body(n.then, ind)
                     if n.orelse:
                         self.ctl(ind, "ELSE", close)
+                        self.edges = before
                         close = self.body(n.orelse, ind)
                     self.ctl(ind, "ENDIF", close)
                 elif isinstance(n, ir.While):
@@ -1103,6 +1201,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.span = span
                 self.refuse(str(e))
             self.pos = {}
+            if self.edges is not None:       # every path leaves in step; what it changed is not known
+                self.edges.forget_changed_by([n])
 
     def plain_run(self, run: PlainRun, ind: str, structure_follows: bool) -> None:
         """The blocks of a run as nodes() writes them, built a few at a time: its last block,
@@ -1129,8 +1229,10 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         """Emit a structure body; a trailing number/comment-only block goes on the closing line."""
         if ns and isinstance(ns[-1], ir.Block) and _deco(ns[-1]):
             self.nodes(ns[:-1], ind + "  ")
+            self.edge_step(ind + "  ")
             return _deco(ns[-1])
         self.nodes(ns, ind + "  ")
+        self.edge_step(ind + "  ")
         return None
 
     def for_loop(self, n: ir.ForLoop, ind: str, deco=None) -> None:
@@ -1148,12 +1250,14 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.lines.append(f"{ind}{var}={self.expr(n.start)}")
         self.lines.append(f"{ind}WHILE {var}{'>=' if down else '<='}{self.expr(n.end, 2)}")
         self.nodes(n.body, ind + "  ")
+        self.edge_step(ind + "  ")
         self.lines.append(f"{ind}  {var}={var}+{self.expr(step, 9)}")
         self.lines.append(f"{ind}ENDWHILE")
 
     def unit(self, nodes: list) -> None:
         """Emit a unit's nodes with DEF blocks that follow code hoisted to the end of the preamble."""
         self.unit_nodes = nodes          # the blocks a computed jump can land on
+        self.jump_regions = {}
         pre = 0
         for n in nodes:
             if isinstance(n, ir.Block) and all(isinstance(s, ir.VarDecl) for s in n.body):
@@ -1335,6 +1439,11 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
             self.st = _State()
             self.pos, self.distance = {}, "absolute"
+            if self.edges is not None:
+                self.edges.forget()     # the caller's state, written in step before the call
+                comp = self.call_comp.get(macro_procs.key(name), set())
+                if len(comp) == 1:      # every call is made with compensation on / off
+                    self.edges.iso.comp = next(iter(comp))
             self.unit(sub.body)
             self.local_names, self.vacancy = {}, {}
 
@@ -1406,6 +1515,11 @@ _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z_0-9]{0,30}$")
 
 
 _STRUCT = (ir.If, ir.While, ir.ForLoop, ir.Loop, ir.RepeatUntil, ir.Case)
+
+
+def _jump_key(x) -> str:
+    t = str(x).upper()
+    return str(int(t)) if t.isdigit() else t
 
 
 def _deco(b: ir.Block):
