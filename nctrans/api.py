@@ -231,8 +231,8 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     program that runs straight through is converted as it is parsed, so memory stays flat however
     long it is. On refusal what was written must be discarded (reset() or OutputFile.discard())."""
     _check_dialect(write)
-    from nctrans.dialects.sinumerik.edge_selection import conversion_machine
-    with _search_path(search_path), conversion_machine(lambda: _machine(machine, "iso-m")):
+    from nctrans.dialects.emit import conversion_machine
+    with _search_path(search_path), conversion_machine(lambda: _machine(machine, read)):
         # written as it goes (`out`): a program that holds structure is parsed compact (its plain
         # stretches held as spans of the text: --flatten runs them, the emitters write them a few
         # blocks at a time), so memory stays flat in program size

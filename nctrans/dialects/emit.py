@@ -18,6 +18,8 @@ only its dialect's spelling.
 """
 from __future__ import annotations
 
+import contextlib
+from contextvars import ContextVar
 from dataclasses import dataclass
 from decimal import Decimal
 from typing import Any, Callable, ClassVar, Optional
@@ -26,6 +28,22 @@ from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import constant
 from nctrans.rules import RulesTable, load_table
+
+
+# the machine a conversion runs for (api.transpile: --machine, else the built-in one), as a
+# callable asked only where an emitter needs the machine's data to choose what to write (the
+# Sinumerik edge for ISO tool offsets: nctrans.dialects.sinumerik.edge_selection)
+CONVERSION_MACHINE: ContextVar[Optional[Callable]] = ContextVar("conversion_machine", default=None)
+
+
+@contextlib.contextmanager
+def conversion_machine(get: Callable):
+    """Within it, `get()` gives the machine a conversion is checked on."""
+    token = CONVERSION_MACHINE.set(get)
+    try:
+        yield
+    finally:
+        CONVERSION_MACHINE.reset(token)
 
 
 class NotExpressible(Exception):

@@ -24,26 +24,11 @@ jump target) is only trusted while nothing changes it.
 """
 from __future__ import annotations
 
-import contextlib
-from contextvars import ContextVar
 from dataclasses import dataclass, replace
-from typing import Callable, Optional, Union
+from typing import Optional, Union
 
+from nctrans.dialects.emit import CONVERSION_MACHINE as _MACHINE
 from nctrans.ir import nodes as ir
-
-# the machine a conversion runs for (api.transpile: --machine, else the built-in one), asked for
-# only where the edge numbering alone does not give the ISO state (see EdgeSelection.by_data)
-_MACHINE: ContextVar[Optional[Callable]] = ContextVar("conversion_machine", default=None)
-
-
-@contextlib.contextmanager
-def conversion_machine(get: Callable):
-    """Within it, `get()` names the machine a conversion is checked on."""
-    token = _MACHINE.set(get)
-    try:
-        yield
-    finally:
-        _MACHINE.reset(token)
 
 UNKNOWN = "unknown"
 Known = Union[int, str, None]           # a number, UNKNOWN, or None (never set)
