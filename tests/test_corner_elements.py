@@ -314,3 +314,50 @@ def test_flattened_corners_run_in_rs274(rs274, tmp_path):
     for r, m in zip(ours, theirs):
         assert m.kind == r.kind
         assert math.dist(pt(r.end, 6), (m.end["X"], m.end["Y"])) < 1e-3
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-150, 150).filter(lambda a: abs(a) > 5), st.floats(5, 30), st.booleans(),
+       st.floats(40, 150), st.floats(0.2, 3))
+def test_rounding_into_an_arc_is_tangent_to_both(turn, radius, cw, sweep, r):
+    """A line along +X to (20, 0), then an arc leaving at `turn` degrees: the rounding starts on
+    the line with its centre straight above or below, ends on the circle, touching it (the two
+    centres and the touching point in one line), and the path is continuous."""
+    radius, sweep, r = round(radius, 3), round(sweep, 3), round(r, 3)
+    t = math.radians(turn)
+    u = (math.cos(t), math.sin(t))
+    left = (-u[1], u[0])
+    side = -1.0 if cw else 1.0
+    centre = (20 + side * radius * left[0], side * radius * left[1])
+    a0 = math.atan2(-centre[1], 20 - centre[0])
+    a1 = a0 + math.radians(sweep) * (-1.0 if cw else 1.0)
+    end = (round(centre[0] + radius * math.cos(a1), 6), round(centre[1] + radius * math.sin(a1), 6))
+    i, j = round(centre[0] - 20, 6), round(centre[1], 6)
+    text = (f"G17 G90 G0 X0 Y0 Z0 F1000\nG1 X20 RND={r}\n{'G2' if cw else 'G3'} X{end[0]} Y{end[1]} "
+            f"I{i} J{j}\nM30\n")
+    recs, diags = run(text)
+    assume(not bad(diags))
+    ms = moves(recs)[1:]
+    assert [m.kind for m in ms] == ["linear", "arc", "arc"]
+    for prev, nxt in zip(ms, ms[1:]):
+        assert math.dist(pt(prev.end, 9), pt(nxt.start, 9)) < 1e-9
+    fillet, arc = ms[1], ms[2]
+    fc, p1, p2 = pt(fillet.center, 9), pt(fillet.start, 9), pt(fillet.end, 9)
+    ac = pt(arc.center, 9)
+    assert p1[1] == pytest.approx(0, abs=1e-9) and 0 < p1[0] <= 20 + 1e-9
+    assert fc[0] == pytest.approx(p1[0], abs=1e-6) and abs(fc[1]) == pytest.approx(r, abs=1e-6)
+    assert math.dist(fc, p2) == pytest.approx(r, abs=1e-6)
+    assert math.dist(ac, p2) == pytest.approx(math.dist(ac, (20, 0)), abs=1e-6)
+    cross = (p2[0] - fc[0]) * (p2[1] - ac[1]) - (p2[1] - fc[1]) * (p2[0] - ac[0])
+    assert abs(cross) < 1e-6 * max(1.0, radius)
+    # the fillet turns the same way as the corner
+    assert fillet.direction == ("ccw" if turn > 0 else "cw")
+
+
+def test_blocks_between_lower_the_pair_for_iso():
+    # Sinumerik allows an M8 block between; ISO needs the contour move in the very next block, so
+    # the rounding and both blocks become the arc and lines it inserts
+    text = HEAD + "G1 X10 RND=2\nM8\nY10\nM30\n"
+    conv = api.transpile(text, "sinumerik", "iso-m")
+    assert ",R" not in conv.text and "G3 X10. Y2. I0. J2." in conv.text
+    assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m")

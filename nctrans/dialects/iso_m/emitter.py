@@ -615,25 +615,33 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     # -------------------------------------------------------------- structure
     def nodes(self, nodes_) -> None:
-        for node in nodes_:
+        ahead = iter(nodes_)
+        node = next(ahead, None)
+        while node is not None:
+            after = next(ahead, None)
             if type(node) is PlainRun:          # a compact body's run (base.CompactBody)
                 self.nodes(run_blocks(node))
-                continue
-            self.span = node.span
-            structure = type(node) is not n.Block
-            if structure:
-                self.forget()
-            try:
-                self.dispatch("s_", node)
-            except NotConvertible as err:
-                if not self.in_place:
-                    self.refuse(str(err))
-                else:
-                    self.out.append(self._refused_in_place(err, type(node).__name__))
-            except NotExpressible as err:
+            else:
+                self.next_node = after          # what a ,R / ,C leads into (_corner_word)
+                self._node(node)
+            node = after
+
+    def _node(self, node) -> None:
+        self.span = node.span
+        structure = type(node) is not n.Block
+        if structure:
+            self.forget()
+        try:
+            self.dispatch("s_", node)
+        except NotConvertible as err:
+            if not self.in_place:
                 self.refuse(str(err))
-            if structure:
-                self.forget()
+            else:
+                self.out.append(self._refused_in_place(err, type(node).__name__))
+        except NotExpressible as err:
+            self.refuse(str(err))
+        if structure:
+            self.forget()
 
     @staticmethod
     def _comment(text: str) -> str:
@@ -1767,6 +1775,12 @@ class IsoEmitter(IsoSpelling, Emitter):
         if word is None:
             raise NotConvertible(f"{s.dialect} {s.reason} {s.text.strip()!r} (no {self.dialect} word for "
                                  "it: the corner is written as the arc or line it inserts)", s.text.strip())
+        if not _contour_block(getattr(self, "next_node", None)):
+            # the ISO control alarms unless the very next block is a G01/G02/G03 move (seed
+            # L4000-4004); the source control may allow blocks between
+            raise NotConvertible(f"{s.dialect} {s.reason} {s.text.strip()!r} (the next block is not a "
+                                 "contour move, which ISO requires after ,R / ,C: the corner is written "
+                                 "as the arc or line it inserts)", s.text.strip())
         return "," + self.addr(word.lstrip(","), s.value)
 
     def _spindle_position(self, s: n.Passthrough) -> list:
@@ -1808,6 +1822,26 @@ class IsoEmitter(IsoSpelling, Emitter):
         elif "value" in s.values:
             words.append(("R", self.addr("R", s.values["value"])))
         return words
+
+
+def _contour_block(node) -> bool:
+    """A block that only moves (a G01/G02/G03 contour move, as far as the block shows): what an ISO
+    ,R / ,C must be followed by."""
+    if type(node) is not n.Block:
+        return False
+    moves = False
+    for s in node.body:
+        t = type(s)
+        if t is n.Motion and s.target and not s.machine_coords:
+            moves = True
+        elif t is n.ModeChange:
+            if s.group == "motion" and s.value not in ("linear", "arc_cw", "arc_ccw"):
+                return False
+        elif t is n.Passthrough and corner_elements.kind_of(s):
+            continue
+        elif t is not n.Feed:
+            return False
+    return moves
 
 
 # SubCall kinds -> the meaning of the code that calls so
