@@ -14,8 +14,8 @@ import pytest
 
 from nctrans import pipeline
 from nctrans.dialects import base
-from nctrans.interp import corner_elements, spindle_position
-from nctrans.interp.unmodelled import no_motion_effect
+from nctrans.interp import spindle_position
+from nctrans.interp.unmodelled import modelled, no_motion_effect
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import MODAL_GROUPS, UNMODELLED_MODES
 from nctrans.source import from_text
@@ -246,10 +246,10 @@ def _silently_unmodelled(dialect: str, kind: str, construct: str) -> str | None:
             return f"{construct}: read no value and said nothing"
         return None
     stmts = _line_statements(ld.program, 2)
-    # corner elements (RND, RNDM, FRC ...) are modelled (interp/corner_elements.py): a modal one
-    # alone rounds nothing and rightly says nothing
+    # corner elements (RND, RNDM, FRC ...) and OFFN are modelled (unmodelled.modelled): a modal
+    # one alone changes nothing and rightly says nothing
     unmodelled = [s for s in stmts if isinstance(s, n.Passthrough)
-                  and not no_motion_effect(s.reason) and not corner_elements.kind_of(s)
+                  and not no_motion_effect(s.reason) and not modelled(s)
                   and not spindle_position.is_modelled(s)]
     unmodelled += [s for s in stmts if isinstance(s, n.ModeChange)
                    and (s.group, s.value) in UNMODELLED_MODES]

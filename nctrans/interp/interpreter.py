@@ -160,6 +160,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.pole: Optional[tuple[float, float]] = None   # polar pole in the plane (program coords)
         self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
         self.corner = None              # corner_elements.CornerStage while RND/CHF ... is in play
+        self.contour_offset = 0.0       # Sinumerik OFFN (contour_offset.py)
         self._unmodelled_at = None                          # the span of the block that set it
         self.spelt_codes: dict[str, str] = {}   # neutral group -> the code spelt last ($P_GG)
         self.stack: list[Frame] = []

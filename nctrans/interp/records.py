@@ -52,7 +52,7 @@ class RecordsMixin:
     def _emit_move(self, kind, start, end, center, cw, turns, payload) -> None:
         """A move of the programmed contour on to cutter compensation and the records."""
         if self.comp_exit or self.comp is not None or (
-                self.st.comp_side != "off" and self.comp_radius):
+                self.st.comp_side != "off" and (self.comp_radius or self.contour_offset)):
             if self._comp_move(kind, start, end, center, cw, turns, payload):
                 return
         elif self.st.comp_side != "off" and not self.st.radius_index:
@@ -131,7 +131,7 @@ class RecordsMixin:
             return False
         if self.comp is None:
             side = self.st.comp_side
-            r = self.comp_radius
+            r = self.comp_radius + self.contour_offset      # OFFN: an allowance on the radius
             if r < 0:           # a negative stored radius swaps the side
                 side, r = ("right" if side == "left" else "left"), -r
             self.comp = self._compensator(side, r)     # lathe.py: the tool-nose tip

@@ -6,7 +6,7 @@ A mixin of Interpreter. Spindle speed limits (SpindleLimit) are handled in lathe
 """
 from __future__ import annotations
 
-from nctrans.interp import computed_g, corner_elements, indirect_g, rigid_tap, spindle_position, unmodelled
+from nctrans.interp import computed_g, contour_offset, corner_elements, indirect_g, rigid_tap, spindle_position, unmodelled
 from nctrans.interp.evaluate import constant
 from nctrans.interp.offsets import NORMAL
 from nctrans.interp.travel_limits import ProgrammedLimits
@@ -215,6 +215,8 @@ class StatementsMixin:
             return (computed_g.select, (self, s, self.ev.compile(s.value)))
         if corner_elements.kind_of(s):
             return corner_elements.compile_word(self, s)
+        if contour_offset.is_offset_word(s):
+            return contour_offset.compile_word(self, s)
         if s.reason == rigid_tap.COMPENSATING_CHUCK:
             return (rigid_tap.compensating_chuck, self)
         if spindle_position.is_modelled(s):

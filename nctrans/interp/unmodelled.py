@@ -54,6 +54,13 @@ FRAME_NOT_MODELLED = "coordinate system change not modelled"
 REPORTED_AS_ERROR = frozenset(("syntax error", "invalid number"))
 
 
+def modelled(s: n.Passthrough) -> bool:
+    """A Passthrough the interpreter models all the same (a corner element RND/CHF/,R/,C, the
+    contour offset OFFN): kept verbatim for conversions, acted on by the run."""
+    from nctrans.interp import contour_offset, corner_elements
+    return bool(corner_elements.kind_of(s)) or contour_offset.is_offset_word(s)
+
+
 def no_motion_effect(reason: str, machine_kind: str = "mill") -> bool:
     """True when a Passthrough with this reason changes nothing on the toolpath of this machine."""
     if reason in NO_MOTION_EFFECT:

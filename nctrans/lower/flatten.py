@@ -46,7 +46,7 @@ from nctrans.interp import corner_elements, spindle_position
 from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.rigid_tap import COMPENSATING_CHUCK
-from nctrans.interp.unmodelled import no_motion_effect
+from nctrans.interp.unmodelled import modelled, no_motion_effect
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans.ir.walk import walk
@@ -203,6 +203,9 @@ class _Walker:
         elif corner_elements.kind_of(s):
             self.diags.append(at_span("NC401", "info", f"--flatten writes {what} as the arc or line "
                                       "it inserts at the corner (interp/corner_elements)", span))
+        elif modelled(s):
+            self.diags.append(at_span("NC401", "info", f"--flatten folds {what} into the compensated "
+                                      "coordinates", span))
         elif no_motion_effect(s.reason, self.machine_kind):
             self.diags.append(at_span("NC401", "info", f"--flatten leaves out {what}: no effect on "
                                       "the motion", span))

@@ -383,6 +383,7 @@ class Lowerer:
         self.motion_words = t.options.get("motion_words", {})
         self.pass_words = t.options.get("passthrough_words", {})
         self.corner_words = t.options.get("corner_elements", {}).get("words", {})
+        self.offset_word = t.options.get("contour_offset", {}).get("word", "")
         self.commands = t.options.get("machine_commands", {})
         self.whole_block = set(t.options.get("whole_block_commands", []))
         self.unsupported = t.options.get("unsupported_functions", {})
@@ -505,7 +506,7 @@ class Lowerer:
             w.out.append(ir.Assign(ir.Var("R", int(name[1:])), value))
         elif name == "LIMS":                                  # the clamp of G96 (lathe.py)
             w.out.append(ir.SpindleLimit(value))
-        elif name in self.corner_words:     # RND=, CHF= ...: interp/corner_elements.py
+        elif name in self.corner_words or name == self.offset_word:   # RND=, OFFN= ...: modelled
             w.out.append(ir.Passthrough(_t(text), self.pass_words.get(name, "corner element"), DIALECT,
                                         address=name, value=value))
         elif name in SPINDLE_POSITIONING:                     # SPOS=90 (interp/spindle_position.py)
