@@ -361,3 +361,27 @@ def test_blocks_between_lower_the_pair_for_iso():
     conv = api.transpile(text, "sinumerik", "iso-m")
     assert ",R" not in conv.text and "G3 X10. Y2. I0. J2." in conv.text
     assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m")
+
+
+LATHE = Machine(name="lathe", kind="lathe",
+                axes={"X": Axis(min=-300.0, max=300.0), "Z": Axis(min=-400.0, max=300.0)},
+                tools=[Tool(number=1, length=0.0, radius=0.0)])
+
+
+def test_corners_of_a_turning_cycle_contour_are_machined():
+    # CYCLE95 contour (X diameter): X20 Z0 -> Z-20 RND=2 -> X40 CHR=1 -> Z-40. In radius the
+    # rounding runs (10,-18) -> (12,-20) about (12,-18), the chamfer (19,-20) -> (20,-21); the
+    # roughing passes keep FALZ 0.2 along Z and FALX 0.1 in X: +0.1 in X, +0.2 in Z
+    text = ("G18 G90 G95 DIAMON\nT1 D1\nG0 X60 Z5 S1000 M3\n"
+            "CYCLE95(\"KONT:KONTE\", 2, 0.2, 0.1, , 0.3, 0.2, 0.1, 1, , , 1)\nG0 X100 Z100\nM30\n"
+            "KONT:\nG1 X20 Z0\nZ-20 RND=2\nX40 CHR=1\nZ-40\nKONTE:\n")
+    tp = nctrans.toolpath(text, "sinumerik", LATHE)
+    recs = list(tp)
+    assert [d for d in tp.diagnostics if d.severity != "info"] == []
+
+    def xz(p):
+        return (round(p["X"], 6), round(p["Z"], 6))
+    arcs = [(xz(r.start), xz(r.end), xz(r.center)) for r in recs if r.kind == "arc"]
+    assert ((10.1, -17.8), (12.1, -19.8), (12.1, -17.8)) in arcs
+    lines = [(xz(r.start), xz(r.end)) for r in recs if r.kind == "linear"]
+    assert ((19.1, -19.8), (20.1, -20.8)) in lines

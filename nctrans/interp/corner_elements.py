@@ -302,3 +302,73 @@ def _join(it, p: Move, new: Move) -> Move:
     it._emit_move(corner.kind, t1, t2, corner.center, corner.cw, None, element_payload)
     _replay(it, cs)
     return replace(new, start=t2)
+
+
+def apply_to_contour(it, blocks, moves: list) -> list:
+    """A turning cycle's contour read without moving (lathe.py `_capture_contour`: tuples (kind,
+    start, end, centre, cw, span, block)) with the roundings and chamfers its blocks program
+    inserted, as the control machines the contour (RND/CHR in CYCLE95 contours, `,R`/`,C` in G71
+    contours). Evaluated as the blocks are read; what cannot be inserted is said at its line."""
+    words = {}                                  # id(block) -> (kind, value, dialect)
+    modal = None
+    for blk in blocks:
+        for s in blk.body:
+            if type(s) is not n.Passthrough or not (kind := kind_of(s)):
+                continue
+            try:
+                v = it._value(it.ev.compile(s.value), s.text.strip())
+            except Exception:                   # an evaluation error: said by the run itself
+                v = None
+            if v is None or kind in ("feed", "feed_modal"):
+                continue
+            v = float(v) * it.st.scale
+            if v < 0:
+                it.diag("NC120", "error", f"{s.text.strip()} must be a length without sign: the control "
+                        "refuses it; nothing is inserted", blk.span)
+                continue
+            if kind == "round_modal":
+                modal = (v, s.dialect) if v > 0 else None
+            elif v > 0:
+                words[id(blk)] = (kind, v, s.dialect)
+        if id(blk) not in words and modal is not None:
+            words[id(blk)] = ("round", modal[0], modal[1])
+    if not words:
+        return moves
+    a1, a2, _ = PLANE_AXES[it.st.plane]
+    out: list = []
+    for i, mv in enumerate(moves):
+        out.append(mv)
+        blk = mv[6]
+        here = words.get(id(blk))
+        last_of_block = i + 1 >= len(moves) or moves[i + 1][6] is not blk
+        if here is None or not last_of_block:
+            continue
+        nxt = moves[i + 1] if i + 1 < len(moves) else None
+        kind, value, dialect = here
+        m = Move(mv[0], mv[1], mv[2], mv[3], mv[4], None, (), blk.span, corner=(kind, value, None, dialect))
+        if nxt is None or nxt[0] not in CONTOUR_KINDS or mv[0] not in CONTOUR_KINDS:
+            _not_inserted(it, m, "the contour has no contour move after it")
+            continue
+        n2 = Move(nxt[0], nxt[1], nxt[2], nxt[3], nxt[4], None, ())
+        if not (_in_plane(m, a1, a2) and _in_plane(n2, a1, a2)):
+            _not_inserted(it, m, "a move leaves the plane")
+            continue
+        first, second = _element(m, a1, a2), _element(n2, a1, a2)
+        if corners.is_tangent(first, second):
+            continue
+        if kind in ("round", "round_modal"):
+            corner, why = corners.rounding(first, second, value)
+        elif kind == "chamfer_leg":
+            corner, why = corners.chamfer_legs(first, second, value)
+        else:
+            corner, why = corners.chamfer_length(first, second, value)
+        if corner is None:
+            _not_inserted(it, m, why)
+            continue
+        t1, t2 = dict(mv[2]), dict(mv[2])
+        t1[a1], t1[a2] = corner.first_end
+        t2[a1], t2[a2] = corner.second_start
+        out[-1] = (mv[0], mv[1], t1) + tuple(mv[3:])
+        out.append((corner.kind, t1, t2, corner.center, corner.cw, mv[5], blk))
+        moves[i + 1] = (nxt[0], t2) + tuple(nxt[2:])
+    return out

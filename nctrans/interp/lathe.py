@@ -23,7 +23,7 @@ import copy
 import math
 from typing import Optional
 
-from nctrans.interp import turning
+from nctrans.interp import corner_elements, turning
 from nctrans.ir import nodes as n
 
 TURNING_KINDS = frozenset(("finish", "rough_turn", "rough_face", "pattern_repeat", "face_peck",
@@ -315,6 +315,8 @@ class LatheMixin:
                     self.capture[i] = self.capture[i] + (blk,)
         finally:
             moves, self.capture = self.capture, None
+            if ok and moves:                # RND / CHR / ,R / ,C in the contour (corner_elements)
+                moves = corner_elements.apply_to_contour(self, blocks, moves)
             (self.pos, self.mpos, self.st, self.span, self.last_from, self.last_arc,
              self.css_surface) = saved
         return moves if ok else None
