@@ -154,7 +154,7 @@ class IsoEmitter(IsoSpelling, Emitter):
     # a milling control applies a tool length along Z (G43 H); a lathe's is not (iso-t)
     writes_edge_lengths: bool = True
     # power-on modes a program from another control relies on, written out where ours differ
-    power_on_groups: tuple[str, ...] = ("feed_mode",)
+    power_on_groups: tuple[str, ...] = ("feed_mode", "plane")
 
     def __init__(self, program: n.Program):
         super().__init__(program)
@@ -193,6 +193,8 @@ class IsoEmitter(IsoSpelling, Emitter):
             self._lay_out_globals(program)
         # plane and three-point mode, for arcs computed from the constant points (self.pos)
         self.plane = "XY"
+        # X words of the source are diameters (ISO-T, Sinumerik DIAMON): a milling X is a radius
+        self.diameter = False
         self.cip_mode = False
         # G33: ISO writes the thread lead as F, which is then the modal feed; the feed the source
         # programmed last is written again on the next feed move after the thread
@@ -481,9 +483,13 @@ class IsoEmitter(IsoSpelling, Emitter):
         return "\n".join(self.out) + "\n"
 
     def _power_on(self) -> None:
-        """The source's power-on feed mode where this control's differs (a lathe's G99 per
-        revolution, a mill's G94 per minute), written before the body."""
+        """The source's power-on feed mode and plane where this control's differ (a lathe's G99
+        per revolution and G18, a mill's G94 per minute and G17), written before the body; the
+        body starts in the source's plane and programming mode (X as diameter on a lathe)."""
         self.span = n.Span(self.program.file, 1)
+        defaults = (self.program.meta or {}).get("defaults") or {}
+        self.plane = defaults.get("plane", self.plane)
+        self.diameter = defaults.get("diameter") == "diameter"
         try:
             codes = self.power_on_codes(self.power_on_groups)
         except NotExpressible as e:
@@ -915,6 +921,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         return key, code
 
     def w_ModeChange(self, s: n.ModeChange):
+        if s.group == "diameter" and self.table.code_for("diameter", s.value) is None:
+            # ISO milling has no diameter mode: the X words are converted to radii instead
+            self.diameter = s.value == "diameter"
+            self.pos = {}
+            return []
         if s.group in ("plane", "cutter_comp", "cycle"):
             self._plane_held(f"mode {s.group}={s.value}")
         if s.group == "distance":
@@ -962,7 +973,11 @@ class IsoEmitter(IsoSpelling, Emitter):
                 # direction of approach (Sinumerik DC/ACP/ACN)
                 raise NotConvertible(f"per-word {av.mode} coordinate on {k}",
                                      f"{k}={'IC' if av.mode == 'inc' else 'AC/DC'}(..)")
-            words.append((k, self.addr(k, av.value)))
+            value = av.value
+            if k == "X" and self.diameter:
+                self.lowered("X programmed as a diameter written as a radius", once="diameter")
+                value = n.Num(value.value / 2) if type(value) is n.Num else n.Binary("/", value, n.Num(2.0))
+            words.append((k, self.addr(k, value)))
         return words
 
     def _cip(self, s: n.Motion):

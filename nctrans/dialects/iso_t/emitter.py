@@ -49,6 +49,10 @@ class TurningEmitter(iso.IsoEmitter):
             if k == "X" and not self.diameter:
                 value = n.Num(2 * value.value) if type(value) is n.Num else n.Binary("*", value, n.Num(2.0))
             inc = av.mode == "inc" or (av.mode is None and self.distance == "incremental")
+            if inc and k not in _INC:
+                # system A has no G91: only X, Z and C have incremental addresses (U, W, H)
+                raise NotExpressible(f"an incremental {k} (ISO turning has incremental addresses "
+                                     f"U, W, H for X, Z, C only)")
             letter = _INC.get(k, k) if inc else k
             if av.mode not in (None, "inc", "abs"):
                 raise NotExpressible(f"per-word {av.mode} coordinate on {k}")

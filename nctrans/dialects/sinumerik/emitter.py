@@ -97,6 +97,7 @@ class _State:
     speed: Optional[ir.Expr] = None
     feed_mode: str = "per_min"
     units: str = "mm"
+    diameter: bool = False                  # X words are diameters (ISO-T, DIAMON): frames are radii
 
 
 class SinumerikEmitter(SinumerikSpelling, Emitter):
@@ -340,6 +341,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             st.distance = self.distance = s.value
         elif g == "feed_mode":
             st.feed_mode = s.value
+        elif g == "diameter":
+            st.diameter = s.value == "diameter"
         elif g == "units":
             st.units = s.value
             if not out.join and any(w.startswith("F") for w in out.words):
@@ -443,8 +446,11 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.frame(s, out)
 
     def w_SetPosition(self, s: ir.SetPosition, out: "_Line") -> None:
+        """ISO G92 / ISO-T G50: ATRANS by the position minus the new value. A frame offset and
+        $P_EP are radii; an X set under diameter programming (ISO-T, DIAMON) is a diameter, halved."""
         self.info("G92", "G92 written as ATRANS by the programmed position minus the new value")
-        ws = [f"{a}=$P_EP[{a}]-({self.expr(v.value)})" for a, v in s.target.items()]
+        ws = [f"{a}=$P_EP[{a}]-({self.expr(v.value)})" + ("/2" if a == "X" and self.st.diameter else "")
+              for a, v in s.target.items()]
         out.alone(f"{self.code_for('frame', 'trans_add')} " + " ".join(ws))
 
     def w_ResetSetPosition(self, s: ir.ResetSetPosition, out: "_Line") -> None:
@@ -1280,6 +1286,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def prologue(self, source_defaults: dict) -> None:
         """A program from another dialect relies on that controller's power-on modes (ISO: G0,
         G80...): where they differ from Sinumerik's (G1, G500...) the first block selects them."""
+        self.st.diameter = source_defaults.get("diameter") == "diameter"
         if self.p.dialect == DIALECT:
             return
         mine = self.t.defaults()
@@ -1438,6 +1445,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             if proc is not None and proc.plain_locals:
                 self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
             self.st = _State()
+            # a subprogram of a diameter-programming source (ISO-T) is read in diameter too
+            self.st.diameter = ((meta.get("defaults") or {}).get("diameter") == "diameter")
             self.pos, self.distance = {}, "absolute"
             if self.edges is not None:
                 self.edges.forget()     # the caller's state, written in step before the call
