@@ -70,6 +70,8 @@ STOP_MESSAGE_VARIABLE = 3006   # Fanuc macro B: #3006=n (message) stops as M00 a
 _EXTERNAL_OUTPUT = re.compile(r"^(?:N\d+\s*)?(?:POPEN|PCLOS|[DB]PRNT\s*\[.*\])\s*$")
 _O_WORDS = re.compile(r"O(\d+)(?=$|[A-Z][-+.\d#\[]|[,#\[/])")
 _O_NAME = re.compile(r"O([0-9A-Z_.]*)$")
+_LINUXCNC_O_WORD = re.compile(r"O\d+(?:SUB|ENDSUB|IF|ELSEIF|ELSE|ENDIF|WHILE|ENDWHILE|DO|REPEAT|"
+                              r"ENDREPEAT|CALL|RETURN|BREAK|CONTINUE)(?![A-Z])")
 _SKIP = re.compile(r"/(\d?)")
 # "[your xy start position]": prose in brackets (a template to fill in), not a macro expression.
 _PLACEHOLDER = re.compile(r"\[[^\]]*[a-z]{2}[^\]]*\]")
@@ -1206,6 +1208,15 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 # Fanuc macro B external output (Renishaw probing macros): a port, not motion
                 cur.append(Block(span, [Passthrough(raw.strip(), "no motion effect (external output)",
                                                     low.dialect)]))
+                seen_block = True
+                continue
+            if c0 == "O" and _LINUXCNC_O_WORD.match(code):
+                # LinuxCNC's o-word subroutines and control flow are not Fanuc syntax: read as a
+                # program number, the rest of the file would silently become subprograms
+                diags.append(Diagnostic("NC002", "error", "LinuxCNC o-word control flow (o<n> "
+                                        "sub/if/while/call ...) is not read by the ISO front end",
+                                        file, lineno, 1))
+                cur.append(_passthrough_block(raw, span, None, None, low, lineno))
                 seen_block = True
                 continue
             if c0 in "O:" and not code.startswith("OR"):

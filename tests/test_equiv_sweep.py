@@ -1,0 +1,95 @@
+"""The equiv sweep (issue #9): every corpus program converted to every other dialect either drives
+the same toolpath as its source (`nctrans equiv`) or is refused with a located error, never
+silently different. The few known exceptions are listed with the reason each still differs; a
+pair that starts to agree must leave the list (the test says so), so the list only shrinks."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import nctrans
+from test_output_vocabulary import TARGETS, _sweep_programs
+
+# programs up to this size, each run to a small step budget (an endless M99 program is compared
+# as far as both ran), so the sweep stays fast; the larger CAM files add only more of the same
+# blocks (the whole corpus at 20 KB was swept by hand: see the issue note)
+_EQUIV_BYTES = 6_000
+_STEPS = "20000"
+
+# "source->target file name": why the conversion still differs from its source
+KNOWN = {
+    # subprogram files: a Sinumerik PROC file alone runs nothing (a library), the ISO O-number
+    # file it becomes runs its body with vacant arguments, so equiv compares a library with a run
+    **{f"sinumerik->{t} {name}": "a PROC file alone runs nothing; its ISO O-number file runs"
+       for t in ("iso-m", "iso-t")
+       for name in ("dubovikov-CHAMFER.spf", "dubovikov-KONUS.spf", "nadj-418-SH400.SPF",
+                    "nadj-418-SP000.SPF", "nadj-fb422-SM400.SPF", "rhoden-LORENZ_RUKU4.SPF",
+                    "syil-WARMUP_CYCLE.SPF")},
+    # found, not fixed: M17 ends a Sinumerik main program; the ISO writer writes M99, which
+    # starts an ISO main program again (B runs its calls a second time)
+    **{f"sinumerik->{t} {name}": "M17 in a main program written as M99 (a restart in ISO)"
+       for t in ("iso-m", "iso-t") for name in ("nadj-fb422-VAL_TEST.MPF", "nadj-fb422-VINT_PRAVKA.MPF")},
+    # arrays passed by reference are no part of a call event: the converted G65 passes the third
+    # PROC parameter as its first letter A (the ISO caller and subprogram agree with each other)
+    **{f"sinumerik->{t} rhoden-SINULORENZ.MPF": "by-reference array arguments shift the call "
+       "event's positions" for t in ("iso-m", "iso-t")},
+    "iso-m->sinumerik donpayne-haas-O2001-advanced-arcs.cnc":
+        "G65 arguments kept as R parameters: the Sinumerik call passes none (positional PROC "
+        "parameters left out on purpose, issue #9 note)",
+    "iso-m->sinumerik safetydav3-CIRCLE-macro.NC": "not examined: the path after `G74 Z1=0` differs",
+    "iso-m->sinumerik safetydav3-WASHER-macro.NC": "not examined: the path after `G74 Z1=0` differs",
+    "iso-m->fagor O2151.nc": "not examined: the Fagor program stops after its first rapid",
+    "iso-m->fagor donpayne-haas-O1012-gauge-tool.cnc": "not examined: an extra program end on Fagor",
+}
+
+
+def _pairs(target: str) -> list[tuple[str, str]]:
+    return [(p, d) for p, d in _sweep_programs() if d != target and Path(p).stat().st_size <= _EQUIV_BYTES]
+
+
+@pytest.mark.parametrize("target", TARGETS)
+def test_every_converted_corpus_program_is_equiv_to_its_source(target, monkeypatch):
+    monkeypatch.setenv("NCTRANS_MAX_STEPS", _STEPS)
+    problems, agreeing_exceptions = [], []
+    pairs = _pairs(target)
+    assert len(pairs) > 30
+    for path, source in pairs:
+        key = f"{source}->{target} {Path(path).name}"
+        conv = nctrans.transpile(Path(path), read=source, write=target)
+        if conv.text is None:
+            if not [d for d in conv.diagnostics if d.severity == "error" and d.line >= 1]:
+                problems.append(f"{key}: refused without a located error")
+            continue
+        same = nctrans.equiv(Path(path), conv.text, read_a=source, read_b=target)
+        if key in KNOWN:
+            if same:
+                agreeing_exceptions.append(key)
+            continue
+        if not same:
+            problems.append(f"{key}: {same.message}")
+    assert not problems, "\n".join(problems)
+    assert not agreeing_exceptions, f"equiv now: remove from KNOWN: {agreeing_exceptions}"
+    swept = {f"{source}->{target} {Path(path).name}" for path, source in pairs}
+    stale = [k for k in KNOWN if k.split(" ", 1)[0].endswith(f"->{target}") and k not in swept]
+    assert not stale, f"no longer swept: remove from KNOWN: {stale}"
+
+
+# ------------------------------------------------------- defects the sweep found, by hand
+
+def test_a_feed_move_without_a_feed_is_a_feed_move_on_every_path():
+    # G1 with no F is NC202; the move is still a feed move (it was a rapid on the fast path of a
+    # milling program and a feed move on a lathe, so iso-m -> iso-t looked different)
+    text = "G0 X-0.25 Y0\nG91 G1 Z-0.08\nG90\nM30\n"
+    kinds = [(r.kind, r.end["Z"]) for r in nctrans.toolpath(text, "iso-m") if r.kind != "stop"]
+    assert kinds == [("rapid", 0.0), ("linear", -0.08)]
+    assert [d.line for d in nctrans.lint(text, dialect="iso-m") if d.rule == "NC202"] == [2]
+
+
+def test_linuxcnc_o_word_control_flow_is_a_located_error_not_subprograms():
+    # read as program numbers, `o100 sub` .. made the rest of the file subprograms: no toolpath,
+    # no diagnostic, and a conversion wrote a lone M30
+    text = "G20\no100 sub\nG0 X1\no100 endsub\no100 call\nM2\n"
+    errors = [(d.rule, d.line) for d in nctrans.lint(text, dialect="iso-m") if d.severity == "error"]
+    assert ("NC002", 2) in errors and ("NC002", 4) in errors and ("NC002", 5) in errors
+    assert nctrans.transpile(text, read="iso-m", write="iso-t").text is None
