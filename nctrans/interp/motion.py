@@ -126,7 +126,7 @@ class MotionMixin:
         mstart = self.mpos
         self.mpos = mend
         sp = self.span
-        if motion == "rapid":       # a feed move with no feed is still a feed move (NC202 said)
+        if feed is None:
             rec = ToolpathRecord(0, sp.file, sp.line, "rapid", mstart, mend, None, None, None,
                                  None, None, None, st.spindle_speed, st.tool)
         else:
