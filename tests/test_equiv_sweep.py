@@ -44,8 +44,6 @@ KNOWN = {
     # flattened Sinumerik output write G1 with no F, which rs274 refuses (ROLIK2_UJEDNO.DRS)
     "iso-m->iso-t donpayne-haas-O1012-gauge-tool.cnc": "a feedless G1 is a rapid on the milling "
         "fast path only",
-    "iso-m->fagor O2151.nc": "not examined: the Fagor program stops after its first rapid",
-    "iso-m->fagor donpayne-haas-O1012-gauge-tool.cnc": "not examined: an extra program end on Fagor",
 }
 
 
@@ -89,3 +87,17 @@ def test_linuxcnc_o_word_control_flow_is_a_located_error_not_subprograms():
     errors = [(d.rule, d.line) for d in nctrans.lint(text, dialect="iso-m") if d.severity == "error"]
     assert ("NC002", 2) in errors and ("NC002", 4) in errors and ("NC002", 5) in errors
     assert nctrans.transpile(text, read="iso-m", write="iso-t").text is None
+
+
+def test_an_iso_main_program_restart_is_an_endless_loop_on_fagor(monkeypatch):
+    # corpus/iso-m/O2151.nc: M99 starts the program again; Fagor wrote one pass and M30. The
+    # second pass starts at Z2 and moves G91 Z-5: Z-3 (hand-followed)
+    monkeypatch.setenv("NCTRANS_MAX_STEPS", "2000")
+    text = "O2151\nG91 G0 Z-5.\nG90 G1 Z-1. F100\nG0 Z2.\nM99\n"
+    out = nctrans.transpile(text, read="iso-m", write="fagor").text
+    code = [line.split(";", 1)[0].strip() for line in out.splitlines()]
+    assert "$WHILE 1" in code and "$ENDWHILE" in code and "M30" not in code
+    ends = [r.end["Z"] for r in nctrans.toolpath(out, "fagor") if r.kind in ("rapid", "linear")][:6]
+    assert ends == [-5.0, -1.0, 2.0, -3.0, -1.0, 2.0]
+    same = nctrans.equiv(text, out, read_a="iso-m", read_b="fagor")
+    assert same and same.endless

@@ -24,6 +24,7 @@ from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
 from nctrans.ir import nodes as n
 from nctrans.plainrun import PlainRun, run_blocks
 from nctrans.ir import walk as ir_walk
+from nctrans.lower import restart_loop
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans.rules import load_table
 
@@ -239,8 +240,18 @@ class FagorEmitter(FagorSpelling, Emitter):
         self._reset()
         self.out.append(f"%{_program_header(p)}")
         self.prologue()
-        self.nodes(p.body)
+        self.nodes(self._restart_as_loop(p.body))
         return "\n".join(self.out) + "\n"
+
+    def _restart_as_loop(self, body: list) -> list:
+        """M99 ending a main program of another dialect starts it again for ever: the body runs
+        inside $WHILE 1 ... $ENDWHILE (lowered alone it would be one pass and a program end)."""
+        last = restart_loop.restart_block(body) if self.program.dialect != DIALECT else None
+        if last is None:
+            return body
+        self.span = body[last].span
+        self.lowered("M99 in a main program (it starts again for ever) written as $WHILE 1 ... $ENDWHILE")
+        return restart_loop.as_loop(body, last)
 
     def prologue(self) -> None:
         """The source controller's power-on modes that change what the words mean, where Fagor's

@@ -43,7 +43,7 @@ from nctrans.dialects.sinumerik.spelling import format_number as _fmt
 from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
-from nctrans.lower import computed_g, macro_procs, modal_numbers
+from nctrans.lower import computed_g, macro_procs, modal_numbers, restart_loop
 from nctrans.plainrun import PlainRun, run_blocks
 from nctrans.dialects.sinumerik.edge_selection import EdgeSelection, NoEdge, jump_regions
 from nctrans.rules import load_table, system_meaning, system_spelling
@@ -1317,12 +1317,10 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         """ISO M99 at the end of a main program from another dialect. In a program that reads G65
         arguments (#1-#33 it never sets) it is the macro's return: M17. Otherwise the control starts
         the program again for ever: the body runs inside LOOP ... ENDLOOP (never one pass)."""
-        if self.p.dialect == DIALECT or type(body) is not list:
+        if self.p.dialect == DIALECT:
             return body
-        last = next((i for i in range(len(body) - 1, -1, -1)
-                     if isinstance(body[i], ir.Block) and body[i].body), None)
-        if last is None or not any(isinstance(s, ir.ProgramEnd) and s.kind == "restart"
-                                   for s in body[last].body):
+        last = restart_loop.restart_block(body)
+        if last is None:
             return body
         b = body[last]
         self.span = b.span
@@ -1333,10 +1331,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             return body[:last] + [ir.Block(b.span, new, b.number, b.label, b.skip, b.comment)] + body[last + 1:]
         self.info("m99-loop", "M99 in a main program (it starts again for ever) written as "
                               "LOOP ... ENDLOOP")
-        rest = [s for s in b.body if not (isinstance(s, ir.ProgramEnd) and s.kind == "restart")]
-        inner = body[:last] + ([ir.Block(b.span, rest, b.number, b.label, b.skip, b.comment)]
-                               if rest or b.number or b.comment else [])
-        return [ir.Loop(body[0].span if body else b.span, inner)] + body[last + 1:]
+        return restart_loop.as_loop(body, last)
 
     def head(self) -> None:
         """What comes before the main body: archive header, path, power-on modes (a macro file:
