@@ -649,19 +649,13 @@ class IsoEmitter(IsoSpelling, Emitter):
         if structure:
             self.forget()
 
-    @staticmethod
-    def _comment(text: str) -> str:
-        depth = 0
-        for ch in text:
-            if ch == "(":
-                depth += 1
-            elif ch == ")":
-                depth -= 1
-                if depth < 0:
-                    break
-        if depth == 0:
-            return f"({text})"
-        return "; " + text.strip()      # unbalanced parentheses: only a ';' comment keeps the text
+    # A comment ends at the first ")" on Fanuc and LinuxCNC, and a "(" inside one is an alarm there
+    # ("Nested comment found"): only Siemens ISO mode nests. Parentheses in the text become brackets.
+    _FLAT_COMMENT = str.maketrans("()", "[]")
+
+    @classmethod
+    def _comment(cls, text: str) -> str:
+        return f"({text.translate(cls._FLAT_COMMENT)})"
 
     def s_Block(self, b: n.Block) -> None:
         prefix = ""
@@ -810,8 +804,7 @@ class IsoEmitter(IsoSpelling, Emitter):
             f"motion: written as alarm #3000={pl.NOT_CONVERTED_ALARM} at its place, so the control "
             "stops there until it is ported by hand; the rest keeps its structure", self._where()))
         self.guards.clear()
-        text = err.construct.replace("(", "[").replace(")", "]")
-        return f"#3000={pl.NOT_CONVERTED_ALARM} ({'NOT CONVERTED: ' + text})"
+        return f"#3000={pl.NOT_CONVERTED_ALARM} {self._comment('NOT CONVERTED: ' + err.construct)}"
 
     def cond(self, e) -> str:
         try:
