@@ -25,6 +25,8 @@ from nctrans.machine import default_mill
 
 # fields that only say how the source spelled something
 _SPELLING = {n.Num: ("text",), n.ModeChange: ("code",), n.PolarPole: ("code",)}
+# ISO writers keep comments flat (Fanuc and rs274 do not nest): "(" and ")" in the text come back as brackets
+_FLAT_COMMENT = str.maketrans("()", "[]")
 
 
 def norm(obj: Any, digits: Optional[int] = None) -> Any:
@@ -35,13 +37,17 @@ def norm(obj: Any, digits: Optional[int] = None) -> Any:
     if dataclasses.is_dataclass(obj):
         skip = _SPELLING.get(type(obj), ())
         return (type(obj).__name__,) + tuple(
-            (f.name, norm(getattr(obj, f.name), digits)) for f in dataclasses.fields(obj)
-            if f.name != "span" and f.name not in skip)
+            (f.name, _comment(getattr(obj, f.name)) if f.name == "comment" else norm(getattr(obj, f.name), digits))
+            for f in dataclasses.fields(obj) if f.name != "span" and f.name not in skip)
     if isinstance(obj, dict):
         return {k: norm(v, digits) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         return [norm(v, digits) for v in obj]
     return obj
+
+
+def _comment(text: Optional[str]) -> Optional[str]:
+    return text.translate(_FLAT_COMMENT) if text is not None else None
 
 
 def ir_round_trip(dialect: str, text: str, file: str = "t.nc"):
