@@ -94,14 +94,18 @@ def _str(s: str) -> str:
 
 
 def _safe_json_line(r: ToolpathRecord) -> str:
-    """The slow, always-valid path: non-finite numbers become null."""
+    """The slow, always-valid path. A non-finite scalar is an unknown value (a spindle angle turned
+    by IC from a turning spindle, said by NC220 at its line): its key is left out, never null.
+    Coordinates are never non-finite (NC108 stops them before a record is made)."""
     d = {}
     for name in ToolpathRecord.__slots__:
         v = getattr(r, name)
         if v is None:
             continue
         if isinstance(v, float):
-            v = round(v, 6) + 0.0 if math.isfinite(v) else None
+            if not math.isfinite(v):
+                continue
+            v = round(v, 6) + 0.0
         elif isinstance(v, dict):
             v = {k: (round(x, 6) + 0.0 if math.isfinite(x) else None) for k, x in v.items()}
         d[name] = v

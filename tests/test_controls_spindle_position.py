@@ -93,3 +93,15 @@ def test_iso_m19_stops_the_spindle_and_converts():
     conv = api.transpile(text, "iso-m", "sinumerik")
     assert conv.text is not None and "M19" in conv.text
     assert api.equiv(text, conv.text, read_a="iso-m", read_b="sinumerik")
+
+
+def test_an_unknown_angle_never_reaches_the_json_record_as_null(tmp_path):
+    # the toolpath JSON of the IC-from-turning case: the event is there, its angle key is left out
+    import json
+    from nctrans.toolpath_io import to_json_line
+    recs, _ = run(HEAD + "SPOS=IC(45)\nSPOS=IC(45)\nM30\n")
+    lines = [json.loads(to_json_line(r)) for r in recs if r.kind == "spindle"]
+    orients = [d for d in lines if d.get("spindle_dir") == "orient"]
+    assert len(orients) == 2
+    assert all(None not in d.values() for d in lines)
+    assert "spindle_angle" not in orients[0] and "spindle_angle" not in orients[1]   # still unknown + 45

@@ -12,7 +12,8 @@ at the line. A feed move after it is not NC209 (as after M5): a positioned spind
 and measuring programs feed with (corpus mojimould-O80000001-main: M19, then G1 with a touch
 probe). An
 IC angle from a spindle that was turning (or whose angle is not known) leaves the angle unknown:
-the event's angle is NaN (null in JSON, compared as unknown by equiv, refused by --flatten) and
+the event's angle is NaN (left out of the JSON record, compared as unknown by equiv, refused by
+--flatten) and
 NC220 says so. Spindles other than the master (`SPOS[2]=`) stay NC220,
 not modelled (nctrans models one spindle).
 """
