@@ -99,6 +99,19 @@ def test_a_structured_program_converts_as_parsed_whole():
     _same_runs(STRUCTURED, "s.nc", "iso-m")
 
 
+# a G65 macro in the same file, called around long plain stretches: it becomes a PROC with named
+# parameters (macro_procs) whichever way the program was parsed
+MACRO_IN_FILE = ("O1000\nG21 G90 G17 G54\nT1 M6\nS1000 M3\n" + cam(0, 300) + "G65 P3000 A1. B2.\n"
+                 + cam(300, 300) + "G65 P3000 A3. B4.\nM30\nO3000\nG1 X#1 Y#2 F100\nM99\n")
+
+
+def test_a_macro_called_between_runs_becomes_a_proc_as_parsed_whole():
+    assert _compact(MACRO_IN_FILE, "m.nc", "iso-m")
+    _same_both_ways(MACRO_IN_FILE, "m.nc", "iso-m", targets=("sinumerik",))
+    out = api.transpile(MACRO_IN_FILE, "iso-m", "sinumerik", file="m.nc").text
+    assert "PROC L3000(REAL ARG_A, REAL ARG_B" in out and "L3000(1., 2.)" in out
+
+
 def test_a_lowering_over_a_run_converts_the_program_parsed_whole():
     assert _compact(OFFSET_AROUND_RUNS, "o.nc", "iso-m")
     _same_both_ways(OFFSET_AROUND_RUNS, "o.nc", "iso-m")

@@ -49,13 +49,16 @@ def key(name: str) -> str:
 
 def plan(program: ir.Program) -> dict[str, MacroProc]:
     """The subprograms (by key()) that become procedures with named parameters."""
+    from nctrans.dialects.base import CompactBody
     letters = ((program.meta or {}).get("options") or {}).get("macro_arguments") or {}
     if not letters or not program.subprograms:
         return {}
     by_local = {int(k): str(letter) for letter, k in letters.items()}
     calls: dict[str, list[ir.SubCall]] = {}
     for body in [program.body, *(s.body for s in program.subprograms.values())]:
-        if type(body) is not list:
+        if type(body) is CompactBody:
+            body = body.items               # its runs of plain lines hold no call
+        elif type(body) is not list:
             return {}                       # a streamed body: calls cannot be seen ahead
         for c in _calls(body):
             calls.setdefault(key(c.name), []).append(c)
