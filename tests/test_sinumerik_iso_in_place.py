@@ -22,7 +22,6 @@ CONSTRUCTS = [
     ("G1 X10 C=IC(90) F100", "C=IC[..])"),
     ("G1 C=DC(180) F100", "C=AC/DC[..])"),
     ("G500", "G500)"),
-    ("DIAMON", "DIAMON)"),
     # more than the 500 common variables #500-#999 hold
     ("DEF REAL BIG[600]", "DEF BIG[..])"),
 ]
@@ -135,3 +134,23 @@ def test_no_effect_function_commented_with_its_rule(word, rule):
     flat = word.replace("(", "[").replace(")", "]")     # Fanuc/LinuxCNC comments do not nest
     assert lines[lines.index("G0 X0. Y0.") + 1] in (f"({flat})", f"(NC413 sinumerik: {flat})")
     assert api.equiv(src, conv.text, read_a="sinumerik", read_b="iso-m").equivalent
+
+
+def test_a_return_ending_a_main_program_is_said_when_written_as_m99():
+    # M17 ends a Sinumerik main program run on its own; ISO M99 there restarts it (NC406 says so)
+    conv = api.transpile("G0 X1 Y2\nM17\n", read="sinumerik", write="iso-m")
+    assert [(d.rule, d.line) for d in conv.diagnostics if d.severity == "warning"] == [("NC406", 2)]
+    # a PROC's RET is a subprogram's return: nothing to say; nor for ISO's own M99
+    proc = api.transpile("PROC FOO(REAL A)\nG0 X=A\nRET\n", read="sinumerik", write="iso-m")
+    assert "NC406" not in {d.rule for d in proc.diagnostics}
+    iso = api.transpile("O1\nG0 X1\nM99\n", read="iso-m", write="iso-m")
+    assert "NC406" not in {d.rule for d in iso.diagnostics}
+
+
+def test_diamon_is_written_as_radius_words():
+    # DIAMON (diameter X, absolute and incremental) is no alarm: ISO X words carry the radius
+    src = "PROC PART(REAL D)\nG1 Z0 F100\nDIAMON\nG1 X=D Z1\nG91 X2\nDIAMOF\nG90 X5\nRET\n"
+    conv = api.transpile(src, read="sinumerik", write="iso-m")
+    lines = [l for l in conv.text.splitlines() if l.startswith(("G1 X", "G91", "G90"))]
+    assert lines == ["G1 X[#1/2] Z1.", "G91 X1.", "G90 X5."]
+    assert "NC412" not in {d.rule for d in conv.diagnostics}

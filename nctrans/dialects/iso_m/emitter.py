@@ -1627,6 +1627,13 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def w_Return(self, s):
         words = [self.code_word("call", "m99")]
+        if self.unit is None and s.to_label is None and self.program.dialect != self.dialect:
+            # another control's return (Sinumerik M17/RET) ends a main program run on its own; an
+            # ISO M99 there restarts it: said, since the file may as well be called as a subprogram
+            self.diags.append(at_span("NC406", "warning", "the source returns from its main program here, "
+                                      "which ends it when run on its own; the M99 written for it "
+                                      f"restarts a main program on {self.target_text} (end it with M30 "
+                                      "if it is not called as a subprogram)", self._where()))
         if s.to_label is not None:
             words.append(("P", "P" + self._goto_target(s.to_label)))
         pop = self._pop_frame()
