@@ -115,3 +115,18 @@ def test_every_conformance_program_converts_to_both_targets():
             if convert_policy(program, target).text is None:
                 refused.append((path.name, target))
     assert all(name.startswith(("10-", "13-")) for name, _ in refused), refused
+
+
+def test_iso_length_offset_of_another_tool_is_refused_for_fagor(tmp_path):
+    # A Fagor D takes the length of the tool in the spindle; ISO H3 under T2 is register 3 (tool 3's
+    # length here): with T2 = 50 mm and T3 = 30 mm the tip would end 20 mm off. Refused at its line.
+    from nctrans import api
+    machine = tmp_path / "m.toml"
+    machine.write_text("[[tools]]\nnumber = 2\nlength = 50\n[[tools]]\nnumber = 3\nlength = 30\n")
+    src = "O1\nG21 G90 G17\nT2 M6\nG43 H{h} Z50.\nG0 X0 Y0\nG1 Z10. F100\nM30\n"
+    other = api.transpile(src.format(h=3), read="iso-m", write="fagor")
+    assert other.text is None
+    assert [(d.rule, d.line) for d in other.diagnostics if d.severity == "error"] == [("NC402", 4)]
+    own = api.transpile(src.format(h=2), read="iso-m", write="fagor")
+    assert own.text is not None and "D2" in own.text
+    assert api.equiv(src.format(h=2), own.text, read_a="iso-m", read_b="fagor", machine=machine).equivalent

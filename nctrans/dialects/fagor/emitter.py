@@ -208,6 +208,9 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.pending_motion: Optional[str] = None     # arc_3point / arc_tangent: one-shot G09/G08
         self.radius_index: Any = None
         self.length_on = False
+        # the tool in the spindle (T<n> M06, constant numbers only) and the T selected for it
+        self.tool_selected: Optional[float] = None
+        self.tool_active: Optional[float] = None
         self.in_sub = False
         # spindle-synchronised moves ("thread") are written as G63: S and the feed mode they need
         self.speed: Optional[float] = None            # the last constant S written (rev/min)
@@ -232,6 +235,7 @@ class FagorEmitter(FagorSpelling, Emitter):
                 self.refuse(f"the parameters of subprogram {name} (Fagor subroutines take P values)")
             self.out.append(f"%L {_sub_name(name)}")
             self.in_sub = True
+            self.tool_selected = self.tool_active = None    # called with whatever tool is in the spindle
             self._reset()
             self.nodes(sub.body)
             if not ir_walk.ends_with_return(sub.body):
@@ -463,8 +467,10 @@ class FagorEmitter(FagorSpelling, Emitter):
     def w_ToolSelect(self, s: n.ToolSelect, word, new_line, rest: list):
         val = self.value
         word("T", "T" + val(s.tool))
+        self.tool_selected = _num(s.tool)
 
     def w_ToolChange(self, s: n.ToolChange, word, new_line, rest: list):
+        self.tool_active = self.tool_selected
         code = self.code_for("tool_change")
         word(code, code)
         # Fagor: D1 is implicit after a tool change (the front end writes it as these two)
@@ -485,8 +491,18 @@ class FagorEmitter(FagorSpelling, Emitter):
             if not self.length_on and _num(s.index) != 0:
                 self.lowered("D selects the tool length offset too on Fagor")
         else:
+            self._length_of_active_tool(s.index)
             word("D", "D" + val(s.index))
             self.lowered("length offset H written as the Fagor offset D of the active tool")
+
+    def _length_of_active_tool(self, h: n.Expr) -> None:
+        """A Fagor D takes the length of the tool in the spindle; an ISO H<k> names offset register k,
+        which (as nctrans reads ISO: register k holds tool k's length) is another tool's length when k
+        is not the active tool's number: no Fagor D says that."""
+        k = _num(h)
+        if k is not None and k != 0 and self.tool_active is not None and k != self.tool_active:
+            raise NotExpressible(f"tool length offset H{k:g} of another tool than the one in the "
+                                 f"spindle (T{self.tool_active:g}): a Fagor D takes the active tool's own length")
 
     def w_Dwell(self, s: n.Dwell, word, new_line, rest: list):
         val = self.value
@@ -627,6 +643,8 @@ class FagorEmitter(FagorSpelling, Emitter):
             self.length_on = True
             # a Fagor source names its D in the code; an ISO G43 takes the H of this block
             nxt = next((x for x in rest if isinstance(x, n.OffsetSelect)), None)
+            if nxt is not None and nxt.kind == "length":
+                self._length_of_active_tool(nxt.index)
             if s.code.upper().startswith("D") and len(s.code) > 1:
                 word("D", s.code.upper())
             elif nxt is None:
