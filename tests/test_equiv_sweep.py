@@ -34,8 +34,6 @@ KNOWN = {
     # PROC parameter as its first letter A (the ISO caller and subprogram agree with each other)
     **{f"sinumerik->{t} rhoden-SINULORENZ.MPF": "by-reference array arguments shift the call "
        "event's positions" for t in ("iso-m", "iso-t")},
-    "iso-m->sinumerik safetydav3-CIRCLE-macro.NC": "not examined: the path after `G74 Z1=0` differs",
-    "iso-m->sinumerik safetydav3-WASHER-macro.NC": "not examined: the path after `G74 Z1=0` differs",
     # a G1 with no F (NC202): the milling interpreter's fast path records it as a rapid, the
     # lathe's (always the general path) as a feed move; recording it as a feed move makes
     # flattened Sinumerik output write G1 with no F, which rs274 refuses (ROLIK2_UJEDNO.DRS)
