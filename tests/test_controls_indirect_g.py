@@ -2,32 +2,12 @@
 numbered `value` in the G group, numbered as $P_GG reads them (rules [options.g_group_index])."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import nctrans
 from nctrans import api
 
-MACHINE = """name = "offsets"
-kind = "mill"
-[axes.X]
-kind = "linear"
-min = -500.0
-max = 500.0
-[axes.Y]
-kind = "linear"
-min = -500.0
-max = 500.0
-[axes.Z]
-kind = "linear"
-min = -500.0
-max = 500.0
-[offsets.G54]
-X = 100.0
-Y = 0.0
-Z = 0.0
-[offsets.G55]
-X = 200.0
-Y = 50.0
-Z = 0.0
-"""
+MACHINE = (Path(__file__).parent / "data" / "offsets-g54-g55.toml").read_text()
 
 # the seed's example: INT_VAR=2 -> G54, +1 -> G55 (group 8: 1 G500, 2 G54, 3 G55)
 SEED = ("DEF INT INT_VAR\nG500 G0 X0 Y0 Z0\nINT_VAR=2\nG[8]=INT_VAR G1 X0 Y0 F100\n"

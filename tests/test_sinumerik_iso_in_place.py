@@ -5,6 +5,8 @@ keeps its structure; never a whole-file refusal, never left out. In a main progr
 to plain motion over its stretch (to the next settable offset), proven equivalent with offsets."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from nctrans import api
@@ -73,29 +75,7 @@ def test_strict_refuses_them():
     assert [d.severity for d in conv.diagnostics if d.rule == "NC412"] == ["error"]
 
 
-OFFSETS = """name = "offsets"
-kind = "mill"
-[axes.X]
-kind = "linear"
-min = -500.0
-max = 500.0
-[axes.Y]
-kind = "linear"
-min = -500.0
-max = 500.0
-[axes.Z]
-kind = "linear"
-min = -500.0
-max = 500.0
-[offsets.G54]
-X = 100.0
-Y = 0.0
-Z = 0.0
-[offsets.G55]
-X = 200.0
-Y = 50.0
-Z = 0.0
-"""
+OFFSETS = (Path(__file__).parent / "data" / "offsets-g54-g55.toml").read_text()
 
 
 def test_g500_in_a_main_program_is_lowered_over_its_stretch(tmp_path):

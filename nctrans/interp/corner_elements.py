@@ -242,6 +242,15 @@ def _in_plane(m: Move, a1: str, a2: str) -> bool:
     return all(abs(m.end.get(a, 0.0) - m.start.get(a, 0.0)) < 1e-9 for a in keys if a not in (a1, a2))
 
 
+def _shape(kind: str, first, second, value: float):
+    """(the rounding arc or chamfer line between two elements, or None, why not) for a corner word's kind."""
+    if kind in ("round", "round_modal"):
+        return corners.rounding(first, second, value)
+    if kind == "chamfer_leg":
+        return corners.chamfer_legs(first, second, value)
+    return corners.chamfer_length(first, second, value)
+
+
 def _element(m: Move, a1: str, a2: str) -> corners.Element:
     return corners.Element(m.kind, (m.start[a1], m.start[a2]), (m.end[a1], m.end[a2]),
                            m.center, m.cw)
@@ -273,12 +282,7 @@ def _join(it, p: Move, new: Move) -> Move:
     kind, value, feed, dialect = p.corner
     corner = None
     if not corners.is_tangent(first, second):
-        if kind in ("round", "round_modal"):
-            corner, why = corners.rounding(first, second, value)
-        elif kind == "chamfer_leg":
-            corner, why = corners.chamfer_legs(first, second, value)
-        else:
-            corner, why = corners.chamfer_length(first, second, value)
+        corner, why = _shape(kind, first, second, value)
         if corner is None:
             if settings(dialect).get("too_large") == "reduced":
                 why += " (the control shrinks it to fit; nctrans does not model how)"
@@ -356,12 +360,7 @@ def apply_to_contour(it, blocks, moves: list) -> list:
         first, second = _element(m, a1, a2), _element(n2, a1, a2)
         if corners.is_tangent(first, second):
             continue
-        if kind in ("round", "round_modal"):
-            corner, why = corners.rounding(first, second, value)
-        elif kind == "chamfer_leg":
-            corner, why = corners.chamfer_legs(first, second, value)
-        else:
-            corner, why = corners.chamfer_length(first, second, value)
+        corner, why = _shape(kind, first, second, value)
         if corner is None:
             _not_inserted(it, m, why)
             continue

@@ -83,6 +83,12 @@ def harmless_elsewhere(s: n.Passthrough, machine_kind: str = "mill") -> bool:
 
 @lru_cache(maxsize=None)
 def _harmless_words(dialect: str) -> frozenset[str]:
+    return _table_words(dialect, "no_motion_effect", "harmless_elsewhere")
+
+
+def _table_words(dialect: str, section: str, key: str) -> frozenset[str]:
+    """The upper-cased words of `[options.<section>] <key>` in the dialect's rules table (none when
+    the dialect has no table of its own)."""
     try:
         from nctrans.rules import load_table
         t = load_table(dialect) if dialect else None
@@ -90,8 +96,7 @@ def _harmless_words(dialect: str) -> frozenset[str]:
         return frozenset()
     if t is None:
         return frozenset()
-    words = t.options.get("no_motion_effect", {}).get("harmless_elsewhere", ())
-    return frozenset(str(w).upper() for w in words)
+    return frozenset(str(w).upper() for w in t.options.get(section, {}).get(key, ()))
 
 
 def leading_word(text: str) -> str:
@@ -108,14 +113,7 @@ def leading_word(text: str) -> str:
 def one_block_codes(dialect: str) -> frozenset[str]:
     """Non-modal codes of `dialect` that take over their own block's motion only
     (`[options.unmodelled_motion] one_block`: ISO G31)."""
-    try:
-        from nctrans.rules import load_table
-        t = load_table(dialect) if dialect else None
-    except Exception:           # a dialect without a table of its own
-        return frozenset()
-    if t is None:
-        return frozenset()
-    return frozenset(str(c).upper() for c in t.options.get("unmodelled_motion", {}).get("one_block", ()))
+    return _table_words(dialect, "unmodelled_motion", "one_block")
 
 
 @lru_cache(maxsize=None)
