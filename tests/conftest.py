@@ -84,3 +84,17 @@ settings.register_profile("default", max_examples=60, deadline=None,
                           suppress_health_check=[HealthCheck.too_slow])
 if not os.environ.get("NCTRANS_FUZZ_PROFILE_SET"):
     settings.load_profile("default")
+
+
+class TextSink:
+    """An output stream that keeps what the writers send it, piece by piece (`parts`): for the
+    tests that convert into a sink instead of a string (the streamed and compact paths)."""
+
+    def __init__(self):
+        self.parts: list[str] = []
+
+    def write(self, s: str) -> None:
+        self.parts.append(s)
+
+    def reset(self) -> None:
+        self.parts = []

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import CORPUS
+from conftest import CORPUS, TextSink
 from nctrans import api, pipeline, plainrun
 from nctrans.dialects.base import CompactBody
 from nctrans.source import from_text
@@ -23,16 +23,6 @@ pytestmark = pytest.mark.skipif(plainrun.native is None, reason="runs of plain l
 TARGETS = ("iso-m", "sinumerik", "fagor", "iso-t")
 
 
-class Sink:
-    def __init__(self):
-        self.parts: list[str] = []
-
-    def write(self, s: str) -> None:
-        self.parts.append(s)
-
-    def reset(self) -> None:
-        self.parts = []
-
 
 def _same_both_ways(text: str, name: str, source: str, targets=TARGETS) -> None:
     """Written as it goes (an output sink), parsed compact and parsed whole (the dialect's
@@ -41,7 +31,7 @@ def _same_both_ways(text: str, name: str, source: str, targets=TARGETS) -> None:
     for target in targets:
         results = []
         for compact in (True, False):
-            sink = Sink()
+            sink = TextSink()
             with _parse_compact(dialect, compact):
                 done = api.transpile(text, source, target, file=name, out=sink)
             results.append(("".join(sink.parts) if done.text is not None else None,
@@ -128,7 +118,7 @@ def test_a_compact_conversion_holds_no_block_of_its_runs(monkeypatch):
         return blocks, rest
     monkeypatch.setattr(plainrun.PlainRun, "take", counting_take)
     text = STRUCTURED.replace(cam(300, 300), cam(300, 5000))
-    sink = Sink()
+    sink = TextSink()
     assert api.transpile(text, "iso-m", "iso-m", file="s.nc", out=sink).text == ""
     assert taken and max(taken) <= plainrun.RUN_CHUNK
     written = "".join(sink.parts)

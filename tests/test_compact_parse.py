@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import CORPUS
+from conftest import CORPUS, TextSink
 from nctrans import api, pipeline, plainrun, toolpath_io
 from nctrans.dialects.base import CompactBody
 from nctrans.dialects.iso_m.frontend import parse_compact
@@ -30,16 +30,6 @@ STRUCTURED = ("%\nO1000\nG21 G90 G17 G40 G49 G80\nT1 M6\nS8000 M3\nG0 X0 Y0 Z5.\
               "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nG80\n#1=#1+1\nEND1\nG0 Z50.\nG1 F500.\n" + cam(400, 400)
               + "M30\nO2000\nG91 G1 X1. F100.\nY1.\nG90\nM99\n%\n")
 
-
-class Sink:
-    def __init__(self):
-        self.parts: list[str] = []
-
-    def write(self, s: str) -> None:
-        self.parts.append(s)
-
-    def reset(self) -> None:
-        self.parts = []
 
 
 
@@ -82,7 +72,7 @@ def _compare(text: str, name: str) -> None:
     assert texts[0] == texts[1]
     for target in ("iso-m", "sinumerik", "fagor"):
         held = api.transpile(text, "iso-m", target, flatten=True, file=name)
-        sink = Sink()
+        sink = TextSink()
         streamed = api.transpile(text, "iso-m", target, flatten=True, file=name, out=sink)
         assert (streamed.text is None) == (held.text is None)
         if held.text is not None:

@@ -25,6 +25,7 @@ from pathlib import Path
 import pytest
 
 import rs274 as h
+from conftest import TextSink
 from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
@@ -537,16 +538,6 @@ def test_cli_convert_flatten(tmp_path, capsys):
 
 # --------------------------------------------------------------------------- streamed (issue 15)
 
-class _Sink:
-    def __init__(self):
-        self.parts: list[str] = []
-
-    def write(self, s: str) -> None:
-        self.parts.append(s)
-
-    def reset(self) -> None:
-        self.parts = []
-
 
 def test_flattened_blocks_come_as_the_program_runs():
     """An endless loop gives its first blocks at once: the flattened program is produced as the
@@ -572,7 +563,7 @@ def test_streamed_flatten_writes_what_the_whole_one_does(source, dialect, target
     from nctrans import api
     text = (Path(__file__).resolve().parents[1] / source).read_text()
     whole = api.transpile(text, dialect, target, flatten=True)
-    sink = _Sink()
+    sink = TextSink()
     streamed = api.transpile(text, dialect, target, flatten=True, out=sink)
     assert whole.text is not None and streamed.text == "" and len(sink.parts) > 1
     assert "".join(sink.parts) == whole.text
@@ -585,7 +576,7 @@ def test_streamed_flatten_keeps_notes_of_a_straight_program_in_order():
     from nctrans import api
     text = "G21 G90\nG0 X0 Y0\nG1 X10 F100\nM123\nG2 X20 R5\nM30\nG0 X5\nM456\n"
     whole = api.transpile(text, "iso-m", "iso-m", flatten=True)
-    sink = _Sink()
+    sink = TextSink()
     streamed = api.transpile(text, "iso-m", "iso-m", flatten=True, out=sink)
     got = [d.format_text() for d in streamed.diagnostics]
     assert got == [d.format_text() for d in whole.diagnostics]
