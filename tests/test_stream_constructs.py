@@ -9,19 +9,9 @@ import tracemalloc
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from conftest import TextSink
 from nctrans import api
 from tests.conftest import CORPUS
-
-
-class Sink:
-    def __init__(self):
-        self.parts: list[str] = []
-
-    def write(self, text: str) -> None:
-        self.parts.append(text)
-
-    def reset(self) -> None:
-        self.parts = []
 
 
 class NullSink:
@@ -43,7 +33,7 @@ def no_whole_parse(monkeypatch):
 
 
 def streamed(text: str, source: str, target: str):
-    sink = Sink()
+    sink = TextSink()
     conv = api.transpile(text, source, target, out=sink)
     return (None if conv.text is None else "".join(sink.parts)), [d.format_text() for d in conv.diagnostics]
 
