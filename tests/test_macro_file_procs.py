@@ -29,11 +29,13 @@ def test_macro_file_is_a_proc_with_every_letter_in_call_order():
     assert body[1] == "DEF REAL LOC10"
     # no power-on modes: a subprogram runs in its caller's
     assert not [x for x in body if x.startswith("G0 G54")]
-    # X, Y, F, Z are used bare (ISO drops the word when vacant): checked on entry; A is not
-    for letter, pos in (("F", 6), ("X", 16), ("Y", 17), ("Z", 18)):
+    # X, Y, F are used bare (ISO drops the word when vacant): checked on entry; A is not, and Z
+    # is used bare only after the macro's own vacancy test `IF[#26EQ#0]GOTO10` (no false stop)
+    for letter, pos in (("F", 6), ("X", 16), ("Y", 17)):
         i = body.index(f"IF NOT $P_SUBPAR[{pos}]")
         assert body[i + 1].strip() == f'SETAL(65001, "ARGUMENT {letter} NOT PASSED")'
     assert "IF NOT $P_SUBPAR[1]" not in body
+    assert "ARGUMENT Z NOT PASSED" not in conv.text
     assert "IF NOT $P_SUBPAR[18] GOTO N10" in body       # the vacancy test, as written in ISO
     assert "N10 LOC10=ARG_A*2" in body and body[-1] in ("RET", "M17")
     assert not [d for d in conv.diagnostics if d.rule == "NC414"]
@@ -82,15 +84,32 @@ def test_caller_and_macro_file_converted_apart_are_equivalent(tmp_path):
 
 
 def test_a_left_out_argument_used_bare_stops_instead_of_moving_to_zero(tmp_path):
-    # the first call leaves Z out: ISO skips G1 Z (the vacancy test); the PROC cannot tell a
-    # dropped word from Z0, so it stops with the alarm on entry, before any move of that call
-    caller = CALLER.replace(" Z-2.", "")
+    # the first call leaves X out: ISO drops the X word of `G1 X#24 Y#25`; the PROC cannot tell a
+    # dropped word from X0, so it stops with the alarm on entry, before any move of that call
+    caller = CALLER.replace(" X10.", "")
     iso, sin = _pair(tmp_path, caller)
     tp = api.toolpath(sin)
     records = list(tp)
     assert [r.kind for r in records if r.kind in ("linear", "rapid")] == ["rapid"]
     assert any("65001" in d.message for d in tp.diagnostics)
     assert not api.equiv(iso, sin).equivalent
+
+
+def test_a_left_out_argument_the_macro_tests_itself_runs_as_in_iso(tmp_path):
+    # the first call leaves Z out: the macro's own `IF[#26EQ#0]GOTO10` skips `G1 Z#26` in ISO, and
+    # the PROC's `IF NOT $P_SUBPAR[18] GOTO N10` does the same: no alarm on entry (was a false stop)
+    caller = CALLER.replace(" Z-2.", "")
+    iso, sin = _pair(tmp_path, caller)
+    tp = api.toolpath(sin)
+    ends = [(r.kind, r.end) for r in tp if r.kind in ("linear", "rapid")]
+    assert not any("65001" in d.message for d in tp.diagnostics)
+    # hand-computed: call 1 feeds to X10 Y5 at Z5, no Z move, rapid X = 2*3; call 2 as before
+    assert ends == [("rapid", {"X": 0.0, "Y": 0.0, "Z": 5.0}),
+                    ("linear", {"X": 10.0, "Y": 5.0, "Z": 5.0}),
+                    ("rapid", {"X": 6.0, "Y": 5.0, "Z": 5.0}),
+                    ("linear", {"X": 20.0, "Y": 7.0, "Z": 5.0}), ("linear", {"X": 20.0, "Y": 7.0, "Z": -1.0}),
+                    ("rapid", {"X": 2.0, "Y": 7.0, "Z": -1.0})]
+    assert api.equiv(iso, sin).equivalent
 
 
 def test_macro_file_that_cannot_be_a_proc_says_so():

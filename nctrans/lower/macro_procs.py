@@ -73,7 +73,7 @@ def plan(program: ir.Program) -> dict[str, MacroProc]:
         used, written, bare, _ = found
         passed = [{v.key for v in c.bindings.values() if isinstance(v.key, int)} for c in mine]
         arguments = {k for k in used - written if k in by_local}
-        if any((arguments & bare) - p for p in passed):
+        if any(_unguarded(sub.body, arguments & bare) - p for p in passed):
             continue                         # a call leaves out an argument the body uses bare
         params = sorted(k for k in arguments.union(*passed) if k in by_local)
         use = local_use(sub.body)
@@ -116,7 +116,14 @@ def standalone(program: ir.Program) -> tuple[Standalone | None, str]:
     arguments = {k for k in used - written if k in by_local}
     proc = MacroProc([(k, by_local[k]) for k in order], sorted(k for k in used if k not in by_local),
                      arguments)
-    return Standalone(proc, arguments & bare), ""
+    return Standalone(proc, _unguarded(body, arguments & bare)), ""
+
+
+def _unguarded(body: list, bare: set[int]) -> set[int]:
+    """Of the arguments used bare, those the macro does not test for vacancy itself before every
+    such use (nctrans.lower.vacancy_flow): only these must be passed."""
+    from nctrans.lower.vacancy_flow import unguarded_bare
+    return unguarded_bare(body, bare, lambda x, statement: bare_in(x, statement) & bare)
 
 
 def _calls(body: list):
@@ -190,6 +197,68 @@ def _expr_locals(e) -> set[int]:
     return out
 
 
+def _local(e) -> int | None:
+    if type(e) is ir.Var and e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
+        return e.key
+    return None
+
+
+def _compared_bare(e) -> set[int]:
+    """The locals a comparison of two variables uses bare (vacant differs from 0 under == / !=,
+    and a comparison with #0 is a vacancy test, not a use)."""
+    if type(e) is not ir.Binary or e.op not in ("==", "!="):
+        return set()
+    sides = (e.left, e.right)
+    if any(type(x) is ir.Var and x.space == "num" and x.key != 0 for x in sides) and \
+            not any(type(x) is ir.Var and x.key == 0 for x in sides) and \
+            all(type(x) is ir.Var for x in sides):
+        return {k for k in map(_local, sides) if k is not None}
+    return set()
+
+
+def _whole(e) -> set[int]:
+    """A value used as it is: vacancy shows (a word dropped, a vacancy copied)."""
+    if type(e) is ir.AxisValue:
+        e = e.value
+    k = _local(e)
+    return set() if k is None else {k}
+
+
+def _expressions(e):
+    """Every expression node in e, not into nested bodies."""
+    yield e
+    if type(e) is ir.Var:
+        for i in e.indices or ():
+            yield from _expressions(i)
+    elif isinstance(e, (list, tuple)):
+        for x in e:
+            yield from _expressions(x)
+    elif isinstance(e, dict):
+        for x in e.values():
+            yield from _expressions(x)
+    elif hasattr(e, "__slots__") and not isinstance(e, (ir.Num, ir.Str, ir.Span)):
+        for f in e.__slots__:
+            if f not in walk.BODIES:
+                yield from _expressions(getattr(e, f, None))
+
+
+def bare_in(x, statement: bool = True) -> set[int]:
+    """The locals a statement (or, statement=False, a structure's condition) uses bare: as a
+    whole value (a word's value, an assigned value) or compared with another variable."""
+    out: set[int] = set()
+    for e in _expressions(x):
+        out |= _compared_bare(e)
+    if not statement:
+        return out
+    if type(x) is ir.Assign:
+        return out | _whole(x.value)
+    for f in x.__slots__:
+        v = getattr(x, f, None)
+        for y in (v.values() if isinstance(v, dict) else v if isinstance(v, list) else (v,)):
+            out |= _whole(y)
+    return out
+
+
 def _locals_used(body: list) -> tuple[set[int], set[int], set[int], set[int]] | None:
     """(the locals #1-#33 a body names, those it assigns, those it uses bare: as a whole value, or
     compared with another variable, those it compares with == / !=); None when it reaches
@@ -199,64 +268,21 @@ def _locals_used(body: list) -> tuple[set[int], set[int], set[int], set[int]] | 
     bare: set[int] = set()
     compares: set[int] = set()
     indirect = False
-
-    def local(e) -> int | None:
-        if type(e) is ir.Var and e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
-            return e.key
-        return None
-
-    def whole(e) -> None:
-        """A value used as it is: vacancy shows (a word dropped, a vacancy copied)."""
-        if type(e) is ir.AxisValue:
-            e = e.value
-        k = local(e)
-        if k is not None:
-            bare.add(k)
-
-    def compared(e) -> None:
-        if type(e) is ir.Binary and e.op in ("==", "!="):
-            sides = (e.left, e.right)
-            compares.update(k for k in map(local, sides) if k is not None)
-            if any(type(x) is ir.Var and x.space == "num" and x.key != 0 for x in sides) and \
-                    not any(type(x) is ir.Var and x.key == 0 for x in sides):
-                if all(type(x) is ir.Var for x in sides):
-                    bare.update(k for k in map(local, sides) if k is not None)
-
-    def visit(e) -> None:
-        nonlocal indirect
-        compared(e)
-        if type(e) is ir.Var:
-            if e.space == "num":
+    for node in walk.walk(body):
+        parts = node.body if type(node) is ir.Block else [node]
+        for e in _expressions(parts):
+            if type(e) is ir.Var and e.space == "num":
                 if e.key is None:
                     indirect = True
-                elif isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
+                elif _local(e) is not None:
                     used.add(e.key)
-            for i in e.indices or ():
-                visit(i)
-        elif isinstance(e, (list, tuple)):
-            for x in e:
-                visit(x)
-        elif isinstance(e, dict):
-            for x in e.values():
-                visit(x)
-        elif hasattr(e, "__slots__") and not isinstance(e, (ir.Num, ir.Str, ir.Span)):
-            for f in e.__slots__:
-                if f not in walk.BODIES:          # walk() visits the nested bodies itself
-                    visit(getattr(e, f, None))
-
-    for node in walk.walk(body):
+            elif type(e) is ir.Binary and e.op in ("==", "!="):
+                compares.update(k for k in map(_local, (e.left, e.right)) if k is not None)
         if type(node) is ir.Block:
-            visit(node.body)
             written.update(s.target.key for s in node.body if type(s) is ir.Assign
                            and s.target.space == "num" and isinstance(s.target.key, int))
             for s in node.body:
-                if type(s) is not ir.Assign:
-                    for f in s.__slots__:
-                        v = getattr(s, f, None)
-                        for x in (v.values() if isinstance(v, dict) else v if isinstance(v, list) else (v,)):
-                            whole(x)
-                else:
-                    whole(s.value)
+                bare |= bare_in(s)
         else:
-            visit(node)
+            bare |= bare_in(node, statement=False)
     return None if indirect else (used, written, bare, compares)
