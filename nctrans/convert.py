@@ -72,6 +72,27 @@ def _library_refusal(program: Program, entry: str, target: str) -> Diagnostic:
                       f"(with --flatten) instead", sub.span.file, sub.span.line, sub.span.col)
 
 
+def _macro_file_note(program: Program) -> Optional[str]:
+    """Why an ISO macro file is not lowered to plain motion, whole or a construct of it (None for
+    any other program): with no G65 call passing its arguments, plain motion would run it with
+    every argument vacant (typically straight into its own argument alarm) from no known position,
+    which is not the macro (a subprogram's constructs are not lowered alone either)."""
+    from nctrans.lower.macro_procs import macro_file
+    if not macro_file(program):
+        return None
+    return ("it is a macro file (it reads G65 arguments #1-#33 it never sets and returns with M99): "
+            "it has no toolpath until a G65 call passes its arguments, so neither the file nor a part "
+            "of it is lowered to plain motion (that would run it with every argument vacant, from no "
+            "known position)")
+
+
+def _macro_refusal(program: Program, why: str) -> Diagnostic:
+    first = next((b for b in getattr(program.body, "items", program.body) if isinstance(b, Block)), None)
+    line = first.span.line if first is not None else 1
+    return Diagnostic("NC402", "error", f"{program.name or program.file} is not flattened: {why}; "
+                      "convert the programs that call it with --flatten instead", program.file, line, 1)
+
+
 def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list[Diagnostic]):
     """(emission, diagnostics) of the whole program lowered to plain motion, the last resort when
     a construct cannot be lowered on its own; (None, [the held-limit error]) when that is refused
@@ -180,6 +201,9 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
     library = _library_entry(program)
     if flatten and library is not None:
         return Conversion(None, [_library_refusal(program, library, target.name)])
+    macro = _macro_file_note(program) if library is None else None
+    if flatten and macro is not None:
+        return Conversion(None, [_macro_refusal(program, macro)])
     if flatten and flatten_with is not None:
         program = flatten_with(diags)
         flattened = True
@@ -189,6 +213,11 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
     if refusals and library is not None:
         diags.extend(result.diagnostics)
         diags.append(_library_refusal(program, library, target.name))
+    elif refusals and macro is not None and not flattened:
+        # a macro file is a subprogram: no construct of it is lowered alone, nor the whole file
+        diags.extend(dataclasses.replace(d, message=f"{d.message}; {macro}; port that construct by hand, "
+                                         "or convert the programs that call it with --flatten")
+                     if _is_refusal(d) else d for d in result.diagnostics)
     elif refusals and not flattened and flatten_with is not None and not strict_mode:
         from nctrans.lower.constructs import lower_constructs
         lowered, notes, remaining = lower_constructs(program, refusals, target.name, machine=machine,
@@ -309,6 +338,9 @@ def convert_flat_stream(program: Program, target: Dialect, blocks: Callable[[lis
     library = _library_entry(program)
     if library is not None:
         return Conversion(None, [_library_refusal(program, library, target.name)])
+    macro = _macro_file_note(program)
+    if macro is not None:
+        return Conversion(None, [_macro_refusal(program, macro)])
     if not all(getattr(p, "structural_only", False) for p in target.lowering_passes):
         return None
     from nctrans.dialects.base import CannotStream

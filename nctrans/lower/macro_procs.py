@@ -286,3 +286,63 @@ def _locals_used(body: list) -> tuple[set[int], set[int], set[int], set[int]] | 
         else:
             bare |= bare_in(node, statement=False)
     return None if indirect else (used, written, bare, compares)
+
+
+def ends_with_restart(body: list) -> bool:
+    """Whether the last block with statements ends the program with M99 (ISO: return or restart)."""
+    last = next((b for b in reversed(body) if isinstance(b, ir.Block) and b.body), None)
+    return last is not None and any(isinstance(s, ir.ProgramEnd) and s.kind == "restart" for s in last.body)
+
+
+def reads_arguments(body: list) -> bool:
+    """Whether a program reads ISO locals #1-#33 it never sets: the G65 arguments of a macro."""
+    read: set = set()
+    written: set = set()
+
+    def expr(e) -> None:
+        if isinstance(e, ir.Var):
+            if e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
+                read.add(e.key)
+            for i in e.indices or ():
+                expr(i)
+        elif isinstance(e, (list, tuple)):
+            for x in e:
+                expr(x)
+        elif isinstance(e, dict):
+            for x in e.values():
+                expr(x)
+        elif hasattr(e, "__slots__") and not isinstance(e, (ir.Num, ir.Str, ir.Span)):
+            for f in e.__slots__:
+                expr(getattr(e, f, None))
+
+    for node in walk.walk(body):
+        if isinstance(node, ir.Block):
+            for s in node.body:
+                if isinstance(s, ir.Assign):
+                    if s.target.space == "num" and isinstance(s.target.key, int):
+                        written.add(s.target.key)
+                    expr(s.value)
+                    expr(s.target.indices)
+                else:
+                    expr(s)
+        else:
+            for attr in ("cond", "subject", "start", "end", "step"):
+                expr(getattr(node, attr, None))
+    return bool(read - written)
+
+
+def macro_file(program: ir.Program) -> bool:
+    """Whether a program is an ISO macro file: its dialect gives G65 arguments letters, and it reads
+    locals #1-#33 it never sets and ends with M99. Such a file has no toolpath of its own: what it
+    does depends on the arguments a G65 call passes."""
+    from nctrans.dialects.base import CompactBody
+    from nctrans.plainrun import PlainRun
+    letters = ((program.meta or {}).get("options") or {}).get("macro_arguments")
+    body = program.body
+    if type(body) is CompactBody:           # its runs of plain lines hold no variable and no M99
+        last = next((x for x in reversed(body.items) if type(x) is PlainRun
+                     or (isinstance(x, ir.Block) and x.body)), None)
+        if type(last) is PlainRun:
+            return False
+        body = [x for x in body.items if type(x) is not PlainRun]
+    return bool(letters) and type(body) is list and ends_with_restart(body) and reads_arguments(body)

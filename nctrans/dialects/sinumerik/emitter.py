@@ -44,6 +44,8 @@ from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import computed_g, macro_procs, modal_numbers, restart_loop
+from nctrans.lower.macro_procs import ends_with_restart as _ends_with_restart
+from nctrans.lower.macro_procs import reads_arguments as _reads_arguments
 from nctrans.plainrun import PlainRun, run_blocks
 from nctrans.dialects.sinumerik.edge_selection import EdgeSelection, NoEdge, jump_regions
 from nctrans.rules import load_table, system_meaning, system_spelling
@@ -1450,49 +1452,6 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                     self.edges.iso.comp = next(iter(comp))
             self.unit(sub.body)
             self.local_names, self.vacancy = {}, {}
-
-
-def _ends_with_restart(body: list) -> bool:
-    """Whether the last block with statements ends the program with M99 (ISO: return or restart)."""
-    last = next((b for b in reversed(body) if isinstance(b, ir.Block) and b.body), None)
-    return last is not None and any(isinstance(s, ir.ProgramEnd) and s.kind == "restart" for s in last.body)
-
-
-def _reads_arguments(body: list) -> bool:
-    """Whether a program reads ISO locals #1-#33 it never sets: the G65 arguments of a macro."""
-    read: set = set()
-    written: set = set()
-
-    def expr(e) -> None:
-        if isinstance(e, ir.Var):
-            if e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= 33:
-                read.add(e.key)
-            for i in e.indices or ():
-                expr(i)
-        elif isinstance(e, (list, tuple)):
-            for x in e:
-                expr(x)
-        elif isinstance(e, dict):
-            for x in e.values():
-                expr(x)
-        elif hasattr(e, "__slots__") and not isinstance(e, (ir.Num, ir.Str, ir.Span)):
-            for f in e.__slots__:
-                expr(getattr(e, f, None))
-
-    for node in walk.walk(body):
-        if isinstance(node, ir.Block):
-            for s in node.body:
-                if isinstance(s, ir.Assign):
-                    if s.target.space == "num" and isinstance(s.target.key, int):
-                        written.add(s.target.key)
-                    expr(s.value)
-                    expr(s.target.indices)
-                else:
-                    expr(s)
-        else:
-            for attr in ("cond", "subject", "start", "end", "step"):
-                expr(getattr(node, attr, None))
-    return bool(read - written)
 
 
 def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
