@@ -106,17 +106,18 @@ def arc_points(r: ToolpathRecord, axes: tuple[str, ...], tol: float) -> list[tup
     i1, i2 = axes.index(a1), axes.index(a2)
     c1, c2 = c.get(a1, 0.0), c.get(a2, 0.0)
     pts = []
-    for k in range(1, n + 1):
+    along = [(sv, ev - sv) for sv, ev in zip(start, end)]
+    dr = r1 - r0
+    cos, sin = math.cos, math.sin
+    for k in range(1, n):
         f = k / n
-        if k == n:
-            pts.append(end)
-            break
         ang = t0 + sweep * f
-        rad = r0 + (r1 - r0) * f
-        p = [sv + (ev - sv) * f for sv, ev in zip(start, end)]
-        p[i1] = c1 + rad * math.cos(ang)
-        p[i2] = c2 + rad * math.sin(ang)
+        rad = r0 + dr * f
+        p = [sv + dv * f for sv, dv in along]
+        p[i1] = c1 + rad * cos(ang)
+        p[i2] = c2 + rad * sin(ang)
         pts.append(tuple(p))
+    pts.append(end)
     return pts
 
 
@@ -236,6 +237,20 @@ class _Stream:
             return self.ahead.popleft()
         return next(self.tokens, None)
 
+    def take_point(self) -> Optional[tuple]:
+        """The next token when it is a run's point ("P"), taken; else None, nothing taken
+        (peek + take in one: equiv pulls every point of every run through here)."""
+        ahead = self.ahead
+        if ahead:
+            if ahead[0][0] != "P":
+                return None
+            return ahead.popleft()
+        t = next(self.tokens, None)
+        if t is not None and t[0] != "P":
+            ahead.append(t)
+            return None
+        return t
+
     def what_next(self) -> str:
         """What follows the current position, in words (for messages): the class of the next
         run, else the first event, else the end."""
@@ -272,11 +287,10 @@ class _Run:
     def _pull(self, keep: bool = True) -> bool:
         if self.ended:
             return False
-        t = self.stream.peek()
-        if t is None or t[0] != "P":
+        t = self.stream.take_point()
+        if t is None:
             self.ended = True
             return False
-        self.stream.take()
         item = (t[1], t[2])
         if keep:
             self.buf.append(item)
@@ -286,7 +300,7 @@ class _Run:
 
     def has(self, k: int) -> bool:
         """Whether point k is held (pulling up to it); False past the run's end."""
-        while k >= self.base + len(self.buf):
+        while k >= self.count:                 # count == base + len(buf) while the walks read
             if not self._pull():
                 return False
         return True
@@ -335,6 +349,21 @@ def _dist_point_segment(p, a, b) -> float:
     return math.dist(p, [x + t * u for x, u in zip(a, ab)])
 
 
+# Rounding allowance of the triangle-inequality bound in _segment_within (relative to the lengths).
+_BOUND_SLACK = 1e-9
+
+
+def _segment_within(p, q0, q1, d0: float, d1: float, tol: float) -> bool:
+    """Whether p lies within tol of segment q0-q1, given its distances d0, d1 to the ends. Any
+    point x of the segment has |p-x| >= (d0 + d1 - |q0-q1|) / 2 (triangle inequality), so where
+    that bound clears tol (with room for rounding) the exact projection is not needed: the answer
+    is the same, found without it (most tests of two close polylines end here)."""
+    length = math.dist(q0, q1)
+    if d0 + d1 - length > 2 * tol + _BOUND_SLACK * (d0 + d1 + length):
+        return False
+    return _dist_point_segment(p, q0, q1) <= tol
+
+
 class _Walk:
     """P's points walked along Q's polyline, Q's segments visited in order: `failed` is the index
     of the first point of P farther than tol from Q (None while none is), `j` the segment of Q
@@ -350,23 +379,36 @@ class _Walk:
 
     def step(self, tol: float) -> None:
         P, Q = self.P, self.Q
-        if not P.has(self.i):
+        i = self.i
+        if i >= P.count and not P.has(i):
             self.finished = True
             return
-        p = P.point(self.i)
-        if not Q.has(1):                        # Q is one point
+        n = len(P.axes.names)
+        p = P.buf[i - P.base][0]                # P.point(i), Q.point(j), read inline: once per step
+        if len(p) != n:
+            p = P.point(i)
+        if Q.count < 2 and not Q.has(1):        # Q is one point
             if math.dist(p, Q.point(0)) > tol:
-                self.failed, self.finished = self.i, True
+                self.failed, self.finished = i, True
             else:
-                self.i += 1
+                self.i = i + 1
             return
         j = self.j
-        q0, q1 = Q.point(j), Q.point(j + 1)
+        k = j - Q.base
+        q0, q1 = Q.buf[k][0], Q.buf[k + 1][0]
+        if len(q0) != n or len(q1) != n:
+            q0, q1 = Q.point(j), Q.point(j + 1)
         # an end point within tol puts the segment within tol (the common case: cheap to test)
-        if math.dist(p, q1) <= tol or math.dist(p, q0) <= tol or _dist_point_segment(p, q0, q1) <= tol:
-            self.i += 1
+        d1 = math.dist(p, q1)
+        if d1 <= tol:
+            self.i = i + 1
             self.stuck = 0
-        elif not Q.has(j + 2):                  # j is Q's last segment
+            return
+        d0 = math.dist(p, q0)
+        if d0 <= tol or _segment_within(p, q0, q1, d0, d1, tol):
+            self.i = i + 1
+            self.stuck = 0
+        elif j + 2 >= Q.count and not Q.has(j + 2):     # j is Q's last segment
             self.failed, self.finished = self.i, True
         else:
             self.j = j + 1
@@ -406,9 +448,9 @@ def _compare_runs(A: _Run, B: _Run, sa: _Stream, sb: _Stream, tol: float) -> Opt
             ab.step(tol)
         if not ba.finished:
             ba.step(tol)
-        A.trim(min(ab.i, ba.j))
-        B.trim(min(ba.i, ab.j))
-        if A.window > LOOKAHEAD or B.window > LOOKAHEAD:
+        A.trim(ab.i if ab.i < ba.j else ba.j)
+        B.trim(ba.i if ba.i < ab.j else ab.j)
+        if A.count - A.low > LOOKAHEAD or B.count - B.low > LOOKAHEAD:     # the windows
             return _out_of_step(A, B, ab, ba, tol)
     fa, fb = ab.failed, ba.failed
     if fa is None:                          # all of A lies along B: does B stop where A does?
