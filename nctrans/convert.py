@@ -232,7 +232,8 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
         streamed = stream_whole([_whole_note(d, target) for d in remaining]) \
             if remaining and not too_large and stream_whole is not None else None
         if streamed is not None and streamed.text is not None:
-            return streamed
+            # the lowering passes' notes (FOR as WHILE) first, as the held whole lowering keeps them
+            return dataclasses.replace(streamed, diagnostics=[*diags, *streamed.diagnostics])
         if streamed is not None:
             remaining = whole_failure(remaining, streamed.diagnostics)
         whole = _lower_whole(program, target, flatten_with, remaining) \
