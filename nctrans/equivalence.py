@@ -179,6 +179,14 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
                     state["feed"] = feed
                     run = None
                     yield ("E", "feed", feed, r)
+                if r.pitch:
+                    # a thread's start angle (its start of several): the same path cut at another
+                    # spindle phase is another thread; no key reads 0, as a single start has
+                    start = (r.thread_start or 0.0) % 360.0
+                    if not _close(state.get("thread_start", 0.0), start):
+                        state["thread_start"] = start
+                        run = None
+                        yield ("E", "thread_start", start, r)
             if run != cls:
                 run = cls
                 yield ("R", cls, axes.point(r.start), r)

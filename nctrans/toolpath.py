@@ -57,6 +57,10 @@ class ToolpathRecord:
     # spindle events positioning the spindle (M19, Sinumerik SPOS/SPOSA): the angle in degrees, 0..360;
     # absent for M19, which positions at the control's setting (SD 43240 M19_SPOS, 0 by default)
     spindle_angle: Optional[float] = None
+    # thread moves (pitch set) of a thread whose start is shifted: the spindle angle in degrees,
+    # 0..360, at which the cut begins (Sinumerik SF=, ISO G33 Q, each start of a multi-start
+    # CYCLE97/CYCLE98); absent when the start angle is 0 (the single-start thread)
+    thread_start: Optional[float] = None
 
     def to_dict(self) -> dict:
         out = {}

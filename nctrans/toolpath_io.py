@@ -174,6 +174,8 @@ def to_json_line(r: ToolpathRecord) -> str:
         s += ',"args":[' + ",".join("null" if a is None else _spell(a) for a in r.args) + "]"
     if r.spindle_angle is not None:
         s += ',"spindle_angle":' + _spell(r.spindle_angle)
+    if r.thread_start is not None:
+        s += ',"thread_start":' + _spell(r.thread_start)
     s += "}"
     if "nan" in s or "inf" in s:      # a non-finite number (or a file name containing the letters)
         return _safe_json_line(r)

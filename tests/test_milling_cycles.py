@@ -588,7 +588,7 @@ def test_cycle97_metric_size_taper_and_refusals():
     moves, _ = _lathe("CYCLE97(, 10, 0, -20, 20, 18, 0, 0, 0.9, 0, 0, 0, 1, 0, 1, 1)")
     thread = next(m for m in moves if m[0] == "linear")
     assert thread == ("linear", pytest.approx(9 - 0.9), pytest.approx(-20), 1.5)
-    for call, rule in (("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0.2, 0, 0, 2, 1, 1, 2)", "NC224"),
+    for call, rule in (("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0.2, 0, 0, 2, 1, 1, 2.5)", "NC225"),
                        ("CYCLE97(2, , 0, 0, 20, 20, 4, 2, 1.2)", "NC225"),
                        ("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 0)", "NC225"),
                        ("CYCLE97(2, , 0, -20, 20, 20, 4, 2, 1.2, 0, 0, 0, 2, 0, 7)", "NC225")):

@@ -50,6 +50,8 @@ from dataclasses import dataclass
 from typing import Callable, Optional
 
 from nctrans.interp.cycles import DRILL_AXIS, PLANE_AXES, cycle_table, milling_cycle
+from nctrans.interp.thread_starts import start_angles
+from nctrans.interp.thread_starts import stamp as stamp_thread_start
 
 # A planned step, in plane coordinates (abscissa, ordinate, height along the tool axis):
 # ("rapid" | "linear", (p1, p2, h)) | ("arc", (p1, p2, h), (c1, c2), cw) | ("feed", f)
@@ -819,14 +821,24 @@ def run_steps(interp, steps, a1: str, a2: str, ax: str) -> None:
 
 def _thread_variant(p: dict[str, float], starts: str) -> int:
     """VARI of CYCLE97/CYCLE98 (1/3 external, 2/4 internal), after the checks both share: finite
-    values, a known VARI, a single thread start (`starts`: the cycle's name for the count)."""
+    values, a known VARI, a whole number of thread starts (`starts`: the cycle's name for the
+    count; the starts are cut in turn by _run_thread_turn)."""
     _finite(p)
     vari = int(p.get("VARI", 1))
     if vari not in (1, 2, 3, 4):
         raise _impossible(f"with VARI {vari} (1/3 external, 2/4 internal thread)")
-    if int(p.get(starts, 1) or 1) > 1:
-        raise _unmodelled(f"with several thread starts {starts}: not modelled")
+    thread_starts(p, starts)
     return vari
+
+
+def thread_starts(p: dict[str, float], starts: str) -> list[float]:
+    """The start angles of CYCLE97 (NUMT) / CYCLE98 (NUMTH) threads: `starts` (0: one) spread
+    evenly over the turn from NSP, 360 / starts apart [GK, Siemens cycles manual: "the thread
+    turns are distributed evenly over the circumference, the first at NSP"]."""
+    count = p.get(starts, 1) or 1
+    if count != int(count) or not 1 <= count <= MAX_PASSES:
+        raise _impossible(f"with {starts} {count:g} (a whole number of thread starts, 1 to {MAX_PASSES})")
+    return start_angles(p.get("NSP", 0.0), int(count))
 
 
 def _thread_pass_depths(vari: int, nrc: int, tdep: float, fal: float, nid: int) -> list[float]:
@@ -984,23 +996,38 @@ def _run_thread_turn(interp, cyc, s, plan: Callable = thread_turn_steps) -> None
     try:
         if not st.spindle_speed:
             raise _impossible("with no spindle speed (the thread feed is the lead x S)")
-        steps = plan(call_values(interp, cyc, s), (interp.pos.get("X", 0.0), interp.pos.get("Z", 0.0)))
+        p = call_values(interp, cyc, s)
+        steps = plan(p, (interp.pos.get("X", 0.0), interp.pos.get("Z", 0.0)))
+        angles = thread_starts(p, "NUMTH" if plan is thread_chain_steps else "NUMT")
+        if len(steps) * len(angles) > MAX_MOVES:
+            raise _impossible(f"with more than {MAX_MOVES} moves")
     except MillingError as err:
         interp.diag(err.rule, err.severity, f"{cyc.name} {err.message}; the call is skipped and "
                     "moves nothing in the analysed toolpath")
         return
-    saved, saved_mode = st.feed, st.feed_mode
+    # several starts: each cut completely in turn, the first at NSP [GK: Siemens cycles manual,
+    # and CYCLE99's default "one thread after the other"]; [NC] each start is approached as the
+    # first one is, from where the one before left the tool, and the start angle in force before
+    # the call (SF=) holds again after it
+    saved, saved_mode, saved_start = st.feed, st.feed_mode, interp.thread_start
     try:
-        for step in steps:
-            end = dict(interp.pos)
-            end["X"], end["Z"] = step[1]
-            if step[0] == "rapid":
-                interp._move("rapid", end)
-                continue
-            st.feed, st.feed_mode = step[2] * st.spindle_speed, "per_min"
-            mark = len(interp.out)
-            interp._move("linear", end)
-            for rec in interp.out[mark:]:
-                rec.pitch = step[2]
+        for k, angle in enumerate(angles):
+            if k:
+                steps = plan(p, (interp.pos.get("X", 0.0), interp.pos.get("Z", 0.0)))
+            interp.thread_start = angle
+            for step in steps:
+                end = dict(interp.pos)
+                end["X"], end["Z"] = step[1]
+                if step[0] == "rapid":
+                    if k and max(abs(end[a] - interp.pos.get(a, 0.0)) for a in "XZ") <= _EPS:
+                        continue            # the next start begins where the last one ended
+                    interp._move("rapid", end)
+                    continue
+                st.feed, st.feed_mode = step[2] * st.spindle_speed, "per_min"
+                mark = len(interp.out)
+                interp._move("linear", end)
+                for rec in interp.out[mark:]:
+                    rec.pitch = step[2]
+                stamp_thread_start(interp, mark)
     finally:
-        st.feed, st.feed_mode = saved, saved_mode
+        st.feed, st.feed_mode, interp.thread_start = saved, saved_mode, saved_start

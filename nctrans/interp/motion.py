@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Optional
 
-from nctrans.interp import arcs, corner_elements, rigid_tap
+from nctrans.interp import arcs, corner_elements, rigid_tap, thread_starts
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
@@ -46,6 +46,8 @@ class MotionMixin:
         }
 
     def _c_motion(self, s: n.Motion):
+        if s.thread_start is not None:          # SF= / G33 Q: a setting, then the move
+            return (self._h_thread_start, thread_starts.compile_motion(self, s))
         if (s.center is None and s.radius is None and s.turns is None and not s.polar
                 and not s.machine_coords and s.via is None and s.aperture is None
                 and not s.indirect):
@@ -77,6 +79,9 @@ class MotionMixin:
         ap = getattr(s, "aperture", None)
         aperture = None if ap is None else self.ev.compile(ap)
         return (words, center, radius, turns, s.machine_coords, polar, via, aperture)
+
+    def _h_thread_start(self, d):
+        thread_starts.run_motion(self, d)
 
     def _slow(self, d):
         full = d[2]
@@ -255,7 +260,9 @@ class MotionMixin:
         if not st.spindle_speed:
             self.diag("NC209", "warning", "thread move (G33) with no spindle speed: the feed "
                       "(lead x S) is unknown")
+        mark = len(self.out)
         self._lead_move(target, lead)
+        thread_starts.stamp(self, mark)
 
     def _lead_move(self, target, lead: float) -> None:
         """A feed move synchronised with the spindle (G33, G331/G332): `lead` mm per revolution,

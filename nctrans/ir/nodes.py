@@ -163,6 +163,8 @@ class Motion:
     indirect: axis words whose axis is computed when the block runs (Sinumerik AX[expr]=value):
     [(axis expression, AxisValue)].
     aperture: opening angle of an arc in degrees (Sinumerik AR=), with centre or end point.
+    thread_start: start angle of a thread in degrees (Sinumerik SF=, ISO G33 Q in 0.001 deg): it
+    sets the control's setting (SD 42000 THREAD_START_ANGLE), in force for later threads too.
     """
     target: dict[str, AxisValue] = field(default_factory=dict)
     center: Optional[dict[str, AxisValue]] = None
@@ -173,6 +175,7 @@ class Motion:
     polar: Optional[dict[str, Expr]] = None
     aperture: Optional[Expr] = None
     indirect: Optional[list] = None
+    thread_start: Optional[Expr] = None
 
 
 @node

@@ -407,6 +407,10 @@ class _Flattener:
             along = max(("X", "Y", "Z"), key=lambda a: abs(target_vals.get(a, prog_now.get(a, 0.0))
                                                            - prog_now.get(a, 0.0)))
             motion_stmt.center = {CENTRE_WORD[along]: n.AxisValue(_num(rec.pitch))}
+            start = rec.thread_start or 0.0          # a setting: written where it changes
+            if start != getattr(self, "thread_start", 0.0):
+                motion_stmt.thread_start = _num(start)
+                self.thread_start = start
         if rec.kind == "arc":
             c = rec.center or {}
             motion_stmt.center = {CENTRE_WORD[a]: n.AxisValue(_num(c.get(a, 0.0) - self.mpos.get(a, 0.0)))

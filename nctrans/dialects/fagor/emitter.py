@@ -665,6 +665,10 @@ class FagorEmitter(FagorSpelling, Emitter):
         val = self.value
         if s.aperture is not None:
             raise NotExpressible("an arc by opening angle")
+        if s.thread_start is not None and _num(s.thread_start) != 0:
+            # Fagor's Q1= holds for its G33 block only, the source's angle is a setting that
+            # holds for later threads too (interp/thread_starts.py): not written
+            raise NotExpressible("a thread start angle (SF=, G33 Q)")
         if s.turns is not None and _num(s.turns) != 0:
             raise NotExpressible("an arc with extra full turns")
         if s.machine_coords:

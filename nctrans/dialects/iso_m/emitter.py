@@ -204,6 +204,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.lead_as_k = self.dialect == "iso-m" and bool((program.meta or {}).get("flattened_from"))
         self.last_feed: Optional[str] = None
         self.feed_clobbered = False
+        # the thread start angle (Sinumerik SF=, ISO Q): a start angle written outside a thread
+        # block waits for the next one; a constant one is written again on each later thread
+        # block (a Fanuc's G32 Q holds for its block only), see _thread_start
+        self.start_pending: Optional[n.Expr] = None
+        self.start_repeat: Optional[float] = None
         # named cycles written as ISO canned cycles (nctrans.dialects.iso_m.cycles): the modal one
         # (MCALL) and whether its G8x mode is on; motion mode, units and feed as programmed
         self.named_cycle: Optional[IsoCycle] = None
@@ -1037,6 +1042,10 @@ class IsoEmitter(IsoSpelling, Emitter):
             return self._cip(s)
         if self.cip_mode and s.target:
             raise NotExpressible("a three-point arc (CIP) without an intermediate point")
+        if s.thread_start is not None:
+            self.start_pending = s.thread_start
+            if not (s.target or s.center or s.machine_coords):
+                return []                   # SF= alone: written with the next thread block
         start = dict(self.pos)
         self.track(s)
         if s.polar:
@@ -1045,7 +1054,9 @@ class IsoEmitter(IsoSpelling, Emitter):
             raise NotExpressible("axis words with a computed axis (AX[..]=)")
         words = []
         if self.thread_mode and s.center:
-            return self._thread(s, words)
+            return self._thread(s, words) + self._thread_start()
+        if self.thread_mode and s.target:
+            words += self._thread_start()
         if self.feed_clobbered and self.last_feed is not None and s.target:
             words.append(("F", self.last_feed))
             self.feed_clobbered = False
@@ -1107,6 +1118,28 @@ class IsoEmitter(IsoSpelling, Emitter):
         words.append(("F", self.addr("F", av.value)))
         self.feed_clobbered = True
         return words
+
+    def _thread_start(self) -> list:
+        """The Q word of a thread block (ISO seed 4.1.16: an integer in 0.001 degree): the start
+        angle programmed since the last thread block, else a constant one written before (a
+        Fanuc's Q holds for its block only, the Sinumerik ISO mode keeps it as setting data:
+        written again, both read it the same); a computed angle is written where it was
+        programmed only (written again it would be evaluated again). LinuxCNC's G33 has no start
+        angle: refused there."""
+        e, self.start_pending = self.start_pending, None
+        if e is None:
+            if not self.start_repeat:
+                return []
+            e = n.Num(self.start_repeat)
+        c = constant(e)
+        if self.lead_as_k and (c is None or c % 360.0):
+            raise NotExpressible("a thread start angle (LinuxCNC's G33 has none)")
+        if self.lead_as_k:
+            return []
+        self.start_repeat = c % 360.0 if c is not None else None
+        if c is not None:
+            return [("Q", "Q" + str(round((c % 360.0) * 1000)))]
+        return [("Q", "Q" + self.val(n.Func("round", [n.Binary("*", e, n.Num(1000.0))])))]
 
     def w_Feed(self, s):
         self.feed_expr = s.value

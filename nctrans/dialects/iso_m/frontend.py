@@ -768,8 +768,12 @@ class Lowering:
             # G33 X.. Z.. K<lead>: LinuxCNC's lead word (ISO's own is F, seed 4.5); the
             # interpreter takes an I/J/K lead before F (interp/motion.py _g33_move)
             center = {k: AxisValue(self.num(k, vals.pop(k))) for k in "IJK" if k in vals}
-        if target or center or radius is not None or b.machine:
-            out.append((B_MOTION, Motion(target, center, radius, turns, machine_coords=b.machine)))
+        start = None
+        if (b.motion_g or self.motion) == "thread" and self.cycle is None and "Q" in vals:
+            start = self._thread_start(vals.pop("Q"), line)
+        if target or center or radius is not None or b.machine or start is not None:
+            out.append((B_MOTION, Motion(target, center, radius, turns, machine_coords=b.machine,
+                                         thread_start=start)))
 
         for k, v in vals.items():       # words nothing above gave a meaning
             text = _word_text(k, v)
@@ -784,6 +788,18 @@ class Lowering:
         if len(out) > 1:
             out.sort(key=itemgetter(0))
         return number, [s for _, s in out], structure, None
+
+    def _thread_start(self, v: Any, line: int):
+        """G33 Q<angle>: the thread's start angle, an integer in 0.001 degree (ISO seed 4.1.16:
+        `Q180000` = 180 deg), as degrees; written with a decimal point it is the control's alarm."""
+        if type(v) is str:
+            if "." in v:
+                self.diags.append(Diagnostic(
+                    "NC121", "error", f"Q{v}: the thread start angle is an integer in 0.001 degree "
+                    "(Q180000 = 180 deg), never written with a decimal point; the control alarms",
+                    self.file, line, 1))
+            return Num(_signed_float(v) / 1000.0, None)
+        return Binary("/", _ex(v), Num(1000.0, None))
 
     def _target(self, v: Any) -> str:
         d = _digits(v)

@@ -658,6 +658,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             ws.append(f"TURN={self.expr(m.turns)}")
         for axis, v in m.indirect or ():
             ws.append(f"AX[{self.expr(axis)}]={self.expr(v.value)}")
+        if m.thread_start is not None:          # SD 42000 THREAD_START_ANGLE, as ISO's Q
+            ws.append(f"SF={self.expr(m.thread_start)}")
         if st.motion == "thread" and not m.center and self._lead_is_feed():
             ws.append(self._lead_from_feed(m, out))
         out.words.extend(ws)

@@ -354,6 +354,7 @@ class _Words:
     polar: dict = field(default_factory=dict)
     radius: Optional[ir.Expr] = None
     aperture: Optional[ir.Expr] = None
+    thread_start: Optional[ir.Expr] = None
     turns: Optional[ir.Expr] = None
     rpl: Optional[ir.Expr] = None
     feed: Optional[ir.Expr] = None
@@ -727,10 +728,10 @@ class Lowerer:
         for sp, v in w.speed:
             w.out.append(ir.SpindleSpeed(v, sp))
         if w.target or w.center or w.via or w.polar or w.radius is not None or w.aperture is not None \
-                or w.turns is not None or w.indirect:
+                or w.turns is not None or w.indirect or w.thread_start is not None:
             w.out.append(ir.Motion(dict(w.target), dict(w.center) or None, w.radius, w.turns,
                                    dict(w.via) or None, w.machine, dict(w.polar) or None, w.aperture,
-                                   list(w.indirect) or None))
+                                   list(w.indirect) or None, w.thread_start))
         elif w.rpl is not None:
             w.out.append(ir.Passthrough("RPL=" + _expr_text(w.rpl), "plane rotation outside ROT", DIALECT))
         if w.repeat is not None:
