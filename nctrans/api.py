@@ -231,13 +231,15 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     program that runs straight through is converted as it is parsed, so memory stays flat however
     long it is. On refusal what was written must be discarded (reset() or OutputFile.discard())."""
     _check_dialect(write)
-    from nctrans.dialects.emit import conversion_machine
-    with _search_path(search_path), conversion_machine(lambda: _machine(machine, read)):
+    from nctrans.dialects.emit import conversion_machine, target_profile
+    written_for = _target_profile(write, profile)
+    with _search_path(search_path), conversion_machine(lambda: _machine(machine, read)), \
+            target_profile(write, written_for):
         # written as it goes (`out`): a program that holds structure is parsed compact (its plain
         # stretches held as spans of the text: --flatten runs them, the emitters write them a few
         # blocks at a time), so memory stays flat in program size
         ld = _load(text, read, file=file, stream=out is not None, compact=out is not None)
-        _set_profile(ld, profile)
+        _set_profile(ld, profile, write)
         with _api_errors():
             target = pipeline.get_dialect(write)
         if ld.streamed is not None:
@@ -251,7 +253,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                 return streamed
             out.reset()                  # convert the whole program: parse it whole
             ld = pipeline.load_source(ld.source, ld.path, ld.dialect)
-            _set_profile(ld, profile)
+            _set_profile(ld, profile, write)
         diags = ld.diagnostics
         out_text: Optional[str] = None
         if ld.program is not None and not any(d.severity == "error" for d in diags):
@@ -291,7 +293,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
                 result = convert(program, target, flatten=flatten, strict_mode=strict,
                                  flatten_with=flatten_with, machine=flat_machine,
                                  resolver=pipeline.make_resolver(ld.source_dir, ld.dialect),
-                                 stream_whole=stream_whole, whole=lambda: _parsed_whole(ld, profile))
+                                 stream_whole=stream_whole, whole=lambda: _parsed_whole(ld, profile, write))
             diags.extend(result.diagnostics)
             out_text = result.text
         elif strict:
@@ -306,24 +308,40 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     return Conversion(out_text, diags, ld.dialect or "", write)
 
 
-def _parsed_whole(ld: pipeline.Loaded, profile: Optional[str]) -> Program:
+def _parsed_whole(ld: pipeline.Loaded, profile: Optional[str], write: Optional[str] = None) -> Program:
     """The program of `ld` parsed whole (convert's fallback for a compact parse)."""
     whole = pipeline.load_source(ld.source, ld.path, ld.dialect)
-    _set_profile(whole, profile)
+    _set_profile(whole, profile, write)
     assert whole.program is not None        # it parsed before, compact
     return whole.program
 
 
-def _set_profile(ld: pipeline.Loaded, profile: Optional[str]) -> None:
-    """Select the source's control profile by name (NCError naming the known ones otherwise)."""
+def _profiles(dialect: Optional[str]) -> list[str]:
+    from nctrans.rules import load_table
+    return sorted((load_table(dialect).options.get("profiles") or {}) if dialect else ())
+
+
+def _target_profile(write: str, profile: Optional[str]) -> Optional[str]:
+    """The profile the target is written for: `profile` when the target's table names it (a
+    source-only profile leaves the target's default)."""
+    return profile if profile is not None and profile in _profiles(write) else None
+
+
+def _set_profile(ld: pipeline.Loaded, profile: Optional[str], write: Optional[str] = None) -> None:
+    """Select the source's control profile by name; a name only the target's table knows is
+    the target's (the control the output is written for, `_target_profile`). NCError naming the
+    known ones when neither knows it."""
     if profile is None or ld.program is None:
         return
-    from nctrans.rules import load_table
-    known = sorted((load_table(ld.dialect).options.get("profiles") or {}) if ld.dialect else ())
-    if profile not in known:
+    known = _profiles(ld.dialect)
+    if profile in known:
+        ld.program.meta["profile"] = profile
+        return
+    target = _profiles(write) if write else []
+    if profile not in target:
         raise NCError(f"profile {profile!r} is not one of {ld.dialect or 'the source'}'s: "
-                      f"{', '.join(known) or 'it has none'}")
-    ld.program.meta["profile"] = profile
+                      f"{', '.join(known) or 'it has none'}"
+                      + (f", nor of {write}'s: {', '.join(target) or 'it has none'}" if write else ""))
 
 
 def _transpile_flat_stream(ld: pipeline.Loaded, target: Any, strict: bool, out: Any,

@@ -562,7 +562,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--flatten", action="store_true", help="emit plain motion only (no macros, loops, calls, cycles)")
     p.add_argument("--machine", metavar="MACHINE.toml", help="machine for --flatten (offsets, tools)")
     p.add_argument("--profile", metavar="NAME", help="control of the source's family (profiles of its rules table); "
-                   "detected from the header comments when omitted")
+                   "detected from the header comments when omitted; a profile of the target's table names the "
+                   "control the output is written for (ISO milling: linuxcnc)")
     _add_search_path(p)
     p.set_defaults(func=cmd_convert)
 

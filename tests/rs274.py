@@ -169,6 +169,17 @@ def parse(text: str) -> Run:
                                   tol=st.tolerance(), out_line=seq, n_word=n_word,
                                   text=f"{name}({args})"))
             st.pos = end
+        elif name == "RIGID_TAP":
+            # G33.1: synchronised to the point and back to where it began (rs274 prints the point
+            # only, in XYZ; the position after it is the start)
+            v = _nums(args)
+            start = dict(st.pos)
+            end = st.to_machine(dict(zip(AXES, v[:3] + [0.0, 0.0, 0.0])))
+            for a in ROTARY_AXES:
+                end[a] = start.get(a, 0.0)
+            for a, b in ((start, end), (end, start)):
+                run.moves.append(Move("linear", dict(a), dict(b), feed=st.feed, tol=st.tolerance(),
+                                      out_line=seq, n_word=n_word, text=f"{name}({args})"))
         elif name == "ARC_FEED":
             v = _nums(args)
             first, second, axis, plane = PLANES[st.plane]
@@ -190,6 +201,14 @@ def parse(text: str) -> Run:
                         "STRAIGHT_PROBE", "RIGID_TAP", "NURBS_FEED", "SPLINE_FEED"):
                 run.events.append(Event(name, args, seq))
     return run
+
+
+def linuxcnc():
+    """A context in which ISO milling is written for LinuxCNC (as `convert --profile linuxcnc`):
+    flattened threads with the lead as K, taps as G33.1, what rs274 runs (rules iso-m
+    [options.profiles.linuxcnc]); api.transpile takes profile="linuxcnc" instead."""
+    from nctrans.dialects.emit import target_profile
+    return target_profile("iso-m", "linuxcnc")
 
 
 def write_tool_table(path: Path, tools: Iterable[tuple[int, float, float]]) -> Path:

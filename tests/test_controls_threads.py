@@ -49,8 +49,9 @@ TAP = "G17 G90 G0 X10 Y10 Z20 S500 M3\nCYCLE84(10, 0, 2, -10, , , 3, , 1.5)\nM30
 
 @pytest.mark.parametrize("target,dialect,down,up", [
     ("sinumerik", "sinumerik", "G33 Z-10 K1.5", "Z2 K1.5"),
-    # flattened ISO is plain motion for LinuxCNC's rs274 (CONTRACT), whose G33 lead word is K
-    ("iso-m", "iso-m", "G33 Z-10. K1.5", "Z2. K1.5"),
+    # flattened ISO for a Fanuc (the default): G33 with the lead as F (seed 4.5); CYCLE84's tap
+    # reverses without stopping, which no G84 does: it stays G33 moves
+    ("iso-m", "iso-m", "G33 Z-10. F1.5", "Z2. F1.5"),
 ])
 def test_flattened_tapping_stays_spindle_synchronised(target, dialect, down, up):
     # CYCLE84 (PIT 1.5, S500): G0 to RFP+SDIS = 2, tap to -10, spindle reversed, tap back to 2,
@@ -68,15 +69,42 @@ def test_flattened_tapping_stays_spindle_synchronised(target, dialect, down, up)
 
 
 def test_flattened_iso_g84_keeps_its_lead():
-    # G94 F750 S500: lead 750/500 = 1.5 (spec 5 "under G94 the lead is F/S")
+    # G94 F750 S500: lead 750/500 = 1.5 (spec 5 "under G94 the lead is F/S"). For a Fanuc (the
+    # default) the tap is its rigid tapping cycle again, from R = where the tap begins (Z2);
+    # for LinuxCNC G33 moves with the lead as K (G84 stops the spindle, G33.1 does not)
     text = "G21 G17 G90 G94 G0 X0 Y0 Z20 S500 M3\nG99 G84 X5 Y5 Z-8 R2 F750\nG80\nG1 X0 F200\nM30\n"
-    conv = api.transpile(text, "iso-m", "iso-m", flatten=True)
-    assert "G33 Z-8. K1.5" in conv.text.splitlines()
-    assert [d.line for d in conv.lowered if "the lead as K" in d.message] == [2]
-    assert any("F200." in ln for ln in conv.text.splitlines())
     src, _ = run(text, "iso-m")
+    fanuc = api.transpile(text, "iso-m", "iso-m", flatten=True)
+    lines = fanuc.text.splitlines()
+    i = lines.index("S500 M29")
+    assert lines[i + 1:i + 3] == ["F750. G99 G84 R2. X5. Y5. Z-8.", "G80"]
+    assert not any(ln.startswith("G33") for ln in lines)
+    assert [d.line for d in fanuc.lowered if "G84/G74" in d.message] == [2]
+    assert any("F200." in ln for ln in lines)
+    out, _ = run(fanuc.text, "iso-m")
+    assert feeds(out) == feeds(src)
+    assert api.equiv(text, fanuc.text, read_a="iso-m", read_b="iso-m")
+    linuxcnc = api.transpile(text, "iso-m", "iso-m", flatten=True, profile="linuxcnc")
+    assert "G33 Z-8. K1.5" in linuxcnc.text.splitlines() and "M29" not in linuxcnc.text
+    assert [d.line for d in linuxcnc.lowered if "as K for LinuxCNC" in d.message] == [2]
+    out, _ = run(linuxcnc.text, "iso-m")
+    assert feeds(out) == feeds(src)
+
+
+def test_flattened_cycle84_for_linuxcnc_is_one_g33_1():
+    # CYCLE84 taps in, reverses, taps out, turns forward: LinuxCNC's G33.1 does exactly that
+    conv = api.transpile(TAP, "sinumerik", "iso-m", flatten=True, profile="linuxcnc")
+    lines = conv.text.splitlines()
+    assert "G33.1 Z-10. K1.5" in lines and "M4" not in lines and not any("G33 " in ln for ln in lines)
+    assert api.equiv(TAP, conv.text, read_a="sinumerik", read_b="iso-m")
+    src, _ = run(TAP, "sinumerik")
     out, _ = run(conv.text, "iso-m")
     assert feeds(out) == feeds(src)
+
+
+def test_a_profile_neither_side_knows_is_a_usage_error():
+    with pytest.raises(Exception, match="nor of iso-m's: haas, linuxcnc"):
+        api.transpile(TAP, "sinumerik", "iso-m", flatten=True, profile="heidenhain")
 
 
 def test_converting_sinumerik_g33_to_iso_writes_the_lead_as_f_and_restores_the_feed():

@@ -176,8 +176,9 @@ class SinumerikCase:
     def flat(self):
         if not hasattr(self, "_flat"):
             diags: list = []
-            program = flatten(self.program, default_mill(), diagnostics=diags, resolver=self.resolver())
-            self._flat = (program, diags, get("iso-m").emit(program))
+            with h.linuxcnc():              # the emission runs in rs274
+                program = flatten(self.program, default_mill(), diagnostics=diags, resolver=self.resolver())
+                self._flat = (program, diags, get("iso-m").emit(program))
         return self._flat
 
 

@@ -330,7 +330,8 @@ class Case:
         self.source = parse(dialect, text, name)
         self.records, self.source_diags = toolpath(self.source, machine)
         self.diags: list = []
-        self.flat = flatten(self.source, machine, diagnostics=self.diags)
+        with h.linuxcnc():                  # the iso-m emission runs in rs274
+            self.flat = flatten(self.source, machine, diagnostics=self.diags)
         self.flat_records, self.flat_diags = toolpath(self.flat, machine)
 
 
@@ -414,7 +415,8 @@ def test_iso_sources_are_clean_and_report_their_lowerings(key):
 @pytest.mark.parametrize("key", _rs274_params())
 def test_flattened_iso_runs_in_rs274_with_the_same_moves(key, rs274, rs274_cache):
     c = case(key)
-    res = get("iso-m").emit(c.flat)
+    with h.linuxcnc():
+        res = get("iso-m").emit(c.flat)
     assert not [d for d in res.diagnostics if d.severity == "error"], res.diagnostics
     run = rs274_run(res.text, key, c.machine, rs274_cache)
     assert run.completed, f"rs274 stops: {run.message}"

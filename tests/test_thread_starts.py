@@ -155,3 +155,14 @@ def test_flattened_sinumerik_keeps_the_angle_and_fagor_refuses_it():
     fagor = api.transpile(SINUMERIK, "sinumerik", "fagor")
     assert fagor.text is None
     assert any(d.rule == "NC402" and "thread start angle" in d.message for d in fagor.diagnostics)
+
+
+def test_flattened_iso_writes_q_for_a_fanuc_and_refuses_it_for_linuxcnc():
+    fanuc = api.transpile(SINUMERIK, "sinumerik", "iso-m", flatten=True)
+    assert fanuc.text is not None
+    threads = [ln for ln in fanuc.text.splitlines() if "F2." in ln and ("G33" in ln or "Z-20." in ln)]
+    assert [ln.split()[-1] for ln in threads] == ["Q90000", "Q90000", "Q0"]
+    assert api.equiv(SINUMERIK, fanuc.text, read_a="sinumerik", read_b="iso-m")
+    linuxcnc = api.transpile(SINUMERIK, "sinumerik", "iso-m", flatten=True, profile="linuxcnc")
+    assert linuxcnc.text is None
+    assert any(d.rule == "NC402" and d.line == 4 and "LinuxCNC" in d.message for d in linuxcnc.diagnostics)

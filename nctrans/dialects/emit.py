@@ -46,6 +46,47 @@ def conversion_machine(get: Callable):
         CONVERSION_MACHINE.reset(token)
 
 
+# the target of the conversion running and the control profile it is written for (`convert
+# --profile` naming one of the target's `[options.profiles]`, None: the dialect's own default)
+TARGET_PROFILE: ContextVar[Optional[tuple]] = ContextVar("target_profile", default=None)
+
+
+@contextlib.contextmanager
+def target_profile(dialect: str, profile: Optional[str]):
+    """Within it, conversions write `dialect` for the control `profile`."""
+    token = TARGET_PROFILE.set((dialect, profile))
+    try:
+        yield
+    finally:
+        TARGET_PROFILE.reset(token)
+
+
+def flat_forms(dialect: Optional[str] = None) -> dict:
+    """How plain motion (--flatten) spells spindle-synchronised moves for the target being
+    written: its rules table's `[options.flat_motion]`, overridden by the profile's `flat_motion`
+    (issue 8: a Fanuc taps with M29 S.. G84, LinuxCNC with G33.1). Also `dialect`: the target's
+    name. `dialect`: the target's forms whatever the conversion running writes (its default
+    control's, unless the conversion writes that dialect for a profile). Empty for a target whose
+    table has no such forms, and outside a conversion when no dialect is named."""
+    current = TARGET_PROFILE.get()
+    profile = None
+    if current is not None and dialect in (None, current[0]):
+        dialect, profile = current
+    if dialect is None:
+        return {}
+    from nctrans.rules import load_table
+    try:
+        options = load_table(dialect).options
+    except Exception:               # a target without a rules table
+        return {}
+    forms = dict(options.get("flat_motion") or {})
+    if profile:
+        forms.update(((options.get("profiles") or {}).get(profile) or {}).get("flat_motion") or {})
+    if forms:
+        forms["dialect"] = dialect
+    return forms
+
+
 class NotExpressible(Exception):
     """Raised while spelling something the target dialect cannot write; the emitter reports it as
     NC402 at the current statement's line."""

@@ -198,6 +198,10 @@ class MotionMixin:
             if vals:
                 rigid_tap.rigid_tap_move(self, vals, center, motion)
             return
+        if motion == rigid_tap.RETURNING:
+            if vals:
+                rigid_tap.returning_tap_move(self, vals, center)
+            return
         if motion == rigid_tap.INTERPOLATED:
             if vals:
                 rigid_tap.interpolated_tap_move(self, vals)

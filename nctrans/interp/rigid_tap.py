@@ -25,6 +25,12 @@ M3/M4 program it, the retraction being a second G63 block after M4 [GK]. So the 
 block's G1 move at F, exactly; only the override, which the toolpath does not model, differs. Under
 G0/G2/G3 the block is not what the seed describes: NC226, and its axis words move nothing.
 
+LinuxCNC G33.1 (ISO milling, what `--flatten --profile linuxcnc` writes for a tap): `G33.1 Z..
+K<lead>` taps spindle-synchronised to the point, reverses the spindle, taps back to where it began
+and turns the spindle the first way again [GK: LinuxCNC G-code reference; rs274 prints one
+RIGID_TAP]. Recorded as CYCLE84's tap without a dwell: the move in, the reversed spindle, the move
+out, the spindle restored. LinuxCNC's overrun past the point on reversal is not modelled.
+
 Fagor G63, interpolated (rigid) tapping (seed L8556-8780, spec 9.8): `G63 Z.. S±n` moves with the
 spindle interpolated, lead = F / S (F per revolution under G95), the spindle turning by the sign of
 S whatever M3/M4 say (the reader writes that direction into the block), modal until M3/M4/M5/M19;
@@ -34,6 +40,7 @@ lead as pitch.
 from __future__ import annotations
 
 INTERPOLATED = "tap_interp"         # Fagor G63
+RETURNING = "tap_return"            # LinuxCNC G33.1
 # the reason a rules table gives a code that taps with a compensating chuck (Sinumerik G63)
 COMPENSATING_CHUCK = "tapping with compensating chuck"
 TAP = "tap_rigid"                   # G331
@@ -125,3 +132,26 @@ def interpolated_tap_move(it, vals) -> None:
         it._record("spindle", spindle_dir=st.spindle_dir or "cw", spindle=st.spindle_speed)
         it.spindle_stopped = False
     it._lead_move(target, lead)
+
+
+def returning_tap_move(it, vals, center) -> None:
+    """One LinuxCNC G33.1 block: in to the point and back, the spindle reversed between (module doc)."""
+    st = it.st
+    start = dict(it.pos)
+    target = it._target(vals)
+    leads = [abs(v) for _, v, _ in it._eval_words(center)] if center else []
+    if not leads or not leads[0]:
+        it.diag("NC206", "error", "G33.1 without a lead (K): the move is not made")
+        return
+    forward = spindle_state(it)
+    if forward not in ("cw", "ccw") or not st.spindle_speed:
+        it.diag("NC206", "error", "G33.1 with the spindle not turning (M3/M4 and S first): the "
+                "move is not made")
+        return
+    reverse = "ccw" if forward == "cw" else "cw"
+    it._lead_move(target, leads[0])
+    st.set("spindle", reverse)
+    it._record("spindle", spindle_dir=reverse, spindle=st.spindle_speed)
+    it._lead_move(start, leads[0])
+    st.set("spindle", forward)
+    it._record("spindle", spindle_dir=forward, spindle=st.spindle_speed)

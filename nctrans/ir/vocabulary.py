@@ -10,7 +10,8 @@ MODAL_GROUPS: dict[str, tuple[str, ...]] = {
     "motion": ("rapid", "linear", "arc_cw", "arc_ccw", "thread", "none",
                "arc_3point", "arc_tangent",                  # Sinumerik CIP (Motion.via) / CT
                "tap_rigid", "tap_rigid_retract",             # Sinumerik G331 / G332
-               "tap_interp"),                                # Fagor G63: lead F/S, hand by S's sign
+               "tap_interp",                                 # Fagor G63
+               "tap_return"),                                # LinuxCNC G33.1: in and back out: lead F/S, hand by S's sign
     "plane": ("XY", "ZX", "YZ"),
     "distance": ("absolute", "incremental"),
     "arc_distance": ("incremental", "absolute"),          # ISO G91.1 / G90.1

@@ -38,10 +38,12 @@ import math
 
 import dataclasses
 import re
+import types
 from typing import Any, Callable, Iterator, Optional
 
 from nctrans.convert import HELD_LIMIT_NOTE as HELD_LIMIT
 from nctrans.diagnostics import Diagnostic, at_span
+from nctrans.dialects.emit import flat_forms
 from nctrans.interp import corner_elements, spindle_position
 from nctrans.interp.interpreter import Interpreter
 from nctrans.interp.frames import PLANE_AXES
@@ -50,6 +52,7 @@ from nctrans.interp.unmodelled import modelled, no_motion_effect
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans.ir.walk import walk
+from nctrans.lower.flat_tapping import TEMPLATES, TapWriter
 from nctrans.toolpath import ToolpathRecord
 
 DECIMALS = 6                        # mm / degrees written: 1 nm, far under any controller's resolution
@@ -250,6 +253,12 @@ class _Flattener:
         self.off: dict[str, float] = {}            # target's offsets (work + tool length), mm
         self.noted: set[str] = set()
         self._raw: Optional[tuple] = None          # interpreter state the offsets were synced for
+        # taps written in the target control's tapping form (flat_tapping.py); records held for
+        # a tap are written later with the offsets state they came with (st_override)
+        self.st_override = None
+        forms = flat_forms()
+        self.taps = TapWriter(self, forms, self._replay, self._offsets_state) \
+            if forms.get("tapping") in TEMPLATES else None
 
     def info_once(self, key: str, message: str, span: n.Span) -> None:
         if key not in self.noted:
@@ -266,7 +275,7 @@ class _Flattener:
 
     # ------------------------------------------------------------------ offsets
     def _wanted_offsets(self, span: n.Span) -> tuple[str, tuple[str, Optional[int]]]:
-        st = self.interp.st
+        st = self.st_override or self.interp.st
         sel = (st.work_offset or "").upper()
         if sel not in ISO_OFFSETS and not sel.startswith("G54.1P"):
             self.info_once("no_offset", f"--flatten: no settable work offset active (here "
@@ -284,7 +293,7 @@ class _Flattener:
         return sel, length
 
     def _sync_offsets(self, body: list, span: n.Span) -> None:
-        st = self.interp.st
+        st = self.st_override or self.interp.st
         raw = (st.work_offset, st.length_mode, st.length_index, st.tool)
         if raw == self._raw:
             return
@@ -306,7 +315,26 @@ class _Flattener:
         self.off = off
 
     # ------------------------------------------------------------------ records
+    def _offsets_state(self):
+        st = self.interp.st
+        return types.SimpleNamespace(work_offset=st.work_offset, length_mode=st.length_mode,
+                                     length_index=st.length_index, tool=st.tool)
+
+    def _replay(self, rec: ToolpathRecord, work_end, work_center, state) -> None:
+        self.st_override = state
+        try:
+            self.record(rec, work_end, work_center)
+        finally:
+            self.st_override = None
+
     def hook(self, rec: ToolpathRecord, work_end, work_center) -> None:
+        if self.ended:
+            return
+        if self.taps is not None and self.taps.offer(rec, work_end, work_center):
+            return
+        self.record(rec, work_end, work_center)
+
+    def record(self, rec: ToolpathRecord, work_end, work_center) -> None:
         if self.ended:
             return
         span = n.Span(rec.file, rec.line)
@@ -381,9 +409,8 @@ class _Flattener:
             motion = "thread"
             self.info_once("thread", "--flatten: tapping and threads written as spindle-synchronised "
                            "G33 moves with their lead, the spindle reversed between them as the "
-                           "source's cycle does (first at this line); an ISO target gets the lead as K, "
-                           "the word of LinuxCNC's G33 (for controls whose G33 takes the lead as F: "
-                           "convert without --flatten)", span)
+                           "source's cycle does (first at this line); ISO milling writes the lead as "
+                           "F (ISO seed 4.5), as K for LinuxCNC (--profile linuxcnc)", span)
         if motion != self.motion:
             body.append(n.ModeChange("motion", motion))
             self.motion = motion
@@ -551,6 +578,8 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
             if any(_incomplete(d) for d in interp_diags[seen:]):
                 break
             seen = len(interp_diags)
+    if fl.taps is not None:
+        fl.taps.flush()
     if fl.blocks:
         last = fl.blocks[-1]
     raised = getattr(interp, "alarm", None)

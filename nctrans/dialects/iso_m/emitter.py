@@ -32,7 +32,7 @@ from typing import Any, Optional
 
 from nctrans.diagnostics import at_span
 from nctrans.interp import corner_elements
-from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, format_number, rewrites
+from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, flat_forms, format_number, rewrites
 from nctrans.ir import nodes as n
 from nctrans.ir import walk
 from nctrans.ir.walk import constant
@@ -199,9 +199,10 @@ class IsoEmitter(IsoSpelling, Emitter):
         # G33: ISO writes the thread lead as F, which is then the modal feed; the feed the source
         # programmed last is written again on the next feed move after the thread
         self.thread_mode = False
-        # ... except in plain motion for rs274 (--flatten --to iso-m, CONTRACT): LinuxCNC's G33 takes
-        # the lead as K and refuses F ("F word used with a g33"); see _thread
-        self.lead_as_k = self.dialect == "iso-m" and bool((program.meta or {}).get("flattened_from"))
+        # ... except in plain motion for LinuxCNC (--flatten --profile linuxcnc: rules iso-m
+        # [options.flat_motion]): its G33 takes the lead as K and refuses F; see _thread
+        self.lead_as_k = bool((program.meta or {}).get("flattened_from")) \
+            and flat_forms(self.dialect).get("thread_lead") == "K"
         self.last_feed: Optional[str] = None
         self.feed_clobbered = False
         # the thread start angle (Sinumerik SF=, ISO Q): a start angle written outside a thread

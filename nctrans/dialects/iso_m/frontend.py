@@ -764,7 +764,8 @@ class Lowering:
                 lv = vals.pop("P", None)
             if lv is not None:
                 turns = Num(float(lv) - 1, None) if type(lv) is str else Binary("-", lv, Num(1.0, None))
-        elif (b.motion_g or self.motion) == "thread" and self.cycle is None and vals.keys() & CENTER_LETTERS:
+        elif (b.motion_g or self.motion) in ("thread", "tap_return") and self.cycle is None \
+                and vals.keys() & CENTER_LETTERS:
             # G33 X.. Z.. K<lead>: LinuxCNC's lead word (ISO's own is F, seed 4.5); the
             # interpreter takes an I/J/K lead before F (interp/motion.py _g33_move)
             center = {k: AxisValue(self.num(k, vals.pop(k))) for k in "IJK" if k in vals}
