@@ -208,3 +208,10 @@ def run_blocks(run: "PlainRun", size: int = RUN_CHUNK):
         blocks, run = run.take(size)
         yield from blocks
         del blocks
+
+
+# The node types of a compact body that stand for blocks read back a few at a time (`take`): a
+# PlainRun, and the spilled plain motion of a construct lowered in a compact program
+# (nctrans.spilled). The emitters write both with run_blocks.
+from nctrans.spilled import SpilledRun  # noqa: E402 (no import of this module there)
+RUNS = (PlainRun, SpilledRun)

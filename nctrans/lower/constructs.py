@@ -52,22 +52,6 @@ class _AllRefused(Exception):
 MARKER_FILE = "<nctrans:segment>"
 
 
-def _compact_check(body: list, refusals: list[Diagnostic], file: str, segments: list[Segment]) -> None:
-    """NeedsWholeParse when the segments of a compact body's items (`body`, runs as PlainRuns)
-    would not be the whole parse's: a run is never inside a segment, never holds a refused line
-    and never holds a label anything jumps to (labels and numbers outside runs are all found)."""
-    from nctrans.plainrun import PlainRun
-    runs = [(i, x) for i, x in enumerate(body) if type(x) is PlainRun]
-    for i, run in runs:
-        first, after = run.line, run.extent().line
-        if any(d.file == file and first <= d.line < after for d in refusals):
-            raise NeedsWholeParse(f"a refusal in the run of plain blocks at line {first}")
-        if any(seg.first <= i <= seg.last for seg in segments):
-            raise NeedsWholeParse(f"a segment over the run of plain blocks at line {first}")
-    if runs and not _jumps(body) <= _labels(body):
-        raise NeedsWholeParse("a jump to a label that may be in a run of plain blocks")
-
-
 @dataclass
 class Segment:
     first: int                          # top-level node indices, inclusive
@@ -83,6 +67,7 @@ class Segment:
     notes: list[Diagnostic] = field(default_factory=list)    # what plain motion leaves out (NC401/NC403)
     diag_mark: int = 0                  # interpreter diagnostics before it started
     first_span: Optional[n.Span] = None  # the span its plain motion's first block takes
+    spill: object = None                # a compact program's: its plain motion as it is made (nctrans.spilled)
 
 
 def _line_index(body: list, file: str) -> dict[int, int]:
@@ -385,12 +370,14 @@ def _widened(found: list[Segment], modal_runs, stretch_runs) -> list[Segment]:
 def _widen_over_jumps(body: list, segments: list[Segment]) -> list[Segment]:
     """Each segment grown until no jump of the main body crosses its border: a jump into it, out
     of it, back over it or forward past it takes the jump's whole span with it, so a label loop
-    (LBL: ... GOTOB LBL) around a construct is lowered whole, as its loop."""
+    (LBL: ... GOTOB LBL) around a construct is lowered whole, as its loop. `body`: the main
+    body's nodes, or (index, node) pairs (a compact body's nodes other than its runs)."""
+    pairs = list(enumerate(body)) if type(body) is list else list(body)
     where: dict[str, int] = {}
-    for i, node in enumerate(body):
+    for i, node in pairs:
         for lab in _labels([node]):
             where.setdefault(lab, i)
-    spans = [(min(i, where[t]), max(i, where[t])) for i, node in enumerate(body)
+    spans = [(min(i, where[t]), max(i, where[t])) for i, node in pairs
              for t in _jumps([node]) if t in where]
     for seg in segments:
         changed = True
@@ -520,42 +507,28 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
     """(program with each lowerable segment replaced by plain motion or None when none is, NC401/
     NC403 notes, refusals that remain)."""
     from nctrans.dialects.base import CompactBody
-    compact = type(program.body) is CompactBody
-    if compact:             # its items, each run of plain blocks one node (NeedsWholeParse)
-        program = dataclasses.replace(program, body=list(program.body.items))
-    elif type(program.body) is not list:
+    if type(program.body) is CompactBody:       # its runs of plain blocks never built whole
+        from nctrans.lower.compact_constructs import lower_compact
+        return lower_compact(program, refusals, target_name, machine=machine, resolver=resolver)
+    if type(program.body) is not list:
         return None, [], refusals
     if machine is None:
         from nctrans.machine import default_mill
         machine = default_mill()
     segments, remaining = _segments(program, refusals)
     segments = _widen_over_jumps(program.body, segments)
-    if compact:
-        _compact_check(program.body, refusals, program.file, segments)
     _static_checks(program, segments)
-    notes: list[Diagnostic] = []
     for seg in segments:
-        if seg.why_not is None:
-            found: list[Diagnostic] = []
-            _Walker(found, getattr(machine, "kind", "mill")).nodes(program.body[seg.first:seg.last + 1])
-            blocked = [d for d in found if d.severity == "error"]
-            if blocked:
-                seg.why_not = blocked[0].message.replace("--flatten", "plain motion")
-            else:
-                seg.notes = [dataclasses.replace(d, message=d.message.replace("--flatten", "plain motion"))
-                             for d in found]
+        _walk_check(seg, program.body[seg.first:seg.last + 1], machine)
     live = [s for s in segments if s.why_not is None]
     if live:
         _run(program, live, machine, resolver)
     new_body: list = []
+    notes: list[Diagnostic] = []
     done = 0
     lowered_any = False
     for k, seg in enumerate(segments):
-        ended = seg.flattener is not None and seg.flattener.ended
-        if seg.why_not is None and (seg.starts != 1 or seg.ends != (0 if ended else 1)):
-            seg.why_not = ("it does not run exactly once" if seg.starts else "it never runs")
-        if seg.why_not is None and seg.end_state is not None and seg.end_state["comp"]:
-            seg.why_not = "cutter radius compensation is on at its end"
+        ended = _settle(seg)
         if seg.why_not is not None:
             remaining.extend(refused(seg))
             continue
@@ -575,7 +548,33 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
     if not lowered_any:
         return None, notes, remaining
     new_body.extend(program.body[done:])
-    return dataclasses.replace(program, body=CompactBody(new_body) if compact else new_body), notes, remaining
+    return dataclasses.replace(program, body=new_body), notes, remaining
+
+
+def _walk_check(seg: Segment, nodes: list, machine) -> None:
+    """What plain motion cannot carry among a segment's nodes (flatten._Walker): why it is not
+    lowered, or the notes of what its plain motion leaves out."""
+    if seg.why_not is not None:
+        return
+    found: list[Diagnostic] = []
+    _Walker(found, getattr(machine, "kind", "mill")).nodes(nodes)
+    blocked = [d for d in found if d.severity == "error"]
+    if blocked:
+        seg.why_not = blocked[0].message.replace("--flatten", "plain motion")
+    else:
+        seg.notes = [dataclasses.replace(d, message=d.message.replace("--flatten", "plain motion"))
+                     for d in found]
+
+
+def _settle(seg: Segment) -> bool:
+    """After the run: why a segment is not lowered when it did not run once or ends under cutter
+    compensation; whether it ended the program."""
+    ended = seg.flattener is not None and seg.flattener.ended
+    if seg.why_not is None and (seg.starts != 1 or seg.ends != (0 if ended else 1)):
+        seg.why_not = ("it does not run exactly once" if seg.starts else "it never runs")
+    if seg.why_not is None and seg.end_state is not None and seg.end_state["comp"]:
+        seg.why_not = "cutter radius compensation is on at its end"
+    return ended
 
 
 def refused(seg: Segment) -> list[Diagnostic]:
@@ -612,15 +611,17 @@ def _run(program: n.Program, segments: list[Segment], machine, resolver) -> None
         seg.first_span = _first_span(program, seg)
         done = seg.last + 1
     body.extend(program.body[done:])
-    from nctrans.dialects.base import CompactBody
-    from nctrans.plainrun import PlainRun
-    compact = any(type(x) is PlainRun for x in body)
-    marked = dataclasses.replace(program, body=CompactBody(body) if compact else body)
     homing = {(b.span.file, b.span.line) for seg in segments
               for b in blocks(program.body[seg.first:seg.last + 1])
               if any(type(x) is n.HomeReturn for x in b.body)}
-    hook = SegmentHook(program, segments, machine, homing,
-                       limits.setting("MAX_LOWERED_BLOCKS", limits.MAX_LOWERED_BLOCKS))
+    run_marked(dataclasses.replace(program, body=body), segments, machine, resolver, homing,
+               limits.setting("MAX_LOWERED_BLOCKS", limits.MAX_LOWERED_BLOCKS))
+
+
+def run_marked(marked: n.Program, segments: list[Segment], machine, resolver, homing: set,
+               most: Optional[int], spill: bool = False) -> None:
+    """Run `marked` (the program with the segments' markers) through a SegmentHook."""
+    hook = SegmentHook(marked, segments, machine, homing, most, spill)
     it = Interpreter(marked, machine, diagnostics=hook.diags, resolver=resolver, flatten_hook=hook)
     hook.interp = it
     try:
@@ -639,8 +640,9 @@ class SegmentHook:
     _AllRefused once every segment is refused: the rest of the run is moot."""
 
     def __init__(self, program: n.Program, segments: list[Segment], machine, homing: set,
-                 most: Optional[int]):
+                 most: Optional[int], spill: bool = False):
         self.program = program
+        self.spill = spill              # plain motion goes to a temporary file as it is made (Segment.spill)
         self.segments = segments
         self.machine = machine
         self.homing = homing            # (file, line) of the G28/G30 blocks inside segments
@@ -654,6 +656,7 @@ class SegmentHook:
         lower."""
         seg.why_not = seg.why_not or why
         seg.flattener = None
+        seg.spill = None
         if all(s.why_not is not None for s in self.segments):
             raise _AllRefused()
 
@@ -668,6 +671,9 @@ class SegmentHook:
                 rec.end is not None and all(abs(rec.end[a] - rec.start.get(a, rec.end[a])) < 1e-9 for a in rec.end):
             return      # G28's intermediate point where the tool already is: LinuxCNC does not move
         seg.flattener.hook(rec, work_end, work_center)
+        if self.spill and len(seg.flattener.blocks) >= 1024:
+            seg.spill.add(seg.flattener.blocks)
+            seg.flattener.blocks.clear()
         if self.most is not None and len(seg.flattener.blocks) > self.most:
             self.current = None
             self.refuse(seg, f"its plain motion runs past {self.most:,} blocks, {HELD_LIMIT_NOTE} "
@@ -711,6 +717,9 @@ class SegmentHook:
         fl.blocks.append(n.Block(seg.first_span, begin,
                                  comment="nctrans: plain motion of a construct the target lacks"))
         seg.flattener = fl
+        if self.spill:
+            from nctrans.spilled import Spill
+            seg.spill = Spill()
         self.current = seg
 
     def finish(self) -> None:

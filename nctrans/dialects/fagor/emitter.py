@@ -22,7 +22,7 @@ from nctrans.dialects.base import EmitResult
 from nctrans.dialects.base import get as get_dialect
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
 from nctrans.ir import nodes as n
-from nctrans.plainrun import PlainRun, run_blocks
+from nctrans.plainrun import RUNS, run_blocks
 from nctrans.ir import walk as ir_walk
 from nctrans.lower import restart_loop
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
@@ -297,7 +297,7 @@ class FagorEmitter(FagorSpelling, Emitter):
     def nodes(self, nodes: list) -> None:
         for node in nodes:
             t = type(node)
-            if t is PlainRun:                   # a compact body's run (base.CompactBody)
+            if t in RUNS:                       # a compact body's run (base.CompactBody)
                 self.nodes(run_blocks(node))
                 continue
             self.span = getattr(node, "span", self.span)

@@ -36,7 +36,7 @@ from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, flat_forms,
 from nctrans.ir import nodes as n
 from nctrans.ir import walk
 from nctrans.ir.walk import constant
-from nctrans.plainrun import PlainRun, run_blocks
+from nctrans.plainrun import RUNS, PlainRun, run_blocks
 
 from . import plan as pl
 from .edge_length import EdgeLengths, edge_offsets
@@ -620,7 +620,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         return None
 
     def _collect_numbers(self, nodes_) -> None:
-        self.unread_runs.extend(x for x in nodes_ if type(x) is PlainRun)
+        self.unread_runs.extend(x for x in nodes_ if type(x) in RUNS)
         for b in walk.blocks(nodes_):
             if b.number:
                 self.used_numbers.add(b.number.lstrip("0") or "0")
@@ -631,10 +631,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         node = next(ahead, None)
         while node is not None:
             after = next(ahead, None)
-            if type(node) is PlainRun:          # a compact body's run (base.CompactBody)
+            if type(node) in RUNS:              # a compact body's run (base.CompactBody)
                 self.nodes(run_blocks(node))
             else:
-                self.next_node = after          # what a ,R / ,C leads into (_corner_word)
+                # what a ,R / ,C leads into (_corner_word): a run's first block
+                self.next_node = (after.take(1)[0] or [None])[0] if type(after) in RUNS else after
                 self._node(node)
             node = after
 

@@ -49,6 +49,7 @@ from nctrans.lower.macro_procs import reads_arguments as _reads_arguments
 from nctrans.plainrun import PlainRun, run_blocks
 from nctrans.dialects.sinumerik.edge_selection import EdgeSelection, NoEdge, jump_regions
 from nctrans.rules import load_table, system_meaning, system_spelling
+from nctrans.plainrun import RUNS
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp import corner_elements
 from nctrans.interp.settable_frames import external_frame_variable
@@ -1150,7 +1151,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         while i < len(ns):
             n = ns[i]
             i += 1
-            if type(n) is PlainRun:             # a compact body's run (base.CompactBody)
+            if type(n) in RUNS:                 # a compact body's run (base.CompactBody)
                 self.plain_run(n, ind, i < len(ns) and isinstance(ns[i], _STRUCT))
                 continue
             self.span = getattr(n, "span", None)

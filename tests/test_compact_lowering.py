@@ -1,0 +1,159 @@
+"""Per-construct lowering of a compact parse (issue 15, nctrans.lower.compact_constructs): where a
+construct's lowering reaches into a run of plain blocks (Sinumerik G70 over a CAM stretch, a
+canned cycle or corner chain ending inside a run, a refused plain line), the program is no longer
+parsed whole: its runs are cut at the segments' borders and the plain motion is spilled to a
+temporary file. The bytes and diagnostics must be the whole parse's, on every target."""
+from __future__ import annotations
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from conftest import TextSink
+from nctrans import api, plainrun
+from nctrans.lower import compact_body
+from test_compact_convert import _MOVE, _PLAIN, _SIN_ARC, _compact, _same_both_ways, cam
+
+pytestmark = pytest.mark.skipif(plainrun.native is None, reason="runs of plain lines need the native kernel")
+
+
+def _no_whole_parse(monkeypatch) -> None:
+    """Converting again parsed whole (the old fallback) fails the test."""
+    def refuse(*_a, **_k):
+        raise AssertionError("the program was parsed whole")
+    monkeypatch.setattr(api, "_parsed_whole", refuse)
+    import nctrans.convert
+    monkeypatch.setattr(nctrans.convert, "expanded", refuse)
+
+
+# G70 (inch lengths) over the first CAM stretch of a structured program: ISO, Fagor and ISO-T
+# refuse the mode, so the stretch from G70 to the block before G71 is lowered to plain motion in
+# mm; the WHILE loop after it keeps its structure
+G70_OVER_RUNS = ("%_N_PART_MPF\nDEF INT CNT\nG71 G90 G17 G40 F500\nT1 D1 M6\nS6000 M3\nG0 X0 Y0 Z5\n"
+                 "G70\nG1 X1 Y2 F10\n" + cam(0, 40) + "G71\nG0 Z5\n" + cam(40, 40)
+                 + "CNT=0\nWHILE CNT<2\nG0 X=CNT Y0 Z5\nCNT=CNT+1\nENDWHILE\nM30\n")
+
+
+def test_g70_over_a_run_is_lowered_without_the_whole_parse(monkeypatch):
+    assert _compact(G70_OVER_RUNS, "g70.mpf", "sinumerik")
+    _no_whole_parse(monkeypatch)
+    sink = TextSink()
+    done = api.transpile(G70_OVER_RUNS, "sinumerik", "iso-m", file="g70.mpf", out=sink)
+    assert done.text == ""
+    out = "".join(sink.parts)
+    # inch to mm by hand: X1 Y2 -> 25.4, 50.8; the first CAM line G1 X0.125 Y0.25 Z-0.5 in
+    # inch -> X3.175 Y6.35 Z-12.7
+    assert "X25.4 Y50.8" in out and "X3.175 Y6.35 Z-12.7" in out
+    # the second stretch (after G71) keeps its source text, and the loop its structure
+    assert "X40.125 Y40.25 Z-5.5" in out and "WHILE[#100LT2]DO1" in out
+    notes = [d.message for d in done.diagnostics if d.rule == "NC401"]
+    assert any("lines 7-48 were lowered to plain motion" in m for m in notes)
+
+
+def test_g70_over_a_run_converts_as_parsed_whole(monkeypatch):
+    _same_both_ways(G70_OVER_RUNS, "g70.mpf", "sinumerik")
+
+
+# a G73 peck cycle (Sinumerik and Fagor lack it) whose last position is followed by plain CAM
+# lines without G80: the cycle's run ends at the first G1 inside the run, so the run is cut there
+CYCLE_INTO_RUN = ("%\nO1000\nG21 G90 G17 G40 G80 F500.\nT1 M6\nS6000 M3\nG0 X0 Y0 Z5.\n" + cam(0, 30)
+                  + "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nX2.\n" + cam(30, 30)
+                  + "#1=0\nWHILE[#1LT2]DO1\nG0 X[#1*5] Y0 Z5.\n#1=#1+1\nEND1\n" + cam(60, 10) + "M30\n%\n")
+
+
+def test_a_cycle_ending_inside_a_run_converts_as_parsed_whole(monkeypatch):
+    assert _compact(CYCLE_INTO_RUN, "c.nc", "iso-m")
+    _same_both_ways(CYCLE_INTO_RUN, "c.nc", "iso-m")
+    _no_whole_parse(monkeypatch)
+    sink = TextSink()
+    assert api.transpile(CYCLE_INTO_RUN, "iso-m", "sinumerik", file="c.nc", out=sink).text == ""
+
+
+def test_a_run_is_cut_into_pieces_that_read_back_its_blocks():
+    from nctrans import pipeline
+    program = pipeline.get_dialect("iso-m").parse_compact(CYCLE_INTO_RUN, "c.nc").program
+    run = next(x for x in program.body.items if type(x) is plainrun.PlainRun)
+    lines = [b.span.line for b in run.expand()]
+    head, tail = compact_body.cut(run, 7)
+    assert (head.blocks, tail.blocks) == (7, len(lines) - 7)
+    assert [b.span.line for b in head.expand()] == lines[:7]
+    assert [b.span.line for b in tail.expand()] == lines[7:]
+    view = compact_body.CompactView(list(program.body.items))
+    start = view.starts[view.items.index(run)]
+    assert [b.span.line for x in view.slice(start + 3, start + 9) for b in x.expand()] == lines[3:10]
+
+
+def test_spilled_plain_motion_reads_back_equal_blocks():
+    from nctrans.ir import nodes as n
+    from nctrans.spilled import CHUNK, Spill
+    made = [n.Block(n.Span("f", k), [n.Motion(target={"X": n.Num(k / 8)})], comment=f"c{k}")
+            for k in range(2 * CHUNK + 5)]
+    spill = Spill()
+    spill.add(made[:CHUNK + 3])
+    spill.add(made[CHUNK + 3:])
+    run = spill.close()
+    assert run.blocks == len(made)
+    for _ in range(2):          # read back as often as an emitter likes
+        assert list(plainrun.run_blocks(run)) == made
+
+
+# --------------------------------------------------------------------------- generated programs
+
+# what some target lowers on its own, placed between runs of plain CAM lines
+_SIN_LOWERED = st.sampled_from([
+    "G70", "G71", "G700", "G710", "G500", "G54",
+    "T2 D1 M6", "G1 X5 Y5 RND=1", "G1 X7 Y2 CHF=0.5",
+    "G331 Z-5 K1", "G0 Z5",
+    "R1=0\nWHILE R1<2\nG0 X=R1*5 Y0 Z5\nR1=R1+1\nENDWHILE",
+    "FOR COUNT=1 TO 2\nG91 G1 X1\nG90\nENDFOR",
+    "MCALL CYCLE81(5,0,1,-3)\nX4 Y4\nMCALL",
+])
+_SIN_RUN = st.lists(st.one_of(_MOVE, _MOVE, _SIN_ARC), min_size=1, max_size=10)
+
+
+@st.composite
+def sinumerik_lowerings(draw) -> str:
+    parts = ["%_N_GEN_MPF", "DEF INT COUNT", "G71 G90 G17 G40 F500", "T1 D1 M6", "S6000 M3",
+             "G0 X0 Y0 Z5", "FOR COUNT=1 TO 2\nG0 Z6\nENDFOR"]
+    for _ in range(draw(st.integers(1, 5))):
+        parts.extend(draw(_SIN_RUN))
+        parts.append(draw(_SIN_LOWERED))
+    parts.extend(draw(_SIN_RUN))
+    parts.append("M30")
+    return "\n".join(parts) + "\n"
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(sinumerik_lowerings())
+def test_generated_sinumerik_lowerings_convert_as_parsed_whole(text):
+    if not _compact(text, "l.mpf", "sinumerik"):
+        return
+    _same_both_ways(text, "l.mpf", "sinumerik")
+
+
+_ISO_LOWERED = st.sampled_from([
+    "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.", "X3. Y2.", "G80",
+    "G81 X1. Y1. Z-3. R1. F80.", "G1 X5. Y5. ,R1.", "G1 X8. Y1. ,C0.5",
+    "G28 G91 Z0\nG90", "G20", "G21", "G55", "G54", "T2 M6", "G18", "G17",
+    "#1=0\nWHILE[#1LT2]DO1\nG0 X[#1*5] Y0 Z5.\n#1=#1+1\nEND1",
+])
+
+
+@st.composite
+def iso_lowerings(draw) -> str:
+    parts = ["%", "O1000", "G21 G90 G17 G40 G80 F500.", "T1 M6", "S6000 M3", "G0 X0 Y0 Z5.",
+             "#2=0\nWHILE[#2LT1]DO2\nG0 Z6.\n#2=#2+1\nEND2"]
+    for _ in range(draw(st.integers(1, 5))):
+        parts.extend(draw(_PLAIN))
+        parts.append(draw(_ISO_LOWERED))
+    parts.extend(draw(_PLAIN))
+    parts += ["M30", "%"]
+    return "\n".join(parts) + "\n"
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(iso_lowerings())
+def test_generated_iso_lowerings_convert_as_parsed_whole(text):
+    if not _compact(text, "l.nc", "iso-m"):
+        return
+    _same_both_ways(text, "l.nc", "iso-m")
