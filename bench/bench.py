@@ -12,8 +12,9 @@ and through the CLI) and the per-file start-up of `nctrans lint` on small ISO an
 Last, the peak resident memory of the CLI's `convert` (to every target, with and without --flatten)
 and `equiv` at 1x and 10x the program, and of the program written as Fagor read back (toolpath,
 lint, convert); the same for the program made structured (loops, calls, a drilling cycle between
-its CAM stretches), as ISO and as Sinumerik (toolpath, lint, convert, equiv): memory must stay flat
-(10x/1x near 1) (`--peaks` runs only that table). Plain-text table; no assertions.
+its CAM stretches), as ISO and as Sinumerik (toolpath, lint, convert, equiv), and the Sinumerik one
+with its whole body under G70 converted to ISO (a construct lowered over the CAM runs): memory must
+stay flat (10x/1x near 1) (`--peaks` runs only that table). Plain-text table; no assertions.
 """
 from __future__ import annotations
 
@@ -201,6 +202,24 @@ def structured_sinumerik(text: str) -> str:
     body = body[:mid] + SINUMERIK_STRUCTURE.rstrip("\n").split("\n") + body[mid:]
     return ("%_N_PART_MPF\nDEF INT COUNT\n" + "\n".join(body)
             + "\nM30\n%_N_L2000_SPF\nG91 G1 X1 F100\nY1\nG90\nM17\n")
+
+
+# A loop of its own (a local counter: nothing outlives the program) after the G70 stretch.
+INCH_STRETCH_LOOP = "G71\nCNT=0\nWHILE CNT<2\nG0 X=CNT Y0 Z5\nCNT=CNT+1\nENDWHILE\n"
+
+
+def sinumerik_inch_stretch(text: str) -> str:
+    """The CAM program converted to Sinumerik with the first half of its body under G70 (inch
+    lengths, which ISO lacks) and a WHILE loop after it: converting it to ISO lowers the stretch
+    from G70 to G71 to plain motion, its CAM runs included, and keeps the loop (before
+    nctrans.lower.compact_constructs, only the whole parse could). Its own G700/G710 are left out,
+    so the stretch holds half the body."""
+    lines = re.sub(r"\bG7[01]0\b", "", text).rstrip("\n").split("\n")
+    end = max(i for i, line in enumerate(lines) if re.search(r"\bM(30|2)\b", line))
+    body = [line for line in lines[:end] if not line.startswith(";")]
+    mid = len(body) // 2
+    return ("%_N_PART_MPF\nDEF INT CNT\nG70\n" + "\n".join(body[:mid]) + "\n" + INCH_STRETCH_LOOP
+            + "\n".join(body[mid:]) + "\nM30\n")
 
 
 def peaks(text: str, name: str) -> tuple[float, float]:
@@ -511,13 +530,21 @@ SINUMERIK_PEAK_RUNS = (
 )
 
 
+# The run of the same program with half its CAM body under Sinumerik G70 (sinumerik_inch_stretch): a
+# construct lowered on its own over the runs of plain blocks, once a whole-parse fallback.
+INCH_STRETCH_PEAK_RUNS = (
+    ("convert --to iso-m (G70 over CAM)", ["convert", "SRC", "--from", "sinumerik", "--to", "iso-m",
+                                                "-o", "OUT"]),
+)
+
+
 def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
     """Peak memory (max RSS) of `convert` and `equiv` through the CLI at 1x and 10x the program:
     streamed, they must stay flat (10x/1x near 1; what grows is the source text each process
     holds, 0.6 MB -> 5.7 MB here)."""
     print("CLI peak memory (max RSS of the process, MiB) and wall time at 1x and 10x the program")
     text = read_text(base)
-    for kind in ("straight", "structured", "structured sinumerik"):
+    for kind in ("straight", "structured", "structured sinumerik", "sinumerik inch stretch"):
         _peak_table(kind, base, text, tmp, notes)
 
 
@@ -525,17 +552,18 @@ def _peak_table(kind: str, base: Path, text: str, tmp: Path, notes: list) -> Non
     """cli_peaks of the program as it is (straight) or made structured (structured())."""
     sizes = []
     runs = PEAK_RUNS
-    stem, ending = kind.replace(" ", "-"), ".mpf" if kind.endswith("sinumerik") else ".nc"
+    stem, ending = kind.replace(" ", "-"), ".mpf" if "sinumerik" in kind else ".nc"
     for times in (1, 10):
         src = tmp / f"peak-{stem}-x{times}{ending}"
-        if kind == "structured sinumerik":
+        if kind in ("structured sinumerik", "sinumerik inch stretch"):
             # the straight table's conversion to Sinumerik (its first row), made structured
             straight = tmp / f"peak-straight-x{times}.mpf"
             if not straight.exists():
                 notes.append(f"{kind}: no Sinumerik conversion of the straight program x{times}")
                 return
-            src.write_text(structured_sinumerik(straight.read_text()))
-            runs = SINUMERIK_PEAK_RUNS
+            make = structured_sinumerik if kind == "structured sinumerik" else sinumerik_inch_stretch
+            src.write_text(make(straight.read_text()))
+            runs = SINUMERIK_PEAK_RUNS if kind == "structured sinumerik" else INCH_STRETCH_PEAK_RUNS
         elif kind == "structured":
             src.write_text(structured(text, times))
         else:
