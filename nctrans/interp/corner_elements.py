@@ -273,6 +273,8 @@ def _join(it, p: Move, new: Move) -> Move:
         why = "an element is a full circle"
     elif _probe(it, p) != p.probe:
         why = "the frame, an offset or cutter compensation changes before the next move"
+    elif any(corners.degenerate(_element(m, a1, a2)) for m in (p, new)):
+        why = "an element has no length in the plane"
     if why:
         _not_inserted(it, p, why)
         _emit(it, p)
@@ -358,6 +360,9 @@ def apply_to_contour(it, blocks, moves: list) -> list:
             _not_inserted(it, m, "a move leaves the plane")
             continue
         first, second = _element(m, a1, a2), _element(n2, a1, a2)
+        if corners.degenerate(first) or corners.degenerate(second):
+            _not_inserted(it, m, "an element has no length in the plane")
+            continue
         if corners.is_tangent(first, second):
             continue
         corner, why = _shape(kind, first, second, value)

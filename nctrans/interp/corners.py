@@ -102,6 +102,14 @@ def _along(e: Element, p: Point) -> Optional[float]:
     return t if -1e-7 <= t <= 1 + 1e-7 else None
 
 
+def degenerate(e: Element) -> bool:
+    """Whether `e` has no direction to round or chamfer: a line of no length in the plane, an arc
+    of no radius (a zero-length or an out-of-plane move beside the corner)."""
+    if e.kind == "linear":
+        return not math.hypot(*_sub(e.end, e.start)) > _EPS
+    return e.center is None or not e.radius > _EPS
+
+
 def deflection(first: Element, second: Element) -> float:
     """Signed turn at the corner, radians in (-pi, pi): > 0 to the left (ccw)."""
     t1 = tangent(first, first.end)
