@@ -38,6 +38,7 @@ from nctrans.ir import walk
 from nctrans.ir.walk import constant
 from nctrans.plainrun import RUNS, PlainRun, run_blocks
 
+from . import per_word
 from . import plan as pl
 from .edge_length import EdgeLengths, edge_offsets
 from .cycles import CycleRefused, IsoCycle, iso_cycle, pattern_positions
@@ -169,6 +170,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         # approach from other dialects) can be followed by the G90 that restores it
         self.restore_absolute = False
         self.restore_arc_incremental = False
+        # per-word AC/IC (nctrans.dialects.iso_m.per_word): whether the G90/G91 in force is known
+        # here on every path (a main program starts under G90; a place reached from elsewhere
+        # forgets it), and the mode a one-block switch must restore after its block
+        self.distance_known = per_word.starts_as_main(program)
+        self.restore_distance: Optional[str] = None
         self.rotation_plane: Optional[str] = None     # the plane a rotation about a named axis holds
         self.arc_distance = "incremental"
         # the plan: labels, locals and O numbers per unit (None = the main program)
@@ -225,6 +231,7 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def forget(self) -> None:
         super().forget()
+        self.distance_known = False
         if getattr(self, "edge_lengths", None) is not None:
             self.edge_lengths.reached_from_elsewhere()
 
@@ -708,6 +715,9 @@ class IsoEmitter(IsoSpelling, Emitter):
         if self.restore_absolute:
             self.restore_absolute = False
             self.out.append(self.code_for("distance", "absolute"))
+        if self.restore_distance is not None:
+            self.out.append(self.code_for("distance", self.restore_distance))
+            self.restore_distance = None
         if self.restore_arc_incremental:
             self.restore_arc_incremental = False
             self.out.append(self.code_for("arc_distance", "incremental"))
@@ -930,6 +940,7 @@ class IsoEmitter(IsoSpelling, Emitter):
             self._plane_held(f"mode {s.group}={s.value}")
         if s.group == "distance":
             self.distance = s.value
+            self.distance_known = True
         if s.group == "arc_distance":       # under G90.1 ISO writes absolute centres as they are
             self.arc_distance = s.value
         elif s.group == "plane":
@@ -1064,7 +1075,8 @@ class IsoEmitter(IsoSpelling, Emitter):
             self.feed_clobbered = False
         if s.machine_coords:
             words.append(self.code_word("nonmodal", "machine_coords"))
-        words += self._axes(s.target)
+        target, switch = per_word.plain_words(self, s)
+        words += switch + self._axes(target)
         if s.aperture is not None:
             words.append(("R", "R" + self._aperture_radius(s, start)))
         if s.center and self.arc_distance != "absolute" and all(av.mode == "abs" for av in s.center.values()) \

@@ -53,6 +53,8 @@ def emit_stream(program: n.Program, chunks: Iterable[list], write: Callable[[str
         raise CannotStream("a fresh N number")
     e.fresh_label = no_fresh_label
     e.written = False
+    if hasattr(e, "distance_known"):
+        e.distance_known = None     # whether the body ends the program (M30) is not seen ahead
     _flush(e, head, write)
     # each chunk is let go before the next is parsed: one chunk of IR is held at a time
     if first is not None:
