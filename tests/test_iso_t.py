@@ -206,8 +206,9 @@ def test_flattened_iso_t_runs_in_rs274_with_the_same_xz_moves(path, rs274, rs274
     machine = default_lathe()
     src = get("iso-t").parse(path.read_text(encoding="utf-8"), path.name).program
     records = list(interpret(src, machine, diagnostics=[]))
-    flat = flatten(src, machine, diagnostics=[])
-    res = get("iso-m").emit(flat)
+    with h.linuxcnc():                      # G92's threads as LinuxCNC's G33 K
+        flat = flatten(src, machine, diagnostics=[])
+        res = get("iso-m").emit(flat)
     assert not [d for d in res.diagnostics if d.severity == "error"], res.diagnostics
     result = rs274_run(res.text, "isot-" + path.stem, machine, rs274_cache)
     assert result.completed, result.message

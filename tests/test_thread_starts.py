@@ -166,3 +166,26 @@ def test_flattened_iso_writes_q_for_a_fanuc_and_refuses_it_for_linuxcnc():
     linuxcnc = api.transpile(SINUMERIK, "sinumerik", "iso-m", flatten=True, profile="linuxcnc")
     assert linuxcnc.text is None
     assert any(d.rule == "NC402" and d.line == 4 and "LinuxCNC" in d.message for d in linuxcnc.diagnostics)
+
+
+G92 = "G18 G99 G97 S500 M3\nG0 X30 Z5\nG92 X19 Z-20 F2 Q180000\nX18\nG0 X40\n"
+
+
+def test_iso_t_g92_threads_are_synchronised_and_keep_q_with_the_cycle():
+    # X is a diameter: radius 9.5 then 9; the second pass (X18 alone) repeats the modal cycle with
+    # its data, Q included, as F and R; a G32 after it starts at 0 (Q holds for the cycle only)
+    threads, diags = _threads(G92 + "G0 X20 Z5\nG32 Z-20 F2\n", "iso-t", "t.nc")
+    assert threads == [(3, -20, 2.0, 180.0), (4, -20, 2.0, 180.0), (7, -20, 2.0, None)]
+    assert not [d for d in diags if d.severity != "info"]
+
+
+@pytest.mark.parametrize("target", ["iso-t", "sinumerik", "iso-m"])
+def test_a_g92_thread_lowered_to_plain_motion_stays_a_thread(target):
+    # was written as G1 feeds per revolution: a thread cut that is not synchronised with the spindle
+    text = G92 + "M30\n"
+    conv = api.transpile(text, "iso-t", target, flatten=True)
+    assert conv.text is not None
+    lines = conv.text.splitlines()
+    assert not any(ln.startswith(("G1 ", "G01 ")) for ln in lines)
+    assert sum("Z-20" in ln and ("G32" in ln or "G33" in ln) for ln in lines) == 2
+    assert api.equiv(text, conv.text, read_a="iso-t", read_b=target)

@@ -23,7 +23,7 @@ import copy
 import math
 from typing import Optional
 
-from nctrans.interp import corner_elements, turning
+from nctrans.interp import corner_elements, thread_starts, turning
 from nctrans.ir import nodes as n
 
 TURNING_KINDS = frozenset(("finish", "rough_turn", "rough_face", "pattern_repeat", "face_peck",
@@ -200,6 +200,16 @@ class LatheMixin:
             if s.kind == "box_face":
                 moves = turning.box_turn(start[::-1], target[::-1], taper)
                 self._emit_turning(moves, swap=True)
+            elif s.kind == "box_thread" and "start_angle" in vals:
+                # Q: the start angle of the cycle's thread, in 0.001 degree (Fanuc G92 [GK], as
+                # G32's Q, seed 4.1.16), kept with the modal cycle's data as F and R are [NC];
+                # the setting in force (SF=) again after it
+                saved = self.thread_start
+                self.thread_start = vals["start_angle"] / 1000.0 % 360.0
+                try:
+                    self._emit_turning(turning.box_thread(start, target, taper))
+                finally:
+                    self.thread_start = saved
             else:
                 fn = turning.box_turn if s.kind == "box_turn" else turning.box_thread
                 self._emit_turning(fn(start, target, taper))
@@ -447,8 +457,14 @@ class LatheMixin:
                 mode = st.feed_mode
                 st.feed_mode = "per_rev"            # F is the lead
                 self._need_feed()
+                mark = len(self.out)
                 self._move("linear", end)
                 st.feed_mode = mode
+                # a thread cut: spindle-synchronised (the record carries the lead, as G32's do),
+                # never a plain feed per revolution (--flatten writes it as a thread move)
+                for rec in self.out[mark:]:
+                    rec.pitch = st.feed
+                thread_starts.stamp(self, mark)
             else:
                 cx, cz = (center[1], center[0]) if swap else center
                 self._move("arc", end, (cz, cx), (not cw) if swap else cw, 0)

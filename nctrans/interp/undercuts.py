@@ -31,7 +31,9 @@ Modelling choices [NC] (what the manual leaves to the control, or what is not es
 - form F: the face recess t2 runs from the radius straight up to the face at the DIN angle of 8°
   (the radius meets it with a small kink instead of tangentially);
 - not modelled, refused at the call's line with no motion (NC115): CYCLE96 forms C and D (an
-  internal thread's undercut is measured from its core diameter, which is not established here),
+  internal thread's undercut is measured from its core diameter, which is not established here;
+  no seed or stored page gives DIN 76's internal rows, and the external A/B table is itself from
+  general knowledge, to confirm: a guessed internal table would be silently wrong),
   VARI 5..8, VARI 0 without a tip direction in the machine model, MCALL.
 """
 from __future__ import annotations
@@ -194,7 +196,8 @@ def plan(interp, cyc, s) -> list[Step]:
         form = _form(interp, s, "ABCD")
         if form in "CD":
             raise unmodelled(f"with FORM {form} (an internal thread's undercut): not modelled; nctrans "
-                             "models the external forms A and B")
+                             "models the external forms A and B (no seed gives DIN 76's internal "
+                             "dimensions, and where the cycle measures them from is not established)")
         diameter = abs(p.get("DIATH", 0.0))
         pitch = coarse_pitch(diameter)
         if pitch is None:
