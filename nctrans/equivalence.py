@@ -179,6 +179,13 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
                     state["feed"] = feed
                     run = None
                     yield ("E", "feed", feed, r)
+                # a thread (a feed synchronised with the spindle, its lead as pitch) is another
+                # motion than a feed at the same speed: the pitch compares as an event
+                pitch = r.pitch or 0.0
+                if not _close(state.get("pitch", 0.0), pitch):
+                    state["pitch"] = pitch
+                    run = None
+                    yield ("E", "pitch", pitch, r)
                 if r.pitch:
                     # a thread's start angle (its start of several): the same path cut at another
                     # spindle phase is another thread; no key reads 0, as a single start has

@@ -189,3 +189,13 @@ def test_a_g92_thread_lowered_to_plain_motion_stays_a_thread(target):
     assert not any(ln.startswith(("G1 ", "G01 ")) for ln in lines)
     assert sum("Z-20" in ln and ("G32" in ln or "G33" in ln) for ln in lines) == 2
     assert api.equiv(text, conv.text, read_a="iso-t", read_b=target)
+
+
+def test_equiv_tells_a_thread_from_a_plain_feed_per_revolution_at_the_same_speed():
+    # G33 K2 at S500 and G95 F2 at S500 both move 1000 mm/min along the same line; only the
+    # first is synchronised with the spindle (a thread), so the programs are not equivalent
+    thread = "G54 G90 G0 X10 Z5\nS500 M3\nG33 Z-20 K2\nG0 X20\nM30\n"
+    feed = "G54 G90 G0 X10 Z5\nS500 M3\nG95 G1 Z-20 F2\nG0 X20\nM30\n"
+    assert api.equiv(thread, thread, read_a="sinumerik", read_b="sinumerik")
+    eq = api.equiv(thread, feed, read_a="sinumerik", read_b="sinumerik")
+    assert not eq and "pitch" in str(eq.difference.message)
