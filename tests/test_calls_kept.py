@@ -13,7 +13,7 @@ from conftest import CORPUS
 from nctrans.dialects.iso_m.plan import stable_number
 
 CALLER = "G17 G90 G71\nG0 X0 Y0 Z10\nWIDEN(3, 4)\nG0 X1\nM30\n"
-PROC = "PROC WIDEN(REAL A, REAL B)\nG1 X=A Y=B F100\nG0 Z=A+B\nRET\n"
+PROC = "PROC WIDEN(REAL DX, REAL DY)\nG1 X=DX Y=DY F100\nG0 Z=DX+DY\nRET\n"
 
 
 def test_unknown_call_is_kept_with_a_warning_not_refused():

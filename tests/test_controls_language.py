@@ -60,14 +60,14 @@ def test_words_written_together():
 
 
 def test_string_functions():
-    text = ('DEF STRING[20] S="ABCDEF"\nDEF STRING[20] SB\nDEF INT L\n'
-            "L=STRLEN(S)\nG0 X=L\n"                      # 6
-            'L=INDEX(S,"C")\nG0 X=L\n'                   # 2
-            'L=RINDEX("ABCABC","B")\nG0 X=L\n'           # 4
-            "SB=SUBSTR(S,1,2)\nL=MATCH(S,SB)\nG0 X=L\n"  # "BC" at 1
-            'L=MINDEX("ABC","XC")\nG0 X=L\n'             # 2
-            'L=INDEX(S,"Z")\nG0 X=L\n'                   # -1
-            'SB=TOLOWER(S)\nIF SB<>"abcdef" GOTOF BAD\n'
+    text = ('DEF STRING[20] SA="ABCDEF"\nDEF STRING[20] SB\nDEF INT LL\n'
+            "LL=STRLEN(SA)\nG0 X=LL\n"                      # 6
+            'LL=INDEX(SA,"C")\nG0 X=LL\n'                   # 2
+            'LL=RINDEX("ABCABC","B")\nG0 X=LL\n'           # 4
+            "SB=SUBSTR(SA,1,2)\nLL=MATCH(SA,SB)\nG0 X=LL\n"  # "BC" at 1
+            'LL=MINDEX("ABC","XC")\nG0 X=LL\n'             # 2
+            'LL=INDEX(SA,"Z")\nG0 X=LL\n'                   # -1
+            'SB=TOLOWER(SA)\nIF SB<>"abcdef" GOTOF BAD\n'
             'IF TOUPPER("ab")<>"AB" GOTOF BAD\n'
             'G0 X=NUMBER("12.5")\n'                       # 12.5
             'IF ISNUMBER("1.5EX2")==0 GOTOF BAD\nIF AXSTRING(X)<>"X" GOTOF BAD\n'
@@ -79,7 +79,7 @@ def test_string_functions():
 
 
 def test_string_function_errors_are_reported():
-    recs, diags = run('DEF REAL V\nV=NUMBER("1,5")\nV=SUBSTR("A",-1)\nV=STRLEN(5)\nM30\n', "sinumerik")
+    recs, diags = run('DEF REAL VV\nVV=NUMBER("1,5")\nVV=SUBSTR("A",-1)\nVV=STRLEN(5)\nM30\n', "sinumerik")
     assert [(d.rule, d.line) for d in diags if d.severity == "error"] == [
         ("NC104", 2), ("NC104", 3), ("NC104", 4)]
 

@@ -7,7 +7,7 @@ import pytest
 from nctrans import lark_cache
 from nctrans.dialects.sinumerik import frontend as sin
 
-PROGRAM = "DEF REAL A=2\nR1=A*3\nIF R1>5 GOTOF END\nG1 X=R1 Y10 F100\nEND:\nM30\n"
+PROGRAM = "DEF REAL AA=2\nR1=AA*3\nIF R1>5 GOTOF END\nG1 X=R1 Y10 F100\nEND:\nM30\n"
 
 
 def _parse_fresh():

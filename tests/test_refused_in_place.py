@@ -74,14 +74,14 @@ def test_a_machine_axis_name_is_never_written_as_an_iso_word():
     assert conv.text is None
     refused = [d for d in conv.diagnostics if d.rule == "NC402" and "XV" in d.message]
     assert refused and refused[0].line == 2
-    proc = api.transpile("PROC SLIDE(REAL A)\nG1 X=A XV=A F100\nG1 X0\nRET\n", read="sinumerik", write="iso-m")
+    proc = api.transpile("PROC SLIDE(REAL DIST)\nG1 X=DIST XV=DIST F100\nG1 X0\nRET\n", read="sinumerik", write="iso-m")
     assert proc.ok
     assert f"#3000={NOT_CONVERTED_ALARM} (NOT CONVERTED: axis XV)" in proc.text.splitlines()
     assert not [x for x in proc.text.splitlines() if x.startswith("G1") and "V" in x]
 
 
 def test_licence_check_on_a_machine_serial_number_is_refused_whole_at_its_if():
-    src = ('PROC P(REAL A)\nG1 X=A F100\nIF $MN_HW_SERIAL_NUMBER <> "SN-1"\nMSG("no licence")\n'
+    src = ('PROC P(REAL DIST)\nG1 X=DIST F100\nIF $MN_HW_SERIAL_NUMBER <> "SN-1"\nMSG("no licence")\n'
            'G4 F99999\nRET\nENDIF\nG1 X0\nRET\n')
     conv = api.transpile(src, read="sinumerik", write="iso-m")
     assert conv.ok

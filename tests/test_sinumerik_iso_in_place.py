@@ -49,8 +49,8 @@ def test_construct_is_an_alarm_at_its_own_line(line, alarm):
 
 
 def test_string_report_in_a_proc_file_keeps_the_rest():
-    src = ("PROC LOG(INT N)\nDEF STRING[40] TEXT\nG0 X0 Y0\nTEXT=SPRINT(\"PASS %d\", N)\n"
-           "G1 X=N*10 F200\nRET\n")
+    src = ("PROC LOG(INT PASS)\nDEF STRING[40] TEXT\nG0 X0 Y0\nTEXT=SPRINT(\"PASS %d\", PASS)\n"
+           "G1 X=PASS*10 F200\nRET\n")
     conv = api.transpile(src, read="sinumerik", write="iso-m")
     assert conv.ok
     assert sorted(d.line for d in conv.diagnostics if d.rule == "NC412") == [2, 4]
@@ -69,7 +69,7 @@ def test_string_report_in_a_proc_file_keeps_the_rest():
 
 
 def test_strict_refuses_them():
-    conv = api.transpile("PROC P\nDEF STRING[8] S1\nG0 X1\nRET\n", read="sinumerik", write="iso-m",
+    conv = api.transpile("PROC P\nDEF STRING[8] SS1\nG0 X1\nRET\n", read="sinumerik", write="iso-m",
                          strict=True)
     assert conv.text is None
     assert [d.severity for d in conv.diagnostics if d.rule == "NC412"] == ["error"]
@@ -121,7 +121,7 @@ def test_a_return_ending_a_main_program_is_said_when_written_as_m99():
     conv = api.transpile("G0 X1 Y2\nM17\n", read="sinumerik", write="iso-m")
     assert [(d.rule, d.line) for d in conv.diagnostics if d.severity == "warning"] == [("NC406", 2)]
     # a PROC's RET is a subprogram's return: nothing to say; nor for ISO's own M99
-    proc = api.transpile("PROC FOO(REAL A)\nG0 X=A\nRET\n", read="sinumerik", write="iso-m")
+    proc = api.transpile("PROC FOO(REAL AA)\nG0 X=AA\nRET\n", read="sinumerik", write="iso-m")
     assert "NC406" not in {d.rule for d in proc.diagnostics}
     iso = api.transpile("O1\nG0 X1\nM99\n", read="iso-m", write="iso-m")
     assert "NC406" not in {d.rule for d in iso.diagnostics}
@@ -129,7 +129,7 @@ def test_a_return_ending_a_main_program_is_said_when_written_as_m99():
 
 def test_diamon_is_written_as_radius_words():
     # DIAMON (diameter X, absolute and incremental) is no alarm: ISO X words carry the radius
-    src = "PROC PART(REAL D)\nG1 Z0 F100\nDIAMON\nG1 X=D Z1\nG91 X2\nDIAMOF\nG90 X5\nRET\n"
+    src = "PROC PART(REAL DD)\nG1 Z0 F100\nDIAMON\nG1 X=DD Z1\nG91 X2\nDIAMOF\nG90 X5\nRET\n"
     conv = api.transpile(src, read="sinumerik", write="iso-m")
     lines = [l for l in conv.text.splitlines() if l.startswith(("G1 X", "G91", "G90"))]
     assert lines == ["G1 X[#1/2] Z1.", "G91 X1.", "G90 X5."]

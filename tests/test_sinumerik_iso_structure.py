@@ -135,7 +135,7 @@ def test_message_with_values_is_a_comment_naming_the_expressions():
 
 def test_def_without_a_value_starts_at_zero_in_iso_too():
     # a vacant common is not 0 in ISO: #100 EQ 0 is false while #100 is vacant
-    src = "DEF REAL A\nIF A==0\nG1 X10 F100\nELSE\nG1 X20 F100\nENDIF\nM30\n"
+    src = "DEF REAL AA\nIF AA==0\nG1 X10 F100\nELSE\nG1 X20 F100\nENDIF\nM30\n"
     conv = _convert(src)
     assert "#100=0" in conv.text.splitlines()
     same = api.equiv(src, conv.text, read_a="sinumerik", read_b="iso-m")
@@ -146,7 +146,7 @@ def test_def_without_a_value_starts_at_zero_in_iso_too():
 
 def test_absolute_arc_centre_from_a_start_known_at_run_time_is_written_under_g90_1():
     # the start point changes each pass: no constant incremental centre exists
-    src = "DEF INT K\nG0 X0 Y0\nFOR K=1 TO 2\nG1 X=10*K Y0 F100\nG3 X=-10*K Y0 I=AC(0) J=AC(0)\nENDFOR\nM30\n"
+    src = "DEF INT KK\nG0 X0 Y0\nFOR KK=1 TO 2\nG1 X=10*KK Y0 F100\nG3 X=-10*KK Y0 I=AC(0) J=AC(0)\nENDFOR\nM30\n"
     conv = _convert(src)
     lines = conv.text.splitlines()
     arc = next(i for i, x in enumerate(lines) if x.startswith("G3"))
@@ -160,7 +160,7 @@ def test_absolute_arc_centre_from_a_start_known_at_run_time_is_written_under_g90
 
 def test_a_parameter_a_call_leaves_out_reads_zero_in_iso_too():
     # Sinumerik: an unprogrammed parameter is 0 (X0); a vacant G65 local would drop the X word
-    src = "G0 X5 Y5\nP1(,3)\nM30\nPROC P1(REAL A, REAL B)\nG1 X=A Y=B F100\nRET\n"
+    src = "G0 X5 Y5\nP1(,3)\nM30\nPROC P1(REAL XA, REAL YB)\nG1 X=XA Y=YB F100\nRET\n"
     conv = _convert(src)
     lines = conv.text.splitlines()
     assert lines[lines.index("IF[#1EQ#0]THEN#1=0") + 1] == "IF[#2EQ#0]THEN#2=0"
@@ -247,7 +247,7 @@ def test_an_omitted_argument_between_others_keeps_the_letters_in_place():
 
 
 def test_a_proc_file_names_its_variables_after_its_o_number():
-    src = "PROC SETUP(REAL A)\nDEF REAL K\nINI[4]=A\nK=INI[4]*2\nG1 X=K F100\nM17\n"
+    src = "PROC SETUP(REAL AA)\nDEF REAL KK\nINI[4]=AA\nKK=INI[4]*2\nG1 X=KK F100\nM17\n"
     conv = _convert(src)
     lines = conv.text.splitlines()
     assert lines[1] == f"O{stable_number('SETUP', set())} (SETUP)"

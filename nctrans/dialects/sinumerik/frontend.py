@@ -24,6 +24,7 @@ from typing import Optional
 from nctrans import limits, plainrun, resources
 from nctrans.diagnostics import Diagnostic, DiagnosticList
 from nctrans.dialects.base import ParseResult
+from nctrans.dialects.sinumerik import names
 from nctrans.dialects.sinumerik.lexer import LexError, number_value, tokenize
 from nctrans.ir import nodes as ir
 from nctrans.ir.vocabulary import MILL_ONLY, MODAL_GROUPS, NO_EFFECT_PREFIX
@@ -693,7 +694,7 @@ class Lowerer:
             elif d == "goto_stmt":
                 w.out.append(_goto(ch[0], ch[1], None))
             elif d == "def_stmt":
-                w.out.extend(self.vardecls(st, code))
+                w.out.extend(self.vardecls(st, code, line))
             elif d == "extern_stmt":
                 w.out.append(ir.Passthrough(_t(text), "declaration", DIALECT))
                 self.meta.setdefault("externs", []).append(str(ch[1]))
@@ -760,7 +761,13 @@ class Lowerer:
             w.out.append(ir.Passthrough(f"{code} S", "spindle speed limit", DIALECT))
             w.speed = []
 
-    def vardecls(self, st: Tree, code: str = "") -> list:
+    def refuse_name(self, name: Token, line: Line) -> None:
+        """NC126 at a declared name the control refuses (names.py)."""
+        why = names.refused(str(name), table().options)
+        if why:
+            self.error("NC126", why, line.lineno, name.column, name.column + len(name))
+
+    def vardecls(self, st: Tree, code: str = "", line: Optional[Line] = None) -> list:
         ch = st.children
         limits = None
         found = {k.upper(): number_value(v) for k, v in _LIMIT.findall(code)}
@@ -781,6 +788,8 @@ class Lowerer:
         out = []
         for dcl in decls:
             name = str(dcl.children[0])
+            if line is not None:
+                self.refuse_name(dcl.children[0], line)
             dims = []
             if dcl.children[2] is not None:
                 dim_exprs = _args(dcl.children[2]) or [omitted()]
@@ -1472,6 +1481,7 @@ def _assemble(low: Lowerer, unit: _Unit, units: list, stmts: list, line: Line, s
                 by_ref = any(isinstance(x, Token) and x.type == "VAR" for x in c.children)
                 ts = next(x for x in c.children if isinstance(x, Tree) and x.data == "type_spec")
                 name = next(str(x) for x in c.children if isinstance(x, Token) and x.type == "IDENT")
+                low.refuse_name(next(x for x in c.children if isinstance(x, Token) and x.type == "IDENT"), line)
                 arr = [x for x in c.children if isinstance(x, Tree) and x.data == "arglist"]
                 dims = [0 if is_omitted(a) else int(a.value) if isinstance(a, ir.Num) else 0
                         for a in _args(arr[0])] or [0] if arr and arr[0] is not None else []
