@@ -189,8 +189,8 @@ def test_blocks_without_motion_between():
 def test_too_large_and_negative_values():
     recs, diags = run(HEAD + "G1 X10 RND=20\nY5\nM30\n")
     assert [pt(r.end) for r in moves(recs)[1:]] == [(10, 0), (10, 5)]
-    (d,) = [d for d in diags if d.rule == "NC217"]
-    assert d.line == 2 and "shrinks" in d.message
+    (d,) = [d for d in diags if d.rule == "NC219"]
+    assert d.line == 2 and "shrinks" in d.message and "inserts none" not in d.message
     recs, diags = run(HEAD + "G1 X10 RND=-2\nY5\nM30\n")
     assert [pt(r.end) for r in moves(recs)[1:]] == [(10, 0), (10, 5)]
     assert ("NC120", 2) in bad(diags)

@@ -228,13 +228,19 @@ def _emit(it, m: Move) -> None:
     it._emit_move(m.kind, m.start, m.end, m.center, m.cw, m.turns, m.payload)
 
 
-def _not_inserted(it, m: Move, why: str) -> None:
+def _not_inserted(it, m: Move, why: str, control_does: str = "") -> None:
+    """Said at the corner word's line: NC218 where the control alarms, NC217 where it inserts no
+    element either, NC219 where it does something nctrans does not model (`control_does`)."""
     kind, value, _, dialect = m.corner
     alarm = settings(dialect).get("missing_next") == "alarm"
-    control = "the control stops with an alarm" if alarm else "the control inserts none"
-    it.diag("NC218" if alarm else "NC217", "error" if alarm else "warning",
-            f"the {_NOUN[kind]} ({value:g}) is not inserted: {why} ({control}; the analysed "
-            "toolpath runs the corner sharp)", m.span)
+    if alarm:
+        rule, severity, control = "NC218", "error", "the control stops with an alarm"
+    elif control_does:
+        rule, severity, control = "NC219", "warning", f"{control_does}; nctrans does not model how"
+    else:
+        rule, severity, control = "NC217", "warning", "the control inserts none"
+    it.diag(rule, severity, f"the {_NOUN[kind]} ({value:g}) is not in the analysed toolpath: {why} "
+            f"({control}; the analysed toolpath runs the corner sharp)", m.span)
 
 
 def _in_plane(m: Move, a1: str, a2: str) -> bool:
@@ -262,7 +268,13 @@ def _join(it, p: Move, new: Move) -> Move:
     plane = p.payload[6]
     a1, a2, _ = PLANE_AXES[plane]
     why = ""
-    if new.kind not in CONTOUR_KINDS:
+    control_does = ""
+    if new.kind == "rapid" and new.payload[6] == plane and _in_plane(p, a1, a2) and _in_plane(new, a1, a2):
+        # Siemens inserts the element before an in-plane G0 and traverses it at rapid (F and FRC
+        # have no effect then) [GK: Siemens Fundamentals, "Chamfer, rounding"]
+        why = "the next move is a rapid (G0) in the plane"
+        control_does = "the control inserts it and traverses it at rapid"
+    elif new.kind not in CONTOUR_KINDS:
         why = "the next move is not a contour move (G1, G2, G3)"
     elif new.payload[6] != plane:
         why = "the plane changes before the next move"
@@ -276,7 +288,7 @@ def _join(it, p: Move, new: Move) -> Move:
     elif any(corners.degenerate(_element(m, a1, a2)) for m in (p, new)):
         why = "an element has no length in the plane"
     if why:
-        _not_inserted(it, p, why)
+        _not_inserted(it, p, why, control_does)
         _emit(it, p)
         _replay(it, it.corner)
         return new
@@ -286,9 +298,8 @@ def _join(it, p: Move, new: Move) -> Move:
     if not corners.is_tangent(first, second):
         corner, why = _shape(kind, first, second, value)
         if corner is None:
-            if settings(dialect).get("too_large") == "reduced":
-                why += " (the control shrinks it to fit; nctrans does not model how)"
-            _not_inserted(it, p, why)
+            reduced = settings(dialect).get("too_large") == "reduced"
+            _not_inserted(it, p, why, "the control shrinks it to fit" if reduced else "")
     if corner is None:
         _emit(it, p)
         _replay(it, it.corner)
