@@ -74,7 +74,8 @@ def test_plate_runs_clean_on_its_machine_with_tool_lengths():
 def test_flange_settable_frame_with_rotation_and_programmable_frames():
     recs = records(SIN / "shop_flange_22.mpf")
     diags = nctrans.lint(SIN / "shop_flange_22.mpf")
-    assert [d.rule for d in diags if d.severity != "info"] == []
+    # CYCLE800 (line 42) swivels the frame; the rotary axes it positions are not modelled: said
+    assert [(d.line, d.rule) for d in diags if d.severity != "info"] == [(42, "NC107")]
     # G55 = $P_UIFR[2] = CTRANS(X,-300,Y,-200,Z,-450):CROT(Z,15)
     # N50-N65: TRANS X10 Y5, AROT Z30, ATRANS X2, G0 X0 Y0 Z5:
     #   programmable: (10 + 2 cos 30, 5 + 2 sin 30) = (11.7321, 6)
@@ -96,8 +97,10 @@ def test_flange_settable_frame_with_rotation_and_programmable_frames():
 def test_fanuc_bracket_frames_macros_and_messages():
     recs = records(ISO / "O2150.nc")
     diags = nctrans.lint(ISO / "O2150.nc")
-    # the probing move G31 is not modelled and says so; nothing else at warning level
-    assert sorted((d.line, d.rule) for d in diags if d.severity != "info") == [(16, "NC220")]
+    # the probing move G31 is not modelled and says so, and so is the test of its unknown result
+    # (#5063 -> #110, taken as false); nothing else at warning level
+    assert sorted((d.line, d.rule) for d in diags if d.severity != "info") == [(16, "NC220"),
+                                                                               (18, "NC107")]
     # G31's axis words move nothing (before: it ran as the modal G0 to Z-10)
     assert at(recs, 16) == []
     # #3006=1 (CHECK PROBE READING): a program stop
@@ -117,7 +120,10 @@ def test_haas_probe_offsets_local_subprogram_and_frames():
     path = ISO / "O0310.nc"
     recs = records(path)
     diags = nctrans.lint(path)
-    assert sorted((d.line, d.rule) for d in diags if d.severity != "info") == [(14, "NC220")]
+    # G31 is not modelled; the test of its result (line 15) and the work offset computed from it
+    # (line 22) are unknown: all said
+    assert sorted((d.line, d.rule) for d in diags if d.severity != "info") == [
+        (14, "NC220"), (15, "NC107"), (22, "NC107")]
     # G10 L10 P5 R101.234 (length), L12 R3. (radius), L13 R0.02 (radius wear): G43 H05 Z25.
     # -> Z 126.234; G41 D05 into a G03 I-20 bore: the tool centre on a circle of 20 - 3.02
     assert xyz(at(recs, 27)[0])[2] == 126.234

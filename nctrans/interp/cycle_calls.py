@@ -317,15 +317,20 @@ class CycleCallsMixin:
         plan = swivel_plan(params)
         self._swivel_retract(plan)
         if plan.mode != "axis":
-            self.diag("NC107", "info", f"CYCLE800 swivel mode {plan.mode!r} (_MODE "
-                      f"{int(params.get('swivel_mode', 0))}) needs the machine's swivel data record "
-                      "and is not interpreted; the programmable frame is kept")
+            self.diag("NC107", "warning", f"CYCLE800 swivel mode {plan.mode!r} (_MODE "
+                      f"{int(params.get('swivel_mode', 0))}) is not modelled: the plane is not "
+                      "swivelled, the moves after it run in the frame that was active before")
             return
         if plan.rotations:
+            # The control positions the rotary axes of the swivel data record so that the tool
+            # stands normal to the new plane [GK]; the kinematics is not in the machine model
             rec = params.get("swivel_record")
-            self.diag("NC107", "info", f"rotary axis positioning needs the swivel data record "
-                      f"{str(rec or '')!r} (machine kinematics, not in the machine model); the rotary "
-                      "axes are not moved, only the programmable frame is swivelled")
+            self.diag("NC107", "warning", f"CYCLE800 swivels the frame, but positioning the rotary "
+                      f"axes of swivel data record {str(rec or '')!r} (the tool normal to the new "
+                      "plane) is not modelled: the machine's kinematics is not in the machine model. "
+                      "The tool tip follows the swivelled path with the tool along machine Z and "
+                      "the rotary axes where they were; machine positions, travel and collision "
+                      "checks are not the machine's")
 
         def op(kind: str, vals: dict[str, float], additive: bool) -> None:
             self._h_frame(n.FrameOp(kind, {a: n.Num(v) for a, v in vals.items()}, additive=additive))

@@ -154,7 +154,7 @@ class FlowMixin:
         def cond():
             v = f()
             if v is UNKNOWN:
-                self.diag("NC107", "info", "condition depends on a value unknown at analysis "
+                self.diag("NC107", "warning", "condition depends on a value unknown at analysis "
                           "time; taken as false")
                 return False
             return bool(v) if v is not None else False

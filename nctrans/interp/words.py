@@ -24,7 +24,7 @@ class WordsMixin:
         if v is None:
             return None
         if v is UNKNOWN:
-            self.diag("NC107", "info", f"{what} depends on a value unknown at analysis time; "
+            self.diag("NC107", "warning", f"{what} depends on a value unknown at analysis time; "
                       "the word is ignored")
             return None
         if isinstance(v, str):
