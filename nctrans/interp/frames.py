@@ -143,6 +143,17 @@ class ProgrammableFrame:
             self.mirror = _about(tuple(tuple(r) for r in m), axes)  # type: ignore
         self._rebuild()
 
+    def add_in_current_system(self, kind: str, values: dict[str, float]) -> None:
+        """Sinumerik AMIRROR / ASCALE (spec 7.3: P := P . Mi, P := P . S): the mirror or scale acts
+        in the system the frame so far produced (after a rotation, about the rotated axes), so it
+        is composed after the additive ops; a mirror twice on one axis is none."""
+        m = [list(r) for r in IDENT]
+        for a, v in values.items():
+            if a in _IDX:
+                m[_IDX[a]][_IDX[a]] = -1.0 if kind == "mirror" else v
+        self.extra = compose(self.extra, (tuple(tuple(r) for r in m), (0.0, 0.0, 0.0)))  # type: ignore
+        self._rebuild()
+
     def set_scale(self, factors: dict[str, float], pivot: dict[str, float]) -> None:
         if not factors:
             self.scale = None
@@ -157,6 +168,10 @@ class ProgrammableFrame:
         """Rotation about `axis` (the normal of the active plane); axis None cancels."""
         if axis is None:
             self.rot = None
+            if self.extra[0] != IDENT:
+                # the rotations added so far go too (Fagor `G73` alone cancels the G73 Q it
+                # accumulated, spec 10.5); only rotations put a matrix into the additive part
+                self.extra = ID_AFFINE
         elif additive:
             self.extra = compose(self.extra, _about(rotation(axis, deg), pivot))
         elif self.rot is not None and pivot.get("_chain"):

@@ -9,6 +9,7 @@ from the machine point (_resync): nothing moves. A mixin of Interpreter.
 """
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Any, Optional
 
 from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
@@ -28,6 +29,18 @@ def copy_frame(src: ProgrammableFrame, dst: Optional[ProgrammableFrame] = None) 
         v = getattr(src, slot)
         setattr(dst, slot, dict(v) if type(v) is dict else v)
     return dst
+
+
+@lru_cache(maxsize=None)
+def additive_frames_compose(dialect: str) -> bool:
+    """Whether the dialect's additive mirror and scale act in the current (rotated) system
+    (rules/<dialect>.toml options.additive_frames = "current_system": Sinumerik AMIRROR/ASCALE),
+    rather than replacing their component of a fixed-order frame (Fagor G11-G14, G72)."""
+    from nctrans.rules import load_table
+    try:
+        return load_table(dialect).options.get("additive_frames") == "current_system"
+    except Exception:       # no table of that name (a test dialect)
+        return False
 
 
 class OffsetsMixin:
@@ -239,6 +252,9 @@ class OffsetsMixin:
                             fr.set_rotation(a.upper(), ang, center(),
                                             additive=s.additive or not first)
                             first = False
+        elif op in ("scale", "mirror") and s.additive and not s.clear and additive_frames_compose(self.program.dialect):
+            vals = {a.upper(): num(e, f"{a} {op}", False) for a, e in s.values.items()}
+            fr.add_in_current_system(op, {a: v for a, v in vals.items() if v is not None})
         elif op == "scale":
             if s.clear:
                 fr.set_scale({}, {})

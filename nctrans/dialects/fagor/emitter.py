@@ -768,6 +768,12 @@ class FagorEmitter(FagorSpelling, Emitter):
     def frame(self, s: n.FrameOp, word) -> None:
         scale, rotation = self.code_for("frame", "scale"), self.code_for("frame", "rotation")
         mirror_off, shift = self.code_for("frame", "mirror_off"), self.code_for("incremental_offset")
+        if s.op in ("scale", "mirror") and s.additive and not s.clear:
+            from nctrans.interp.offsets import additive_frames_compose
+            if additive_frames_compose(self.program.dialect):
+                # Sinumerik AMIRROR/ASCALE compose in the current (rotated, mirrored) system;
+                # Fagor's G11-G14 and G72 replace the mirror set and the factor in a fixed order
+                raise NotExpressible(f"an additive {s.op} in the current coordinate system")
         if s.op == "scale":
             if s.clear:
                 word("", scale, alone=True)
