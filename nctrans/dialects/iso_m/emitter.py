@@ -996,6 +996,9 @@ class IsoEmitter(IsoSpelling, Emitter):
         a1, a2, a3 = pl.PLANE.get(self.plane, pl.PLANE["XY"])
         if s.center or s.radius is not None or s.turns is not None or s.polar or s.machine_coords:
             raise NotExpressible("a three-point arc (CIP) with centre, radius or turn words")
+        if self.diameter and "X" in (a1, a2):
+            # the points are diameters in X: the circle through them is not the arc's
+            raise NotExpressible("a three-point arc (CIP) with X programmed as a diameter")
         extra = (set(s.target) | set(s.via)) - {a1, a2, a3}
         if extra:
             raise NotExpressible(f"a three-point arc (CIP) moving {', '.join(sorted(extra))}")
@@ -1041,6 +1044,8 @@ class IsoEmitter(IsoSpelling, Emitter):
             raise NotExpressible("an arc by opening angle (AR=) with a centre or a computed angle")
         if any(a not in start or a not in self.pos for a in (a1, a2)):
             raise NotExpressible("an arc by opening angle (AR=) from or to a point that is not a constant")
+        if self.diameter and "X" in (a1, a2):
+            raise NotExpressible("an arc by opening angle (AR=) with X programmed as a diameter")
         chord = math.hypot(self.pos[a1] - start[a1], self.pos[a2] - start[a2])
         r = chord / (2 * math.sin(math.radians(ang) / 2))
         self.lowered("arc by opening angle (AR=) written with the radius R of that arc")

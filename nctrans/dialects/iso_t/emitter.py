@@ -59,6 +59,15 @@ class TurningEmitter(iso.IsoEmitter):
             words.append((letter, self.addr(letter, value)))
         return words
 
+    def _cip(self, s: n.Motion):
+        """The mill's three-point arc, computed in the IR's units: X is a radius there unless the
+        program is in diameter mode, and the X word of a lathe is a diameter (I stays a radius)."""
+        words = super()._cip(s)
+        if self.diameter:
+            return words
+        return [(k, "X" + iso.format_number(2 * float(w[1:]), True)) if k == "X" else (k, w)
+                for k, w in words]
+
     def w_ToolSelect(self, s):
         t = s.tool
         if type(t) is n.Num and t.value == int(t.value) and 0 <= t.value < 100:
