@@ -184,3 +184,11 @@ def test_three_point_and_opening_angle_arcs_under_diamon_convert_to_the_same_pat
     recs, _ = run(src)
     arc = [r for r in recs if r.kind == "arc"][0]
     assert (round(arc.center["X"], 6), round(arc.center["Z"], 6)) == (20.0, -20.0)
+
+
+def test_fagor_g73_alone_cancels_the_accumulated_rotation():
+    # G73 Q30 (incremental, spec 10.5): X10 -> (8.660254, 5); `G73` alone cancels it, so X20 Y0
+    # is (20, 0). Before, the accumulated rotation stayed: (17.320508, 10)
+    recs, _ = run("%T\nG00 X0 Y0 Z0\nG73 Q30\nG01 X10 Y0 F100\nG73\nG01 X20 Y0\nM30\n", "fagor")
+    ends_xy = [(round(r.end["X"], 6), round(r.end["Y"], 6)) for r in recs if r.kind == "linear"]
+    assert ends_xy == [(8.660254, 5.0), (20.0, 0.0)]
