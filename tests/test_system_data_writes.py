@@ -140,7 +140,8 @@ def test_unmodelled_read_is_a_warning_never_zero():
     recs, diags = run("G0 X5\nR1=$AA_OFF[X]\nG0 X=R1\nR2=$P_UNKNOWN_THING\nM30\n")
     assert ends(recs) == [(5, 0, 0)]                    # the X word is left out, not 0
     got = sorted((d.line, d.rule) for d in diags if d.severity == "warning")
-    assert got == [(2, "NC236"), (4, "NC236")]
+    # the read (NC236) and the X word it leaves out (NC107, line 3) are both said
+    assert got == [(2, "NC236"), (3, "NC107"), (4, "NC236")]
 
 
 def test_cr_on_g1_is_reported_and_the_line_is_straight():
