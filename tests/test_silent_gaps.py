@@ -192,3 +192,15 @@ def test_fagor_g73_alone_cancels_the_accumulated_rotation():
     recs, _ = run("%T\nG00 X0 Y0 Z0\nG73 Q30\nG01 X10 Y0 F100\nG73\nG01 X20 Y0\nM30\n", "fagor")
     ends_xy = [(round(r.end["X"], 6), round(r.end["Y"], 6)) for r in recs if r.kind == "linear"]
     assert ends_xy == [(8.660254, 5.0), (20.0, 0.0)]
+
+
+def test_a_fagor_mirror_set_converts_to_sinumerik_as_the_same_path():
+    # G14 X-1 Y-1 then G14 X1: Y alone stays mirrored, X10 Y5 -> (10, -5). Written as AMIRROR
+    # (which adds to the mirror in force) it came out unmirrored: (10, 5)
+    import nctrans
+    src = "%T\nG00 X0 Y0 Z5\nG14 X-1 Y-1\nG01 X10 Y5 F100\nG14 X1\nG01 X10 Y5\nG10\nG01 X10 Y5\nM30\n"
+    recs, _ = run(src, "fagor")
+    assert [(r.end["X"], r.end["Y"]) for r in recs if r.kind == "linear"] == [
+        (-10.0, -5.0), (10.0, -5.0), (10.0, 5.0)]
+    conv = nctrans.transpile(src, read="fagor", write="sinumerik")
+    assert conv.ok and nctrans.equiv(src, conv.text, read_a="fagor", read_b="sinumerik")

@@ -203,7 +203,16 @@ def _constructs(dialect: str, data: dict) -> list[tuple[str, str]]:
     for nv in opts.get("numbered_variables", []):
         variables += [f"#{nv['first']}", f"#{nv.get('last', nv['first'])}"]
     out += [("variable", _variable_line(dialect, v)) for v in dict.fromkeys(variables)]
+    # corner elements of the table (ISO ,R / ,C): in a contour block followed by another
+    corner = opts.get("corner_elements", {}).get("words", {})
+    out += [("code", f"G1 X1 {w}0.5" if w.startswith(",") else f"G1 X1 {w}=0.5")
+            for w in corner if dialect != "sinumerik"]
     if dialect == "sinumerik":
+        # the string and axis functions of the language (interp/strings.py), not a table:
+        # AXNAME's axis drives an axis word
+        from nctrans.interp.strings import FUNCTIONS
+        out += [("variable", 'G1 AX[AXNAME("X")]=1')]
+        out += [("function", f'R1={f}("1")') for f in FUNCTIONS if f not in ("AXNAME", "AXSTRING")]
         cycles = tomllib.loads((RULES / "cycles.toml").read_text())
         for section in ("cycle", "pattern", "milling", "swivel", "unmodelled"):
             out += [("code", f"{c['name']}()") for c in cycles.get(section, [])]

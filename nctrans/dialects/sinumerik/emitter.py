@@ -687,6 +687,12 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def frame(self, f: ir.FrameOp, out: "_Line") -> None:
         trans, trans_add = self.code_for("frame", "trans"), self.code_for("frame", "trans_add")
         add = "_add" if f.additive else ""
+        if f.op in ("mirror", "scale") and f.additive and not f.clear:
+            from nctrans.interp.offsets import additive_frames_compose
+            if not additive_frames_compose(self.program.dialect):
+                # the source's mirror set or factor replaces its component (Fagor G11-G14, G72);
+                # AMIRROR/ASCALE would compose with the one in force
+                raise NotExpressible(f"a {f.op} that replaces the one in force (AMIRROR/ASCALE add to it)")
         if f.op == "all" or (f.clear and not f.values):
             if f.op not in ("all",):
                 self.info("frame_clear", "cancelling one frame component clears the whole "
