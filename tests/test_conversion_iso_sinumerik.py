@@ -267,8 +267,16 @@ def test_sinumerik_flattened_to_iso_runs_in_rs274_with_the_same_moves(path, rs27
     out = rs274_cache / f"conv-flat--{path.parent.name}--{path.name}.ngc"
     out.write_text(res.text, encoding="utf-8")
     run = h.run_rs274(out, zero_table, out.with_suffix(".out"))
-    assert run.completed, f"rs274 stops: {run.message}"
-    problem = h.compare(run.moves, _motions(_split(c.records)), path.name)
+    records = c.records
+    no_feed = [(d.file, d.line) for d in diags if d.rule == "NC202"]
+    if no_feed and not run.completed and "zero feed rate" in run.message:
+        # a feed move with no feed (NC202) alarms on the source's controller as on LinuxCNC:
+        # the flattened program writes it as the feed move it is and stops there in rs274 too
+        first = next(i for i, r in enumerate(records) if (r.file, r.line) == no_feed[0])
+        records = records[:first]
+    else:
+        assert run.completed, f"rs274 stops: {run.message}"
+    problem = h.compare(run.moves, _motions(_split(records)), path.name)
     assert problem is None, problem
 
 

@@ -131,7 +131,7 @@ class MotionMixin:
         mstart = self.mpos
         self.mpos = mend
         sp = self.span
-        if feed is None:
+        if motion == "rapid":           # a feedless G1 stays a feed move (NC202), as on the general path
             rec = ToolpathRecord(0, sp.file, sp.line, "rapid", mstart, mend, None, None, None,
                                  None, None, None, st.spindle_speed, st.tool)
         else:
