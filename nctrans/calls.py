@@ -13,6 +13,10 @@ target control provides agree on it without seeing each other; the output names 
 A kept call's arguments, as `equiv` compares them, are positional: a G65's letters count in the
 order a PROC's parameters are passed as letters (A B C D E F H M Q R S T U V W X Y Z, then I J K),
 a letter not passed is an omitted argument, so `CALL(1,,3)` and `G65 P.. A1. C3.` are one call.
+An argument passed by reference (a VAR parameter of the call's declaration, Sinumerik EXTERN, or a
+whole array) is no part of the event: a G65 passes it in memory (the spill slots of
+nctrans.dialects.iso_m.plan), not as a letter, and what the unknown callee does with it is not
+modelled on either side, so `FOO(ARR, 2)` with FOO(VAR REAL[3], REAL) and `G65 P.. A2.` are one call.
 `call_keys` gives the identities one call may have, so `equiv` can tell that a kept call in the
 conversion is the same call as in the source (an opaque event: same call, same evaluated
 arguments, same point of the toolpath).
@@ -64,6 +68,14 @@ def call_arguments(call) -> list:
     named = sorted(call.named_args.items(), key=lambda kv: (
         bound[kv[0]] if isinstance(bound[kv[0]], int) else 1000, kv[0]))
     return list(call.args) + [e for _, e in named]
+
+
+def by_reference(declared: Optional[list], count: int) -> Optional[list[bool]]:
+    """Per positional argument of a call: passed by reference as the declaration says (the
+    `extern_params` signature: dicts with by_ref and dims), or None when there is no usable one."""
+    if declared is None or len(declared) < count:
+        return None
+    return [bool(p.get("by_ref")) or bool(p.get("dims")) for p in declared[:count]]
 
 
 STRING_NUMBERS = 10_000_000

@@ -587,7 +587,9 @@ def differences(a: Iterable[ToolpathRecord], b: Iterable[ToolpathRecord], tol: f
                     side, t = ("A", ta) if a_event else ("B", tb)
                     other = "B" if side == "A" else "A"
                     msg = f"{_fmt_event(t[1], t[2])} in {side} has no counterpart in {other}"
-                    found = Difference(msg, t[3], last_b) if side == "A" else Difference(msg, last_a, t[3])
+                    ended = (tb if side == "A" else ta) is None       # the other toolpath is over
+                    found = (Difference(msg, t[3], last_b, at_end=ended) if side == "A"
+                             else Difference(msg, last_a, t[3], at_end=ended))
                 s = sa if a_event else sb
                 t = s.take()
                 if a_event:

@@ -34,3 +34,20 @@ def test_m99_main_program_against_one_pass_is_different():
     other = api.equiv(ISO, LOOP.replace("LOOP\n", "").replace("ENDLOOP\n", ""), read_a="iso-m",
                       read_b="sinumerik")
     assert not other and not other.endless
+
+
+def test_a_call_event_past_the_end_of_the_other_toolpath_is_a_difference_at_its_end():
+    # two endless runs cut by the step budget at different points: when the longer one's next
+    # record is a kept call (an event, not motion), the difference is still "the other ended"
+    # (at_end), so both-endless runs that agreed on everything both ran are equivalent
+    from nctrans.equivalence import compare
+    from nctrans.toolpath import ToolpathRecord as R
+    o, p = {"X": 0.0, "Y": 0.0, "Z": 0.0}, {"X": 1.0, "Y": 0.0, "Z": 0.0}
+    q = {"X": 1.0, "Y": 2.0, "Z": 0.0}
+    move = R(0, "a", 1, "rapid", o, p)
+    call = R(0, "a", 2, "call", call="FOO", args=[2.0])
+    d = compare([move, call], [move])
+    assert d is not None and d.at_end and "no counterpart" in d.message
+    # a call missing in the middle is not at the end
+    d = compare([move, call, R(0, "a", 3, "rapid", p, q)], [move, R(0, "b", 3, "rapid", p, q)])
+    assert d is not None and not d.at_end

@@ -16,6 +16,9 @@ from test_output_vocabulary import TARGETS, _sweep_programs
 # blocks (the whole corpus at 20 KB was swept by hand: see the issue note)
 _EQUIV_BYTES = 6_000
 _STEPS = "20000"
+# a finite program whose conversion has more blocks per loop pass (ISO passes arrays in spill
+# slots) may run out of the small budget on one side only: compared again with this one
+_STEPS_AGAIN = "200000"
 
 # "source->target file name": why the conversion still differs from its source
 KNOWN = {
@@ -30,20 +33,17 @@ KNOWN = {
     # starts an ISO main program again (B runs its calls a second time)
     **{f"sinumerik->{t} {name}": "M17 in a main program written as M99 (a restart in ISO)"
        for t in ("iso-m", "iso-t") for name in ("nadj-fb422-VAL_TEST.MPF", "nadj-fb422-VINT_PRAVKA.MPF")},
-    # arrays passed by reference are no part of a call event: the converted G65 passes the third
-    # PROC parameter as its first letter A (the ISO caller and subprogram agree with each other)
-    **{f"sinumerik->{t} rhoden-SINULORENZ.MPF": "by-reference array arguments shift the call "
-       "event's positions" for t in ("iso-m", "iso-t")},
-    # a G1 with no F (NC202): the milling interpreter's fast path records it as a rapid, the
-    # lathe's (always the general path) as a feed move; recording it as a feed move makes
-    # flattened Sinumerik output write G1 with no F, which rs274 refuses (ROLIK2_UJEDNO.DRS)
-    "iso-m->iso-t donpayne-haas-O1012-gauge-tool.cnc": "a feedless G1 is a rapid on the milling "
-        "fast path only",
 }
 
 
 def _pairs(target: str) -> list[tuple[str, str]]:
     return [(p, d) for p, d in _sweep_programs() if d != target and Path(p).stat().st_size <= _EQUIV_BYTES]
+
+
+def _cut_on_one_side(same) -> bool:
+    """The difference is only that one run stopped at the step budget (NC205) and the other went on."""
+    cut = {d.file for d in same.diagnostics if d.rule == "NC205" and d.severity == "error"}
+    return same.difference is not None and same.difference.at_end and len(cut) == 1
 
 
 @pytest.mark.parametrize("target", TARGETS)
@@ -60,6 +60,10 @@ def test_every_converted_corpus_program_is_equiv_to_its_source(target, monkeypat
                 problems.append(f"{key}: refused without a located error")
             continue
         same = nctrans.equiv(Path(path), conv.text, read_a=source, read_b=target)
+        if not same and _cut_on_one_side(same):
+            monkeypatch.setenv("NCTRANS_MAX_STEPS", _STEPS_AGAIN)
+            same = nctrans.equiv(Path(path), conv.text, read_a=source, read_b=target)
+            monkeypatch.setenv("NCTRANS_MAX_STEPS", _STEPS)
         if key in KNOWN:
             if same:
                 agreeing_exceptions.append(key)
@@ -74,6 +78,41 @@ def test_every_converted_corpus_program_is_equiv_to_its_source(target, monkeypat
 
 
 # ------------------------------------------------------- defects the sweep found, by hand
+
+def test_a_feed_move_without_a_feed_is_a_feed_move_on_every_path():
+    # corpus O1012: `G91 G01 Z-.08` with no F in force is NC202; the milling fast path recorded it
+    # as a rapid, the lathe (general path) as a feed move, so iso-m -> iso-t looked different. It
+    # is a feed move with no feed everywhere: the controller alarms at it (LinuxCNC: "Cannot do g1
+    # with zero feed rate"), it never becomes a rapid
+    text = "G0 X-0.25 Y0\nG91 G1 Z-0.08\nG90\nM30\n"
+    out = nctrans.transpile(text, read="iso-m", write="iso-t").text
+    for program, dialect in ((text, "iso-m"), (out, "iso-t")):
+        moves = [(r.kind, r.end["Z"], r.feed) for r in nctrans.toolpath(program, dialect) if r.kind != "stop"]
+        assert moves == [("rapid", 0.0, None), ("linear", -0.08, None)], (dialect, program)
+        assert [d.rule for d in nctrans.lint(program, dialect=dialect)].count("NC202") == 1
+    assert nctrans.equiv(text, out, read_a="iso-m", read_b="iso-t")
+    # flattened (plain motion from the toolpath) it is refused at its line, never written as a G0
+    flat = nctrans.transpile(text, read="iso-m", write="sinumerik", flatten=True)
+    assert flat.text is None and ("NC202", 2) in [(d.rule, d.line) for d in flat.diagnostics]
+
+
+@pytest.mark.parametrize("extern", ["EXTERN FOO(VAR REAL[3], REAL)\n", ""])
+def test_arrays_passed_by_reference_are_no_part_of_a_kept_calls_event(extern):
+    # corpus SINULORENZ: LORENZ_RUKU4(STATE, STATE_PLUS, DELTA) with two VAR arrays. The ISO caller
+    # passes the arrays in spill slots and DELTA as letter A; the source's event had (, , 0.02) and
+    # the converted one (0.02). The arrays go in memory on both sides, so the event is (DELTA)
+    text = f"DEF REAL S[3], DELTA\n{extern}DELTA=2\nS[1]=7\nFOO(S, DELTA)\nFOO(S, DELTA+1)\nM30\n"
+    calls = [(r.call, r.args) for r in nctrans.toolpath(text, "sinumerik") if r.kind == "call"]
+    assert calls == [("FOO", [2.0]), ("FOO", [3.0])]
+    out = nctrans.transpile(text, read="sinumerik", write="iso-m").text
+    assert "#[#149+151]=#501" in out            # S[1] goes to the callee in its spill slot
+    iso_calls = [(r.call, r.args) for r in nctrans.toolpath(out, "iso-m") if r.kind == "call"]
+    assert iso_calls == [("O9403", [2.0]), ("O9403", [3.0])]
+    assert nctrans.equiv(text, out, read_a="sinumerik", read_b="iso-m")
+    # a wrong value passed is still a difference
+    wrong = out.replace("G65 P9403 A[#100+1]", "G65 P9403 A[#100+2]")
+    assert wrong != out and not nctrans.equiv(text, wrong, read_a="sinumerik", read_b="iso-m")
+
 
 def test_linuxcnc_o_word_control_flow_is_a_located_error_not_subprograms():
     # read as program numbers, `o100 sub` .. made the rest of the file subprograms: no toolpath,

@@ -198,9 +198,13 @@ class CallsMixin:
         """A call nothing here defines: a "call" record (name, evaluated arguments in the order
         nctrans.calls.call_arguments gives; a string as its string number), so a conversion that
         keeps the call can be compared with its source."""
-        from nctrans.calls import SPILLED_AFTER, call_arguments, string_number
+        from nctrans.calls import SPILLED_AFTER, by_reference, call_arguments, string_number
         values = []
-        for e in call_arguments(s):
+        declared = ((self.program.meta or {}).get("extern_params") or {}).get(str(s.name).upper())
+        by_ref = by_reference(declared, len(s.args)) or [self._whole_array(e) for e in s.args]
+        for i, e in enumerate(call_arguments(s)):
+            if i < len(by_ref) and by_ref[i]:
+                continue                        # passed in memory, not as a value (nctrans.calls)
             if e is None or (type(e) is n.Num and e.text == ""):
                 values.append(None)             # an omitted argument
                 continue
@@ -215,6 +219,16 @@ class CallsMixin:
         if s.named_args and not s.args and len(values) >= SPILLED_AFTER and values[SPILLED_AFTER - 1] is not None:
             values = self._with_spilled(values)     # all 18 letters used: more may be spilled
         self._record("call", call=s.name, args=values)
+
+    def _whole_array(self, e) -> bool:
+        """A call argument naming a whole array (passed by reference wherever it is passed)."""
+        if type(e) is not n.Var or e.space != "name" or e.indices:
+            return False
+        try:
+            from nctrans.interp.evaluate import Array
+            return isinstance(self.ev.make_ref(e), Array)
+        except EvalError:
+            return False
 
     def _with_spilled(self, values: list) -> list:
         """A G65 of a converted program passes the parameters past its 18 letters in the spill
