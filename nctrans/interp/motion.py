@@ -344,6 +344,9 @@ class MotionMixin:
         """G53: the words are machine coordinates of the controlled point, this block only."""
         if self.corner is not None:     # a held move first: G53 starts from where it ends
             corner_elements.flush(self, "the next move is in machine coordinates (G53)")
+        for a, _, _ in vals:
+            if a not in self.mpos:
+                self._new_axis(a)   # first use: from machine 0, as any other move (not a jump)
         mend = dict(self.mpos)
         for a, v, _ in vals:
             mend[a] = v
