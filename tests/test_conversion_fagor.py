@@ -130,3 +130,46 @@ def test_iso_length_offset_of_another_tool_is_refused_for_fagor(tmp_path):
     own = api.transpile(src.format(h=2), read="iso-m", write="fagor")
     assert own.text is not None and "D2" in own.text
     assert api.equiv(src.format(h=2), own.text, read_a="iso-m", read_b="fagor", machine=machine).equivalent
+
+
+# ------------------------------------------------------------- ISO length over a tool change
+
+_GEOMETRY = REPO / "tests" / "data" / "rs274-geometry-machine.toml"     # tool n: 50.8 + 2.54 n mm
+
+
+def test_iso_length_off_over_a_tool_change_is_d0_on_fagor():
+    # a Fagor M06 brings D1 of the new tool (length on); the ISO program has no G43: Z10 is Z10
+    # with tool 2 (55.88 mm) in the spindle, not Z65.88. D0 before the first Z move keeps it
+    import nctrans
+    text = "%\nO1\nG21 G90\nT2 M6\nG0 X1. Y2.\nG0 Z10.\nM30\n%\n"
+    out = nctrans.transpile(text, read="iso-m", write="fagor").text
+    code = [line.split(";")[0].strip() for line in out.splitlines()]
+    assert "G00 X1 Y2" in code and "G00 Z10 D0" in code, out      # X/Y alone do not show it
+    ends = [r.end["Z"] for r in nctrans.toolpath(out, "fagor", machine=_GEOMETRY) if r.kind == "rapid"]
+    assert ends == [0.0, 10.0]
+    assert nctrans.equiv(text, out, read_a="iso-m", read_b="fagor", machine=_GEOMETRY)
+
+
+def test_iso_length_register_of_the_old_tool_after_a_tool_change_is_refused_on_fagor():
+    # ISO keeps G43 H1 (53.34 mm) over T2 M6: Z10 is machine Z63.34; a Fagor M06 applies tool 2's
+    # D1 (Z65.88) and no Fagor D takes tool 1's length: refused at the Z move, never 2.54 mm off
+    import nctrans
+    text = "%\nO1\nG21 G90\nT1 M6\nG43 H1 Z50.\nG0 X0 Y0\nT2 M6\nG0 Z10.\nM30\n%\n"
+    z = [r.end["Z"] for r in nctrans.toolpath(text, "iso-m", machine=_GEOMETRY) if r.kind == "rapid"]
+    assert z[-1] == pytest.approx(63.34)
+    conv = nctrans.transpile(text, read="iso-m", write="fagor")
+    assert conv.text is None
+    assert ("NC402", 8) in [(d.rule, d.line) for d in conv.diagnostics if d.severity == "error"]
+
+
+def test_iso_length_set_again_after_a_tool_change_stays_structural_on_fagor():
+    # the usual CAM order: T2 M6, X/Y, then G43 H2 with the first Z move: nothing saw H1 between,
+    # so no D0 and no refusal; H2 under T2 is tool 2's own length (Z5 -> machine Z60.88)
+    import nctrans
+    text = ("%\nO1\nG21 G90\nT1 M6\nG43 H1 Z50.\nG0 X0 Y0\nT2 M6\nS1000 M3\nG0 X5. Y5.\n"
+            "G43 H2 Z10.\nG1 Z5. F100.\nM30\n%\n")
+    conv = nctrans.transpile(text, read="iso-m", write="fagor")
+    assert conv.text is not None and "D0" not in conv.text, conv.diagnostics
+    z = [r.end["Z"] for r in nctrans.toolpath(conv.text, "fagor", machine=_GEOMETRY) if r.kind == "linear"]
+    assert z == [pytest.approx(5.0 + 55.88)]
+    assert nctrans.equiv(text, conv.text, read_a="iso-m", read_b="fagor", machine=_GEOMETRY)

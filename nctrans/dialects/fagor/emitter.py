@@ -218,6 +218,17 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.tap_cancelled = False                    # an M3/M4/M5/M19 ended G63 on the control
         self.s_negative = False                       # a G63 wrote S negative: positive before M3/M4
         self.spindle_dir: Optional[str] = None
+        # An ISO source keeps its length register (G43 H<k>) over a tool change, where a Fagor
+        # M06 brings D1 of the new tool: what the ISO program has in force ("off", a register
+        # number, None: not known) and, after an M06 that made them differ, what Fagor must still
+        # be told before a block lets the length show ("off": write D0; a register: refused)
+        # (a mill's: a lathe applies no length along the tool axis, its T<tt><oo> selects the offset)
+        self.registers = (program.dialect != DIALECT and not _table_option(program.dialect, "edge_offsets")
+                          and _machine_kind(program.dialect) == "mill")
+        self.iso_length: Any = "off"
+        self.iso_h: Optional[float] = None
+        self.length_behind: Any = None
+        self.comp_on = False
 
     def lowered(self, what: str, once: Any = None) -> None:
         """Each lowering once per source line."""
@@ -236,11 +247,13 @@ class FagorEmitter(FagorSpelling, Emitter):
             self.out.append(f"%L {_sub_name(name)}")
             self.in_sub = True
             self.tool_selected = self.tool_active = None    # called with whatever tool is in the spindle
+            self.iso_length, self.iso_h, self.length_behind = None, None, None   # the caller's
             self._reset()
             self.nodes(sub.body)
             if not ir_walk.ends_with_return(sub.body):
                 self.out.append(self.code_for("return"))
         self.in_sub = False
+        self.iso_length, self.iso_h, self.length_behind = "off", None, None
         self._reset()
         self.out.append(f"%{_program_header(p)}")
         self.prologue()
@@ -301,6 +314,8 @@ class FagorEmitter(FagorSpelling, Emitter):
                 self.nodes(run_blocks(node))
                 continue
             self.span = getattr(node, "span", self.span)
+            if self.length_behind is not None and (t is not n.Block or _is_target(node, self.targets)):
+                self._length_shows(None)
             if t is n.Block:
                 self.block(node)
             elif t is n.If:
@@ -428,7 +443,30 @@ class FagorEmitter(FagorSpelling, Emitter):
 
     def statement(self, s, word, new_line, rest: list) -> int:
         """Write one statement (`w_<NodeType>`); returns how many following statements it consumed."""
+        if self.length_behind is not None and _shows_length(s):
+            self._length_shows(word)
         return self.dispatch("w_", s, word, new_line, rest) or 0
+
+    def _length_shows(self, word) -> None:
+        """A block (or structure) that lets the tool length show while Fagor's M06 has put D1 of
+        the new tool where the ISO program keeps another length: D0 where the ISO length is off,
+        else refused (no Fagor D takes another tool's length)."""
+        behind, self.length_behind = self.length_behind, None
+        if behind == "off" and not self.comp_on:
+            if word is None:
+                self.out.append("D0")
+            else:
+                word("D", "D0")
+            self.length_on = False
+            self.lowered("ISO tool length off over the tool change: D0 written, as a Fagor M06 "
+                         "applies the new tool's offset D1")
+            return
+        what = ("no length (G49, or none selected)" if behind == "off"
+                else f"the length of register H{behind:g}")
+        raise NotExpressible(f"{what} still in force after the tool change to T{self.tool_active:g} "
+                             "(ISO keeps it until G43/G49; a Fagor M06 applies the new tool's own "
+                             "offset D1" + (", and D0 would end the radius compensation)" if
+                                            behind == "off" else ", and no Fagor D takes another tool's length)"))
 
     def w_Motion(self, s: n.Motion, word, new_line, rest: list):
         self.motion_words(s, word)
@@ -482,6 +520,9 @@ class FagorEmitter(FagorSpelling, Emitter):
         if not self.length_on:
             self.lowered("M06 on Fagor activates offset D1 of the new tool (tool length on)")
         self.length_on, self.radius_index = True, 1
+        if self.registers and self.tool_active is not None and self.iso_length is not None \
+                and self.iso_length != self.tool_active:
+            self.length_behind = self.iso_length        # until the program sets its length again
 
     def w_OffsetSelect(self, s: n.OffsetSelect, word, new_line, rest: list):
         val = self.value
@@ -492,6 +533,10 @@ class FagorEmitter(FagorSpelling, Emitter):
                 self.lowered("D selects the tool length offset too on Fagor")
         else:
             self._length_of_active_tool(s.index)
+            self.iso_h = _num(s.index)
+            if self.iso_length != "off":
+                self.iso_length = self.iso_h
+            self.length_behind = None
             word("D", "D" + val(s.index))
             self.lowered("length offset H written as the Fagor offset D of the active tool")
 
@@ -629,6 +674,8 @@ class FagorEmitter(FagorSpelling, Emitter):
                 self.tap_cancelled = False
                 word("GMOTION", self.code_for("motion", "tap_interp"))
                 return 0
+        if g == "cutter_comp":
+            self.comp_on = v != "off"
         if g == "distance":
             self.distance = v
         if g == "plane":
@@ -636,13 +683,17 @@ class FagorEmitter(FagorSpelling, Emitter):
         if g == "tool_length":
             if v == "minus":
                 raise NotExpressible("negative tool length compensation (G44)")
+            self.length_behind = None
             if v == "off":
                 self.length_on = False
+                self.iso_length = "off"
                 word("D", "D0")
                 return 0
             self.length_on = True
             # a Fagor source names its D in the code; an ISO G43 takes the H of this block
             nxt = next((x for x in rest if isinstance(x, n.OffsetSelect)), None)
+            h = _num(nxt.index) if nxt is not None and nxt.kind == "length" else self.iso_h
+            self.iso_length = h if h is not None else self.tool_active
             if nxt is not None and nxt.kind == "length":
                 self._length_of_active_tool(nxt.index)
             if s.code.upper().startswith("D") and len(s.code) > 1:
@@ -828,6 +879,41 @@ def _word_order(w: str) -> int:
     if w.startswith(("$", "P", "V.", "L", "LL")) and not w[:1] in "G":
         return 100 if not w.startswith("#") else 0
     return _ORDER.get(w[:1], 50)
+
+
+# statements that never let the control see the tool length (a motion is judged by its axes)
+_LENGTH_HIDDEN = (n.ToolSelect, n.ToolChange, n.OffsetSelect, n.Feed, n.SpindleSpeed, n.SpindleLimit,
+                  n.Dwell, n.Stop, n.Message, n.VarDecl, n.Assign, n.ModeChange, n.ProgramEnd)
+
+
+def _shows_length(s) -> bool:
+    """A statement that can show the tool length: a move with a tool-axis (or any non-X/Y) word,
+    machine coordinates, polar or indirect axes; anything not known to hide it (a call, a jump)."""
+    if type(s) is n.Motion:
+        return bool(s.machine_coords or s.polar or s.indirect or any(a.upper() not in ("X", "Y") for a in s.target))
+    if type(s) is n.ModeChange:
+        return s.group == "cycle"
+    return not isinstance(s, _LENGTH_HIDDEN)
+
+
+def _is_target(b, targets: set) -> bool:
+    """A block a jump may land on (its state depends on the path)."""
+    num = str(b.number).upper().lstrip("N") if b.number is not None else None
+    return b.label is not None or (num is not None and num.isdigit() and _key(num) in targets)
+
+
+def _machine_kind(dialect: str) -> Optional[str]:
+    try:
+        return get_dialect(dialect).machine_kind
+    except Exception:           # a dialect not registered here (a test's)
+        return None
+
+
+def _table_option(dialect: str, key: str) -> Any:
+    try:
+        return load_table(dialect).options.get(key)
+    except Exception:           # a dialect without a table of its own (a test's)
+        return None
 
 
 def _num(e) -> Optional[float]:
