@@ -173,3 +173,19 @@ def test_iso_length_set_again_after_a_tool_change_stays_structural_on_fagor():
     z = [r.end["Z"] for r in nctrans.toolpath(conv.text, "fagor", machine=_GEOMETRY) if r.kind == "linear"]
     assert z == [pytest.approx(5.0 + 55.88)]
     assert nctrans.equiv(text, conv.text, read_a="iso-m", read_b="fagor", machine=_GEOMETRY)
+
+
+def test_iso_g49_under_radius_compensation_is_not_a_fagor_d0():
+    # a Fagor D0 ends length and radius compensation (8065 manual, tool offsets); an ISO G49 under
+    # G41 ends the length only: never written as D0 there. The analysis says at the G49 that the
+    # held compensated move before it takes the new length (not modelled exactly: NC220)
+    import nctrans
+    text = ("%\nO1\nG21 G17 G90 G94\nT1 M6\nG43 H1 Z50.\nG0 X-10. Y0\nG1 Z-1. F100.\nG41 D1 X0 Y0\n"
+            "G1 X20.\nG49\nG1 Y20.\nG40 X30. Y30.\nG0 Z50.\nM30\n%\n")
+    conv = nctrans.transpile(text, read="iso-m", write="fagor")
+    said = [(d.rule, d.line) for d in conv.diagnostics if "D0 ends the radius" in d.message]
+    assert said and said[0][1] == 10
+    assert conv.text is None or "flattened" in conv.text
+    lint = [(d.rule, d.line) for d in nctrans.lint(text, dialect="iso-m", machine=_GEOMETRY)]
+    assert ("NC220", 10) in lint
+    assert ("NC220", 10) not in [(d.rule, d.line) for d in nctrans.lint(text, dialect="iso-m")]

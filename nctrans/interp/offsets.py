@@ -98,6 +98,12 @@ class OffsetsMixin:
             z = self.machine.length_offset(int(idx)) if idx else 0.0
             if st.length_mode == "minus":
                 z = -z
+        if self.comp is not None and z != self.off.tool_z:
+            # the compensated move held before this block is written when the next one comes,
+            # with the offsets then in force: said, not silently shifted (LinuxCNC refuses it)
+            self.diag("NC220", "warning", "a tool length change under cutter radius compensation is "
+                      "not modelled exactly: the compensated move before this block is analysed "
+                      "with the new length (LinuxCNC refuses the change; end the compensation first)")
         self.off.set_tool(z)
         self._resync()
         if self.travel_limits is not None:      # limits on the tool tip follow its length

@@ -685,6 +685,10 @@ class FagorEmitter(FagorSpelling, Emitter):
                 raise NotExpressible("negative tool length compensation (G44)")
             self.length_behind = None
             if v == "off":
+                if self.comp_on and self.registers:
+                    raise NotExpressible("tool length off (G49) under cutter radius compensation: a "
+                                         "Fagor D0 ends the radius compensation too (8065 manual, "
+                                         "tool offsets)")
                 self.length_on = False
                 self.iso_length = "off"
                 word("D", "D0")
