@@ -4,7 +4,10 @@ Two record streams are cut into the same shape of sequence: *runs* of consecutiv
 class (rapid or feed), separated by *gaps* holding what changed in between (tool changes, spindle
 speed and direction, coolant, dwells, stops) and by feed-rate changes. Runs compare geometrically:
 arcs are discretised into chords (sag well under the tolerance), and each run's points must lie
-within `tol` mm of the other run's polyline, in order, both ways, with matching end points. So an
+within `tol` mm of the other run's polyline, in order (each found no earlier along the other
+polyline than the one before it: a move back along its own line is a difference), both ways,
+with matching end points. Where a move stops along a straight line is not compared: two
+collinear moves in one direction (Z110 -> Z105 -> Z54) are the path of one (Z110 -> Z55 -> Z54). So an
 arc in one program equals the same arc written as short lines in the other. Gaps compare by order
 and value of their events, after dropping events that change nothing (S1000 M3 on one line equals
 S1000 then M3). Zero-length moves are ignored. The first difference is returned with both sides'
@@ -364,30 +367,43 @@ def _dist_point_segment(p, a, b) -> float:
     return math.dist(p, [x + t * u for x, u in zip(a, ab)])
 
 
-# Rounding allowance of the triangle-inequality bound in _segment_within (relative to the lengths).
+# Rounding allowance of the triangle-inequality bound in _Walk.step (relative to the lengths): any
+# point x of a segment q0-q1 has |p-x| >= (|p-q0| + |p-q1| - |q0-q1|) / 2, so where that bound clears
+# tol the segment is farther than tol from p without the projection.
 _BOUND_SLACK = 1e-9
 
 
-def _segment_within(p, q0, q1, d0: float, d1: float, tol: float) -> bool:
-    """Whether p lies within tol of segment q0-q1, given its distances d0, d1 to the ends. Any
-    point x of the segment has |p-x| >= (d0 + d1 - |q0-q1|) / 2 (triangle inequality), so where
-    that bound clears tol (with room for rounding) the exact projection is not needed: the answer
-    is the same, found without it (most tests of two close polylines end here)."""
-    length = math.dist(q0, q1)
-    if d0 + d1 - length > 2 * tol + _BOUND_SLACK * (d0 + d1 + length):
-        return False
-    return _dist_point_segment(p, q0, q1) <= tol
+def _earliest_along(p, a, b, t: float, tol: float) -> Optional[float]:
+    """The first position s >= t along segment a->b (0 at a, 1 at b) within tol of p, or None.
+    Matching each point at the first place it fits, never behind the last one matched, makes the
+    walk follow the path in order: a move back along its own line (Z110 -> Z40 -> Z54) is not the
+    straight Z110 -> Z54, while two collinear moves one way are the one path they cover."""
+    d = [y - x for x, y in zip(a, b)]
+    L2 = sum(v * v for v in d)
+    ap = [y - x for x, y in zip(a, p)]
+    tol2 = tol * tol
+    if L2 <= _ZERO * _ZERO:
+        return t if sum(v * v for v in ap) <= tol2 else None
+    u = sum(v * w for v, w in zip(d, ap)) / L2          # p projected on the line (unclamped)
+    h2 = max(0.0, sum(v * v for v in ap) - u * u * L2)  # squared distance from the line
+    if h2 > tol2:
+        return None
+    w = math.sqrt((tol2 - h2) / L2)                     # half the stretch of the line within tol
+    if u + w < t or u - w > 1.0:
+        return None
+    return max(t, u - w)
 
 
 class _Walk:
-    """P's points walked along Q's polyline, Q's segments visited in order: `failed` is the index
-    of the first point of P farther than tol from Q (None while none is), `j` the segment of Q
-    reached. One step is one distance test."""
+    """P's points walked along Q's polyline in order: `failed` is the index of the first point of
+    P farther than tol from Q past where the previous point was found (None while none is), `j`
+    the segment of Q reached and `t` the position on it (0..1). One step is one distance test."""
 
     def __init__(self, P: _Run, Q: _Run):
         self.P, self.Q = P, Q
         self.i = 0
         self.j = 0
+        self.t = 0.0                # position on segment j (0..1) where P's last point was found
         self.failed: Optional[int] = None
         self.finished = False
         self.stuck = 0              # steps since P's point last advanced
@@ -413,20 +429,20 @@ class _Walk:
         q0, q1 = Q.buf[k][0], Q.buf[k + 1][0]
         if len(q0) != n or len(q1) != n:
             q0, q1 = Q.point(j), Q.point(j + 1)
-        # an end point within tol puts the segment within tol (the common case: cheap to test)
-        d1 = math.dist(p, q1)
-        if d1 <= tol:
+        # the triangle-inequality bound rejects a segment far from p without the projection
+        d0, d1 = math.dist(p, q0), math.dist(p, q1)
+        length = math.dist(q0, q1)
+        far = d0 + d1 - length > 2 * tol + _BOUND_SLACK * (d0 + d1 + length)
+        at = None if far else _earliest_along(p, q0, q1, self.t, tol)
+        if at is not None:
             self.i = i + 1
-            self.stuck = 0
-            return
-        d0 = math.dist(p, q0)
-        if d0 <= tol or _segment_within(p, q0, q1, d0, d1, tol):
-            self.i = i + 1
+            self.t = at
             self.stuck = 0
         elif j + 2 >= Q.count and not Q.has(j + 2):     # j is Q's last segment
             self.failed, self.finished = self.i, True
         else:
             self.j = j + 1
+            self.t = 0.0
             self.stuck += 1
 
 

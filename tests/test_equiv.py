@@ -284,3 +284,31 @@ def test_an_axis_that_appears_late_is_compared():
     assert compare(a.recs, b.recs) is not None
     b.recs[-1].end = {**b.recs[-1].end, "A": 90.0}
     assert compare(a.recs, b.recs) is None
+
+
+def test_a_move_back_along_its_own_line_is_a_difference():
+    # Z110 -> Z40 -> Z54 passes 14 mm below Z54 and comes back: every point lies on the line of
+    # the straight Z110 -> Z54 extended, so the walk must follow the path in order to see it
+    straight = Stream().rapid(Z=110).rapid(Z=54).recs
+    overshoot = Stream("b.nc").rapid(Z=110).rapid(Z=40).rapid(Z=54).recs
+    for a, b in ((straight, overshoot), (overshoot, straight)):
+        d = compare(a, b)
+        assert d is not None and "Z40.0000" in d.message
+    # the same as feed moves, and back along a diagonal in X/Z
+    assert compare(Stream().line_to(Z=110).line_to(Z=54).recs,
+                   Stream().line_to(Z=110).line_to(Z=40).line_to(Z=54).recs) is not None
+    d = compare(Stream().rapid(X=0, Z=110).rapid(X=20, Z=90).recs,
+                Stream().rapid(X=0, Z=110).rapid(X=10, Z=100).rapid(X=5, Z=105).rapid(X=20, Z=90).recs)
+    assert d is not None and "X5.0000" in d.message
+
+
+def test_collinear_moves_one_way_are_the_one_path_they_cover():
+    # where a straight move stops on its way is not compared (contract: geometric comparison):
+    # Z110 -> Z105 -> Z54, Z110 -> Z55 -> Z54 and Z110 -> Z54 are one path; jitter within the
+    # tolerance backwards is not a reversal
+    one = Stream().rapid(Z=110).rapid(Z=54).recs
+    early = Stream().rapid(Z=110).rapid(Z=105).rapid(Z=54).recs
+    late = Stream().rapid(Z=110).rapid(Z=55).rapid(Z=54).recs
+    jitter = Stream().rapid(Z=110).rapid(Z=80).rapid(Z=80.0005).rapid(Z=54).recs
+    for a, b in ((early, late), (early, one), (late, one), (jitter, one), (one, jitter)):
+        assert compare(a, b) is None
