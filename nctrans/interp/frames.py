@@ -164,13 +164,14 @@ class ProgrammableFrame:
         self._rebuild()
 
     def set_rotation(self, axis: Optional[str], deg: float, pivot: dict[str, float],
-                     additive: bool = False) -> None:
-        """Rotation about `axis` (the normal of the active plane); axis None cancels."""
+                     additive: bool = False, cancel_added: bool = False) -> None:
+        """Rotation about `axis` (the normal of the active plane); axis None cancels, and with
+        `cancel_added` the rotations added so far go too."""
         if axis is None:
             self.rot = None
-            if self.extra[0] != IDENT:
-                # the rotations added so far go too (Fagor `G73` alone cancels the G73 Q it
-                # accumulated, spec 10.5); only rotations put a matrix into the additive part
+            if cancel_added and self.extra[0] != IDENT:
+                # (Fagor `G73` alone cancels the G73 Q it accumulated, spec 10.5; ISO G69 keeps
+                # a Sinumerik AROT); only rotations put a matrix into the additive part
                 self.extra = ID_AFFINE
         elif additive:
             self.extra = compose(self.extra, _about(rotation(axis, deg), pivot))

@@ -43,6 +43,17 @@ def additive_frames_compose(dialect: str) -> bool:
         return False
 
 
+@lru_cache(maxsize=None)
+def rotation_cancel_drops_added(dialect: str) -> bool:
+    """Whether cancelling the rotation also cancels the rotations added to it (rules/<dialect>.toml
+    options.rotation_cancel = "with_added": Fagor `G73` alone after `G73 Q` increments)."""
+    from nctrans.rules import load_table
+    try:
+        return load_table(dialect).options.get("rotation_cancel") == "with_added"
+    except Exception:       # no table of that name (a test dialect)
+        return False
+
+
 class OffsetsMixin:
     """Coordinate-system statements and the program <-> machine point mapping."""
 
@@ -237,7 +248,8 @@ class OffsetsMixin:
                 fr.set_local(vals, additive=s.additive)
         elif op == "rot":
             if s.clear:
-                fr.set_rotation(None, 0.0, {})
+                fr.set_rotation(None, 0.0, {},
+                                cancel_added=rotation_cancel_drops_added(self.program.dialect))
             else:
                 plane = st.plane
                 if s.angle is not None:
