@@ -130,11 +130,11 @@ def test_arrays_passed_by_reference_are_no_part_of_a_kept_calls_event(extern):
     # corpus SINULORENZ: LORENZ_RUKU4(STATE, STATE_PLUS, DELTA) with two VAR arrays. The ISO caller
     # passes the arrays in spill slots and DELTA as letter A; the source's event had (, , 0.02) and
     # the converted one (0.02). The arrays go in memory on both sides, so the event is (DELTA)
-    text = f"DEF REAL S[3], DELTA\n{extern}DELTA=2\nS[1]=7\nFOO(S, DELTA)\nFOO(S, DELTA+1)\nM30\n"
+    text = f"DEF REAL ST[3], DELTA\n{extern}DELTA=2\nST[1]=7\nFOO(ST, DELTA)\nFOO(ST, DELTA+1)\nM30\n"
     calls = [(r.call, r.args) for r in nctrans.toolpath(text, "sinumerik") if r.kind == "call"]
     assert calls == [("FOO", [2.0]), ("FOO", [3.0])]
     out = nctrans.transpile(text, read="sinumerik", write="iso-m").text
-    assert "#[#149+151]=#501" in out            # S[1] goes to the callee in its spill slot
+    assert "#[#149+151]=#501" in out            # ST[1] goes to the callee in its spill slot
     iso_calls = [(r.call, r.args) for r in nctrans.toolpath(out, "iso-m") if r.kind == "call"]
     assert iso_calls == [("O9403", [2.0]), ("O9403", [3.0])]
     assert nctrans.equiv(text, out, read_a="sinumerik", read_b="iso-m")
@@ -160,7 +160,7 @@ def test_a_proc_file_and_its_iso_subprogram_compare_as_called(tmp_path):
     # them called by the same one-line caller. Here the PROC moves to its parameter (vacant: 0)
     # and 5 mm up; a wrong conversion (Z6) is found
     proc = tmp_path / "UP.SPF"
-    proc.write_text("PROC UP(REAL H)\nG1 G94 X=H Z5 F100\nRET\n", encoding="utf-8")
+    proc.write_text("PROC UP(REAL HT)\nG1 G94 X=HT Z5 F100\nRET\n", encoding="utf-8")
     conv = nctrans.transpile(proc, read="sinumerik", write="iso-m").text
     same = _subprogram_as_called(proc, "sinumerik", "iso-m", conv, tmp_path)
     assert same and same.records[0] == same.records[1] >= 2, same.message
