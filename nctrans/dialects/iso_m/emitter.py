@@ -1151,6 +1151,8 @@ class IsoEmitter(IsoSpelling, Emitter):
                 return []
             e = n.Num(self.start_repeat)
         c = constant(e)
+        if c is not None and not math.isfinite(c):
+            raise NotExpressible("a thread start angle that is not a finite number")
         if self.lead_as_k and (c is None or c % 360.0):
             raise NotExpressible("a thread start angle (LinuxCNC's G33 has none)")
         if self.lead_as_k:
