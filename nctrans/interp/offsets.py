@@ -32,26 +32,26 @@ def copy_frame(src: ProgrammableFrame, dst: Optional[ProgrammableFrame] = None) 
 
 
 @lru_cache(maxsize=None)
+def _frame_option(dialect: str, key: str):
+    """options.<key> of rules/<dialect>.toml (None for a test dialect without a table)."""
+    from nctrans.rules import load_table
+    try:
+        return load_table(dialect).options.get(key)
+    except Exception:       # no table of that name (a test dialect)
+        return None
+
+
 def additive_frames_compose(dialect: str) -> bool:
     """Whether the dialect's additive mirror and scale act in the current (rotated) system
-    (rules/<dialect>.toml options.additive_frames = "current_system": Sinumerik AMIRROR/ASCALE),
-    rather than replacing their component of a fixed-order frame (Fagor G11-G14, G72)."""
-    from nctrans.rules import load_table
-    try:
-        return load_table(dialect).options.get("additive_frames") == "current_system"
-    except Exception:       # no table of that name (a test dialect)
-        return False
+    (options.additive_frames = "current_system": Sinumerik AMIRROR/ASCALE), rather than
+    replacing their component of a fixed-order frame (Fagor G11-G14, G72)."""
+    return _frame_option(dialect, "additive_frames") == "current_system"
 
 
-@lru_cache(maxsize=None)
 def rotation_cancel_drops_added(dialect: str) -> bool:
-    """Whether cancelling the rotation also cancels the rotations added to it (rules/<dialect>.toml
-    options.rotation_cancel = "with_added": Fagor `G73` alone after `G73 Q` increments)."""
-    from nctrans.rules import load_table
-    try:
-        return load_table(dialect).options.get("rotation_cancel") == "with_added"
-    except Exception:       # no table of that name (a test dialect)
-        return False
+    """Whether cancelling the rotation also cancels the rotations added to it
+    (options.rotation_cancel = "with_added": Fagor `G73` alone after `G73 Q` increments)."""
+    return _frame_option(dialect, "rotation_cancel") == "with_added"
 
 
 class OffsetsMixin:
