@@ -119,11 +119,15 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
             hits[i] += 1
             if weight >= 1.0 and dialect not in first:
                 first[dialect] = (lineno, m.start() + 1, m.group(0).strip()[:30])
+    specific = dict.fromkeys(names, 0.0)   # constructs other dialects lack (not plain words, not sniffing)
     for (dialect, weight, _cap, _rx), h in zip(markers, hits):
         evidence[dialect] += weight * h
+        if weight >= 1.0:
+            specific[dialect] += weight * h
     for d in dialects:
         for shape, (weight, cap) in d.comment_evidence.items():
             evidence[d.name] += weight * min(shapes[shape], cap)
+            specific[d.name] += weight * min(shapes[shape], cap)
     head = text[:200_000]
     for d in dialects:
         evidence[d.name] += _SNIFF_WEIGHT * _sniff(d, head)
@@ -133,10 +137,17 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
         if suffix:
             owners = [n for n in names if suffix in extensions(n)]
             # an ending only one dialect uses (.mpf) says more than a shared one (.nc)
-            weight = _EXT_WEIGHT * 1.5 if len(owners) == 1 and suffix not in base.COMMON_ENDINGS and all(
-                suffix not in extensions(n) for n in base.names() if n not in owners) else _EXT_WEIGHT
+            exclusive = len(owners) == 1 and suffix not in base.COMMON_ENDINGS and all(
+                suffix not in extensions(n) for n in base.names() if n not in owners)
+            weight = _EXT_WEIGHT * 1.5 if exclusive else _EXT_WEIGHT
             for n in owners:
                 evidence[n] += weight / len(owners)
+            if exclusive:
+                # plain word blocks (G0 X10, M30) are valid in the ending's own dialect too: they
+                # speak for another dialect only next to one of its own constructs
+                for n in names:
+                    if n not in owners and not specific[n]:
+                        evidence[n] = 0.0
     total = sum(evidence.values())
     scores = {n: (e / total if total else 0.0) for n, e in evidence.items()}
     ranked = sorted(scores.items(), key=lambda kv: -kv[1])
