@@ -327,6 +327,12 @@ def _target_profile(write: str, profile: Optional[str]) -> Optional[str]:
     return profile if profile is not None and profile in _profiles(write) else None
 
 
+def use_profile(ld: pipeline.Loaded, profile: Optional[str]) -> None:
+    """Run or read the loaded program as the source family's control `profile` (None: as detected);
+    NCError naming the known ones for a name its rules table does not know."""
+    _set_profile(ld, profile)
+
+
 def _set_profile(ld: pipeline.Loaded, profile: Optional[str], write: Optional[str] = None) -> None:
     """Select the source's control profile by name; a name only the target's table knows is
     the target's (the control the output is written for, `_target_profile`). NCError naming the
@@ -479,11 +485,13 @@ class Toolpath(Iterator[ToolpathRecord]):
 
 
 def toolpath(source: Source, dialect: Optional[str] = None, machine: MachineLike = None, *,
-             search_path: Iterable[PathLike] = (), file: str = STRING_LABEL) -> Toolpath:
+             search_path: Iterable[PathLike] = (), file: str = STRING_LABEL,
+             profile: Optional[str] = None) -> Toolpath:
     """The canonical motions of a program (text, a path or a parsed `Program`), streamed.
 
     Records are in machine coordinates, mm and degrees, as `nctrans toolpath --format jsonl`
-    writes them. The program runs while the result is iterated."""
+    writes them. The program runs while the result is iterated. `profile`: the control of the
+    source's family that runs it (rules `[options.profiles]`, e.g. iso-m "linuxcnc")."""
     dirs = list(search_path)
 
     def run(records: Iterator[ToolpathRecord]) -> Iterator[ToolpathRecord]:
@@ -499,6 +507,7 @@ def toolpath(source: Source, dialect: Optional[str] = None, machine: MachineLike
         return Toolpath(run(records), diags, source.file, dialect or source.dialect)
     with _search_path(dirs):
         ld = _load(source, dialect, stream=True, file=file, compact=True)
+    _set_profile(ld, profile)
     m = _machine(machine, ld.dialect)
     return Toolpath(run(pipeline.toolpath_of(ld, m)), ld.diagnostics, ld.label, ld.dialect,
                     parsed=ld.program is not None)

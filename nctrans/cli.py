@@ -299,6 +299,7 @@ def cmd_toolpath(args) -> int:
     if ld.program is None:
         _print_text_diags(ld.diagnostics, sys.stderr)
         return EXIT_DIAGNOSTICS
+    api.use_profile(ld, args.profile)
     jsonl = not args.summary and args.format != "csv"
     records = pipeline.toolpath_of(ld, machine, fast_sink="jsonl" if jsonl else None)
     from nctrans import toolpath_io
@@ -604,6 +605,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("jsonl", "csv"), default="jsonl")
     p.add_argument("--summary", action="store_true",
                    help="print a short summary (counts, lengths, bounding box, tools, cycle time) instead")
+    p.add_argument("--profile", metavar="NAME", help="control of the source's family that runs it (profiles of "
+                   "its rules table, e.g. iso-m linuxcnc); detected from the header comments when omitted")
     p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error",
                    help="exit 1 when a diagnostic at or above this severity was reported")
     _add_search_path(p)

@@ -78,7 +78,8 @@ class CycleCallsMixin:
     def _position_at(self) -> str:
         mode = self.__dict__.get("_cycle_positioning")
         if mode is None:
-            mode = self._cycle_positioning = cycle_table().position_at(self.program.dialect)
+            mode = self._cycle_positioning = cycle_table().position_at(
+                self.program.dialect, self.program.meta.get("profile"))
         return mode
 
     def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None,

@@ -481,8 +481,19 @@ class CycleTable:
                    milling_model=dict(d.get("milling_model", {})),
                    undercut=_undercut_tables(d.get("undercut", {})))
 
-    def position_at(self, dialect: str) -> str:
-        """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle)."""
+    def position_at(self, dialect: str, profile: Optional[str] = None) -> str:
+        """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle); a
+        control profile of the dialect's rules table may override it (`cycle_positioning`)."""
+        if profile:
+            from nctrans.rules import load_table
+            from nctrans.tables import TableError
+            try:
+                options = load_table(dialect).options
+            except TableError:          # a dialect without a rules table has no profiles
+                options = {}
+            own = ((options.get("profiles") or {}).get(profile) or {}).get("cycle_positioning")
+            if own in ("clear_level", "current"):
+                return own
         return self.positioning.get(dialect, self.positioning.get("default", "clear_level"))
 
     def neutral(self, name: str) -> str:
