@@ -317,8 +317,8 @@ def _parsed_whole(ld: pipeline.Loaded, profile: Optional[str], write: Optional[s
 
 
 def _profiles(dialect: Optional[str]) -> list[str]:
-    from nctrans.rules import load_table
-    return sorted((load_table(dialect).options.get("profiles") or {}) if dialect else ())
+    from nctrans.rules import option
+    return sorted(option(dialect, "profiles") or {})
 
 
 def _target_profile(write: str, profile: Optional[str]) -> Optional[str]:

@@ -127,3 +127,12 @@ def system_spelling(table_name: str, key: str | int, axis: Optional[str] = None
 def load_table(dialect: str) -> RulesTable:
     """rules/<dialect>.toml, validated by pydantic (once per content: see nctrans.tables)."""
     return tables.load(RULES_DIR / f"{dialect}.toml", RulesTable, RulesTable.from_data)
+
+
+def option(dialect: Optional[str], key: str, default: Any = None) -> Any:
+    """`[options] key` of rules/<dialect>.toml, or `default` when the table does not set it or the
+    dialect has no table of its own (a dialect a test registers). A shipped table that does not
+    load still fails loudly: a broken rules file must not read as "option unset"."""
+    if not dialect or not (RULES_DIR / f"{dialect}.toml").is_file():
+        return default
+    return load_table(dialect).options.get(key, default)

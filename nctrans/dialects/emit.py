@@ -74,14 +74,10 @@ def flat_forms(dialect: Optional[str] = None) -> dict:
         dialect, profile = current
     if dialect is None:
         return {}
-    from nctrans.rules import load_table
-    try:
-        options = load_table(dialect).options
-    except Exception:               # a target without a rules table
-        return {}
-    forms = dict(options.get("flat_motion") or {})
+    from nctrans.rules import option
+    forms = dict(option(dialect, "flat_motion") or {})
     if profile:
-        forms.update(((options.get("profiles") or {}).get(profile) or {}).get("flat_motion") or {})
+        forms.update(((option(dialect, "profiles") or {}).get(profile) or {}).get("flat_motion") or {})
     if forms:
         forms["dialect"] = dialect
     return forms

@@ -18,11 +18,8 @@ from nctrans.ir import nodes as n
 
 @lru_cache(maxsize=None)
 def _word(dialect: str) -> str:
-    try:
-        from nctrans.rules import load_table
-        return str(load_table(dialect).options.get("contour_offset", {}).get("word", "")).upper()
-    except Exception:           # a dialect without a table of its own
-        return ""
+    from nctrans.rules import option
+    return str((option(dialect, "contour_offset") or {}).get("word", "")).upper()
 
 
 def is_offset_word(s: n.Passthrough) -> bool:

@@ -36,11 +36,8 @@ _NOUN = {"round": "rounding", "round_modal": "modal rounding", "chamfer_length":
 @lru_cache(maxsize=None)
 def settings(dialect: str) -> dict:
     """The dialect's `[options.corner_elements]` table ({} when it has none)."""
-    try:
-        from nctrans.rules import load_table
-        return dict(load_table(dialect).options.get("corner_elements", {}) or {})
-    except Exception:           # a dialect without a table of its own
-        return {}
+    from nctrans.rules import option
+    return dict(option(dialect, "corner_elements") or {})
 
 
 def kind_of(s: n.Passthrough) -> Optional[str]:

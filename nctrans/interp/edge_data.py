@@ -18,11 +18,8 @@ from nctrans.interp.evaluate import EvalError, UNKNOWN
 
 def flat_edge_variables(dialect: str) -> dict[str, str]:
     """Spelling (upper case) -> "length" / "radius" from the dialect's rules table."""
-    try:
-        from nctrans.rules import load_table
-        found = load_table(dialect).options.get("flat_edge_data", {})
-    except Exception:           # a dialect without a table of its own
-        return {}
+    from nctrans.rules import option
+    found = option(dialect, "flat_edge_data", {})
     return {str(k).upper(): str(v) for k, v in found.items() if v in ("length", "radius")}
 
 

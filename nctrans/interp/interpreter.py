@@ -81,11 +81,8 @@ MOVE_KINDS = frozenset(("rapid", "linear", "arc"))
 def _default_cutting_edge(dialect) -> int:
     """The D number a tool brings when none is programmed (rules/<dialect>.toml
     options.default_cutting_edge; 0: none, G41/G42 without D compensate by zero)."""
-    from nctrans.rules import load_table
-    try:
-        return int(load_table(dialect).options.get("default_cutting_edge", 0) or 0)
-    except Exception:       # no table of that name (a test dialect): no default edge
-        return 0
+    from nctrans.rules import option
+    return int(option(dialect, "default_cutting_edge", 0) or 0)
 
 
 class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMixin, OffsetsMixin,

@@ -287,11 +287,8 @@ class MotionMixin:
     def _thread_lead_is_feed(self) -> bool:
         v = getattr(self, "_lead_is_feed", None)
         if v is None:
-            try:
-                from nctrans.rules import load_table
-                v = load_table(self.program.dialect).options.get("thread_lead") == "feed"
-            except Exception:          # no table for this dialect
-                v = False
+            from nctrans.rules import option
+            v = option(self.program.dialect, "thread_lead") == "feed"
             self._lead_is_feed = v
         return v
 

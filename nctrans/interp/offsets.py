@@ -34,11 +34,8 @@ def copy_frame(src: ProgrammableFrame, dst: Optional[ProgrammableFrame] = None) 
 @lru_cache(maxsize=None)
 def _frame_option(dialect: str, key: str):
     """options.<key> of rules/<dialect>.toml (None for a test dialect without a table)."""
-    from nctrans.rules import load_table
-    try:
-        return load_table(dialect).options.get(key)
-    except Exception:       # no table of that name (a test dialect)
-        return None
+    from nctrans.rules import option
+    return option(dialect, key)
 
 
 def additive_frames_compose(dialect: str) -> bool:

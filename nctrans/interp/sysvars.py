@@ -23,19 +23,13 @@ AXES = "XYZABC"
 
 def entries(dialect: str) -> list[dict]:
     """The dialect's system-variable map (empty for a dialect without one)."""
-    try:
-        from nctrans.rules import load_table
-        return list(load_table(dialect).options.get("numbered_variables", ()))
-    except Exception:            # no table for this dialect
-        return []
+    from nctrans.rules import option
+    return list(option(dialect, "numbered_variables", ()))
 
 
 def _ranges(dialect: str, key: str) -> tuple[tuple[int, int], ...]:
-    try:
-        from nctrans.rules import load_table
-        spans = load_table(dialect).options.get(key, ())
-    except Exception:            # no table for this dialect
-        return ()
+    from nctrans.rules import option
+    spans = option(dialect, key, ())
     return tuple((int(a), int(b)) for a, b in spans)
 
 
@@ -77,11 +71,8 @@ def write_policy(dialect: str) -> Callable[[str], str]:
     """What writing a named system variable nothing models is (`[options.system_variable_writes]`
     of the rules table): "read_only" (the control refuses it, NC228), "no_effect" (stored, quiet)
     or "unmodelled" (stored, NC237)."""
-    try:
-        from nctrans.rules import load_table, system_meaning
-        spec = load_table(dialect).options.get("system_variable_writes", {}) or {}
-    except Exception:            # no table for this dialect
-        return lambda name: "unmodelled"
+    from nctrans.rules import option, system_meaning
+    spec = option(dialect, "system_variable_writes") or {}
 
     def match(names) -> Callable[[str], bool]:
         exact = {str(x).upper() for x in names if not str(x).endswith("*")}

@@ -30,11 +30,8 @@ from nctrans.ir import nodes as n
 
 def edge_offsets(dialect: str) -> bool:
     """Whether a source dialect's D selects a cutting edge (length and radius)."""
-    try:
-        from nctrans.rules import load_table
-        return bool(load_table(dialect).options.get("edge_offsets"))
-    except Exception:           # a dialect without a table of its own
-        return False
+    from nctrans.rules import option
+    return bool(option(dialect, "edge_offsets"))
 
 
 def _const(e) -> Optional[int]:

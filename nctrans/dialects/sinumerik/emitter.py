@@ -48,7 +48,7 @@ from nctrans.lower.macro_procs import ends_with_restart as _ends_with_restart
 from nctrans.lower.macro_procs import reads_arguments as _reads_arguments
 from nctrans.plainrun import PlainRun, run_blocks
 from nctrans.dialects.sinumerik.edge_selection import EdgeSelection, NoEdge, jump_regions
-from nctrans.rules import load_table, system_meaning, system_spelling
+from nctrans.rules import option as rules_option, system_meaning, system_spelling
 from nctrans.plainrun import RUNS
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp import corner_elements
@@ -668,10 +668,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def _lead_is_feed(self) -> bool:
         """The source reads a thread's lead from F (its table's `thread_lead = "feed"`: ISO G33
         Z.. F<lead>); Sinumerik reads it from I/J/K only."""
-        try:
-            return load_table(self.p.dialect).options.get("thread_lead") == "feed"
-        except Exception:           # a dialect without a table of its own
-            return False
+        return rules_option(self.p.dialect, "thread_lead") == "feed"
 
     def _lead_from_feed(self, m: ir.Motion, out: "_Line") -> str:
         """The lead word (I/J/K of the one axis that moves) holding the F of the block, or the F
