@@ -127,6 +127,23 @@ def test_a_return_ending_a_main_program_is_said_when_written_as_m99():
     assert "NC406" not in {d.rule for d in iso.diagnostics}
 
 
+@pytest.mark.parametrize("target", ["iso-m", "iso-t"])
+def test_a_main_program_file_ending_with_a_return_is_written_with_m30(target, tmp_path):
+    # an .MPF (or a %_N_.._MPF header) is a main program: M17 ends it, so ISO M30, not M99 (which
+    # restarts an ISO main program endlessly); an .SPF is a subprogram file: M17 is its M99
+    text = "G0 X1 Y2\nG1 X5 F100\nM17\n"
+    for name, header, end in (("PART.MPF", "", "M30"), ("PART.txt", "%_N_PART_MPF\n", "M30"),
+                              ("PART.SPF", "", "M99")):
+        src = tmp_path / name
+        src.write_text(header + text)
+        conv = api.transpile(src, read="sinumerik", write=target)
+        ends = [ln for ln in conv.text.splitlines() if ln.startswith(("M30", "M99"))]
+        assert ends == [end], (name, conv.text)
+        assert "NC406" not in {d.rule for d in conv.diagnostics if d.severity == "warning"}
+        if end == "M30":
+            assert api.equiv(src, conv.text, read_a="sinumerik", read_b=target).equivalent
+
+
 def test_diamon_is_written_as_radius_words():
     # DIAMON (diameter X, absolute and incremental) is no alarm: ISO X words carry the radius
     src = "PROC PART(REAL DD)\nG1 Z0 F100\nDIAMON\nG1 X=DD Z1\nG91 X2\nDIAMOF\nG90 X5\nRET\n"

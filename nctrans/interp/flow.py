@@ -446,6 +446,10 @@ class FlowMixin:
             return unit, unit.code, target, 0
         if kind == "return":
             if not self.stack:
+                # M17/RET in the main body of a program run on its own ends it, as M30 does (seed
+                # 840D: a main program's M2/M30 is read as M17 when it is called; the reverse here)
+                self._comp_flush()
+                self._record("stop", stop_kind="end")
                 raise _Stop
             while self.stack[-1].section:          # RET inside a repeated section ends the call
                 self.stack[-1].repeats = 0

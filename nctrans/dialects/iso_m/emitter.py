@@ -1681,9 +1681,18 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def w_Return(self, s):
         words = [self.code_word("call", "m99")]
-        if self.unit is None and s.to_label is None and self.program.dialect != self.dialect:
-            # another control's return (Sinumerik M17/RET) ends a main program run on its own; an
-            # ISO M99 there restarts it: said, since the file may as well be called as a subprogram
+        kind = self._source_program_kind() if self.unit is None and s.to_label is None \
+            and self.program.dialect != self.dialect else "same"
+        if kind == "MPF":
+            # another control's return (Sinumerik M17/RET) in a file that is a main program
+            # (.MPF, or its %_N_.._MPF header) ends it; an ISO M99 there would restart it endlessly
+            self.diags.append(at_span("NC406", "info", "the source returns from its main program "
+                                      "here, which ends it: written as M30 (an ISO M99 restarts a "
+                                      "main program)", self._where()))
+            return [self.code_word("program_end", "end_rewind")]
+        if kind is None:
+            # a return ending a text that is neither (stdin, no header): run on its own it ends
+            # there, but an ISO M99 there restarts it; said, since it may as well be called
             self.diags.append(at_span("NC406", "warning", "the source returns from its main program here, "
                                       "which ends it when run on its own; the M99 written for it "
                                       f"restarts a main program on {self.target_text} (end it with M30 "
@@ -1694,6 +1703,16 @@ class IsoEmitter(IsoSpelling, Emitter):
         if pop:
             return _Lines([[("#", pop[0])], words])
         return words
+
+    def _source_program_kind(self) -> Optional[str]:
+        """"MPF" or "SPF": whether the source file is a main program or a subprogram file, by its
+        header (`%_N_.._MPF`) or its name (.MPF/.SPF); None when neither says."""
+        meta = self.program.meta if isinstance(self.program.meta, dict) else {}
+        kind = str(meta.get("program_type") or "").upper()
+        if kind in ("MPF", "SPF"):
+            return kind
+        suffix = str(self.program.file or "").upper().rpartition(".")[2]
+        return suffix if suffix in ("MPF", "SPF") else None
 
     def w_ProgramEnd(self, s):
         meaning = _PROGRAM_END.get(s.kind, _PROGRAM_END["end_rewind"])
