@@ -138,7 +138,7 @@ def _machine(machine: MachineLike, dialect: Optional[str]) -> Machine:
 
 def _load(source: Union[str, "os.PathLike[str]", _source.SourceText], dialect: Optional[str], *,
           stream: bool = False, file: str = STRING_LABEL, fallback: Optional[str] = None,
-          compact: bool = False) -> pipeline.Loaded:
+          compact: Union[bool, str] = False) -> pipeline.Loaded:
     """Read and parse text (a str) or a file (a PathLike). The CLI also passes already decoded
     standard input (a SourceText). `compact`: see pipeline.load_source (runs only)."""
     _check_dialect(dialect)
@@ -238,7 +238,8 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
         # written as it goes (`out`): a program that holds structure is parsed compact (its plain
         # stretches held as spans of the text: --flatten runs them, the emitters write them a few
         # blocks at a time), so memory stays flat in program size
-        ld = _load(text, read, file=file, stream=out is not None, compact=out is not None)
+        ld = _load(text, read, file=file, stream=out is not None,
+                   compact="jumps" if out is not None else False)
         _set_profile(ld, profile, write)
         with _api_errors():
             target = pipeline.get_dialect(write)

@@ -34,8 +34,9 @@ HELD_LIMIT_NOTE = "the most a conversion holds in memory"
 
 
 class NeedsWholeParse(Exception):
-    """Lowering a construct of a compact program (Dialect.parse_compact) would reach into one of
-    its runs of plain blocks (nctrans.lower.constructs): convert() converts it parsed whole."""
+    """Lowering a construct of a compact program (Dialect.parse_compact) would need a jump target
+    inside one of its runs of plain blocks (nctrans.lower.compact_constructs): convert() converts
+    it parsed whole."""
 
 
 @dataclass
@@ -167,8 +168,8 @@ def convert(program: Program, target: Dialect, *, flatten_with: Optional[Callabl
 
     `program` may be parsed compact (Dialect.parse_compact: its main body's runs of plain blocks
     held as spans of the text, written a few blocks at a time, so memory stays flat); when a
-    construct's lowering would reach into a run, it is converted again parsed whole: `whole()`
-    (by default its runs expanded in place)."""
+    construct's lowering would need a jump target inside a run, it is converted again parsed
+    whole: `whole()` (by default its runs expanded in place)."""
     args = dict(flatten_with=flatten_with, flatten=flatten, strict_mode=strict_mode, machine=machine,
                 resolver=resolver, stream_whole=stream_whole)
     try:

@@ -11,7 +11,7 @@ import gc
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterable, Iterator, Optional
+from typing import Callable, Iterable, Iterator, Optional, Union
 
 from nctrans import detection as _detect
 from nctrans import source as _source
@@ -94,7 +94,7 @@ _CHECK_HEAD = 4 * 1024
 
 
 def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Optional[str] = None,
-                stream: bool = False, fallback: Optional[str] = None, compact: bool = False) -> Loaded:
+                stream: bool = False, fallback: Optional[str] = None, compact: Union[bool, str] = False) -> Loaded:
     """Parse already-read text (`compact`: see Dialect.parse_compact; for runs only): choose the dialect (given, else the file's own `nctrans: dialect=`
     pragma, else `fallback` (the project configuration's), else detected), parse, collect
     diagnostics. With `stream` the parse may be lazy (Dialect.streams): the program must then be
@@ -122,7 +122,8 @@ def load_source(src: _source.SourceText, path: str = _source.STDIN, dialect: Opt
     if compact:
         # only run (toolpath, equiv, --flatten): a structured program whose plain stretches are
         # held as spans of the text (Dialect.parse_compact), complete like a whole parse
-        result = d.parse_compact(src.text, label)
+        # compact="jumps" (convert): a program that jumps into its main body too
+        result = d.parse_compact(src.text, label, jumps=compact == "jumps")
         if result is not None:
             _add_parse_diagnostics(diags, result.diagnostics, src, dialect, guess)
             return Loaded(path, label, src, dialect, result.program, diags, guess)
@@ -198,7 +199,7 @@ def finish_stream(ld: Loaded) -> None:
 
 
 def load(path: str, dialect: Optional[str] = None, stream: bool = False,
-         fallback: Optional[str] = None, compact: bool = False) -> Loaded:
+         fallback: Optional[str] = None, compact: Union[bool, str] = False) -> Loaded:
     """Read, decode, detect and parse one file ('-' = stdin). PipelineError if it cannot be read.
     `stream`, `fallback`: see load_source."""
     try:

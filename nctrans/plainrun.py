@@ -196,6 +196,22 @@ class PlainRun:
         return self.take(self.blocks)[0]
 
 
+def cut(run: PlainRun, k: int) -> tuple[PlainRun, PlainRun]:
+    """(the first `k` blocks of `run`, the rest), 0 < k < run.blocks, as PlainRuns over its text
+    (the first k blocks are built a chunk at a time to find where the rest starts)."""
+    rest: Optional[PlainRun] = run
+    taken = 0
+    while taken < k:
+        blocks, rest = rest.take(min(1024, k - taken))
+        taken += len(blocks)
+    assert rest is not None
+    end = RunEnd()
+    end.found(rest.start, rest.line, rest.motion, rest.cycle)
+    head = PlainRun(run.file, run.text, run.start, rest.start, run.line, run.sep, k, run.lower,
+                    run.motion, run.cycle, run.arc_abs, run.strict, run.max_chars, end)
+    return head, rest
+
+
 # Blocks of a run built at a time when a consumer takes a run block by block (the emitters of a
 # compact body): enough that per-take costs vanish, few enough that memory stays flat.
 RUN_CHUNK = 1024

@@ -2,7 +2,7 @@
 program whose plain stretches are held as PlainRuns (Dialect.parse_compact), the emitters writing
 them a few blocks at a time, must give the bytes and diagnostics of the whole parse, on every
 target: on generated programs (hypothesis), on corpus programs the compact parse takes, and where
-a construct's lowering reaches into a run (NeedsWholeParse: converted again parsed whole)."""
+a construct's lowering reaches into a run (more in test_compact_lowering.py)."""
 from __future__ import annotations
 
 import re
@@ -48,7 +48,7 @@ def _parse_compact(dialect, on: bool):
     cls = type(dialect)
     had = "parse_compact" in cls.__dict__
     saved = cls.__dict__.get("parse_compact")
-    cls.parse_compact = lambda self, text, file="<stdin>": None
+    cls.parse_compact = lambda self, text, file="<stdin>", jumps=False: None
     try:
         yield
     finally:
@@ -76,8 +76,8 @@ STRUCTURED = ("%\nO1000\nG21 G90 G17 G40 G49 G80\nT1 M6\nS8000 M3\nG0 X0 Y0 Z5.\
               "G1 F500.\n" + cam(300, 300) + "M30\nO2000\nG91 G1 X1. F100.\nY1.\nG90\nM99\n%\n")
 
 # a peck drilling cycle (refused by Sinumerik and Fagor) inside a local offset (G52) that holds
-# CAM stretches: its lowering is widened over the offset's whole run, runs included, so the
-# program is converted again parsed whole
+# CAM stretches: its lowering is widened over the offset's whole run, runs included (lowered
+# without the whole parse: nctrans.lower.compact_constructs, tests/test_compact_lowering.py)
 OFFSET_AROUND_RUNS = ("%\nO1001\nG21 G90 G17 G40 G80\nT1 M6\nS8000 M3\nG0 X0 Y0 Z5.\nG52 X10. Y5.\n"
                       + cam(0, 50) + "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nX2.\nG80\n" + cam(50, 50)
                       + "G52 X0 Y0\nM98 P2000\n" + cam(100, 50) + "M30\nO2000\nG0 Z10.\nM99\n%\n")
@@ -102,7 +102,7 @@ def test_a_macro_called_between_runs_becomes_a_proc_as_parsed_whole():
     assert "PROC L3000(REAL ARG_A, REAL ARG_B" in out and "L3000(1., 2.)" in out
 
 
-def test_a_lowering_over_a_run_converts_the_program_parsed_whole():
+def test_a_lowering_over_runs_converts_as_parsed_whole():
     assert _compact(OFFSET_AROUND_RUNS, "o.nc", "iso-m")
     _same_both_ways(OFFSET_AROUND_RUNS, "o.nc", "iso-m")
 

@@ -51,11 +51,15 @@ class CompactBody:
     """The main body of a Program parsed compact (Dialect.parse_compact): its items in order,
     each run of plain blocks as a PlainRun read again from the text when it runs. Not a list, so
     the interpreter runs it batch by batch as a streamed body (iterated again, it starts over);
-    only the interpreter and the streamed flattening take it (they take PlainRuns apart)."""
-    __slots__ = ("items",)
+    only the interpreter and the streamed flattening take it (they take PlainRuns apart).
+    `jumps`: something may jump into it (parsed with parse_compact(jumps=True), for convert): no
+    run then holds a block anything jumps to, and the interpreter runs it as the whole parse's
+    code (interp/compact_code.py) instead of batch by batch."""
+    __slots__ = ("items", "jumps")
 
-    def __init__(self, items: list):
+    def __init__(self, items: list, jumps: bool = False):
         self.items = items
+        self.jumps = jumps
 
     def __iter__(self):
         return iter(self.items)
@@ -176,9 +180,10 @@ class Dialect:
         output (the caller then emits the whole program)."""
         return None
 
-    def parse_compact(self, text: str, file: str = "<stdin>") -> Optional[ParseResult]:
+    def parse_compact(self, text: str, file: str = "<stdin>", jumps: bool = False) -> Optional[ParseResult]:
         """A whole parse whose main body is a CompactBody, or None (parse() then): for the runs
-        of a program that holds structure (loops, calls) around long plain stretches."""
+        of a program that holds structure (loops, calls) around long plain stretches. `jumps`:
+        a program that jumps into its main body too (CompactBody.jumps)."""
         return None
 
     def parse_stream(self, text: str, file: str = "<stdin>") -> Optional[ParseResult]:

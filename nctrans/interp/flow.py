@@ -24,6 +24,7 @@ from typing import Any, Callable, Iterator, Optional
 from nctrans.interp import corner_elements, unmodelled
 from nctrans.interp.compiled import (BLOCK, CASE, EXEC, Frame, JFALSE, JUMP, MAX_CALL_DEPTH, PLAIN,
                                      Unit, _Stop, _plain_entry, label_key)
+from nctrans.interp.compact_code import CompactCode
 from nctrans.interp.cycles import unmodelled_cycle
 from nctrans.interp.evaluate import EvalError, UNKNOWN
 from nctrans.interp.native import KERNEL_BLOCKS
@@ -86,7 +87,10 @@ class FlowMixin:
                 if node.label:
                     unit.labels.setdefault(label_key(node.label), []).append(pc)
             elif t is PlainRun:
-                code.append(_plain_entry(node))
+                if type(code) is list:
+                    code.append(_plain_entry(node))
+                else:                           # a compact body that jumps (compact_code)
+                    code.add_run(node)
             elif t is n.If:
                 j = len(code)
                 code.append(None)
@@ -242,10 +246,19 @@ class FlowMixin:
         # it is compiled a batch of blocks at a time, run, and the batch dropped, so memory does
         # not grow with the program. Labels are per batch (nothing jumps to them).
         stream = None
-        if type(body) is not list:
-            stream = iter(body)
-            body = []
-        main = self.unit_for(id(prog), prog.name or "main", body, prog.file, [])
+        if getattr(body, "jumps", False):
+            # a compact body that may be jumped into: the whole parse's code, its runs' blocks
+            # built as they run (compact_code)
+            main = Unit(prog.name or "main", prog.file, [])
+            main.code = CompactCode()       # type: ignore[assignment]
+            self._emit_nodes(body.items, main)
+            main.seen = bytearray(len(main.code))
+            self.units[id(prog)] = main
+        else:
+            if type(body) is not list:
+                stream = iter(body)
+                body = []
+            main = self.unit_for(id(prog), prog.name or "main", body, prog.file, [])
         self._main = main if stream is None else None      # a streamed body cannot restart
         unit, code = main, main.code
         pc = sidx = 0

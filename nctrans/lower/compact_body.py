@@ -17,23 +17,7 @@ from typing import Iterator, Optional
 
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import walk
-from nctrans.plainrun import PlainRun, RunEnd, run_blocks
-
-
-def cut(run: PlainRun, k: int) -> tuple[PlainRun, PlainRun]:
-    """(the first `k` blocks of `run`, the rest), 0 < k < run.blocks, as PlainRuns over its text
-    (the first k blocks are built a chunk at a time to find where the rest starts)."""
-    rest: Optional[PlainRun] = run
-    taken = 0
-    while taken < k:
-        blocks, rest = rest.take(min(1024, k - taken))
-        taken += len(blocks)
-    assert rest is not None
-    end = RunEnd()
-    end.found(rest.start, rest.line, rest.motion, rest.cycle)
-    head = PlainRun(run.file, run.text, run.start, rest.start, run.line, run.sep, k, run.lower,
-                    run.motion, run.cycle, run.arc_abs, run.strict, run.max_chars, end)
-    return head, rest
+from nctrans.plainrun import PlainRun, cut, run_blocks
 
 
 class CompactView:

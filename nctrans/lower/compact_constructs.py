@@ -11,8 +11,10 @@ a chunk at a time. Since nothing is held, a segment's plain motion is not bounde
 limits.MAX_LOWERED_BLOCKS (as in the streamed lowering, stream_constructs); an endless loop
 around a construct still stops at the interpreter's budgets.
 
-Only a jump to a label inside a run (a contour's block numbers, G71 P Q) still needs the whole
-parse (convert.NeedsWholeParse): the interpreter runs a compact body straight through."""
+A program that jumps into its main body is parsed with no jump target inside a run
+(dialects/compact_jumps.py); a jump to a label inside a run (a contour's block numbers, G71 P Q,
+in a program parsed compact for its other consumers) still needs the whole parse
+(convert.NeedsWholeParse)."""
 from __future__ import annotations
 
 import dataclasses
@@ -45,7 +47,7 @@ def lower_compact(program: n.Program, refusals: list[Diagnostic], target_name: s
                     or next(labelled_blocks(view.items, targets, c._label_key), None) is not None):
         raise NeedsWholeParse("a jump to a label that may be in a run of plain blocks")
     segments, remaining = _segments(program, view, refusals)
-    segments = c._widen_over_jumps(structure, segments)
+    segments = c._widen_over_jumps([], segments, structure)
     _static_checks(program, view, structure, segments)
     for seg in segments:
         c._walk_check(seg, [x for i, x in structure if seg.first <= i <= seg.last], machine)
@@ -76,7 +78,7 @@ def lower_compact(program: n.Program, refusals: list[Diagnostic], target_name: s
     if not lowered_any:
         return None, notes, remaining
     new_body.extend(view.slice(done, len(view) - 1))
-    return dataclasses.replace(program, body=CompactBody(new_body)), notes, remaining
+    return dataclasses.replace(program, body=CompactBody(new_body, program.body.jumps)), notes, remaining
 
 
 def _segments(program: n.Program, view: CompactView, refusals: list[Diagnostic]
@@ -209,7 +211,7 @@ def _run(program: n.Program, view: CompactView, structure: list, segments: list[
     homing = {(b.span.file, b.span.line) for seg in segments
               for b in blocks([x for i, x in structure if seg.first <= i <= seg.last])
               if any(type(s) is n.HomeReturn for s in b.body)}
-    c.run_marked(dataclasses.replace(program, body=CompactBody(body)), segments, machine, resolver,
+    c.run_marked(dataclasses.replace(program, body=CompactBody(body, program.body.jumps)), segments, machine, resolver,
                  homing, None, spill=True)
 
 

@@ -367,12 +367,13 @@ def _widened(found: list[Segment], modal_runs, stretch_runs) -> list[Segment]:
     return merged
 
 
-def _widen_over_jumps(body: list, segments: list[Segment]) -> list[Segment]:
+def _widen_over_jumps(body: list, segments: list[Segment], pairs: Optional[list] = None) -> list[Segment]:
     """Each segment grown until no jump of the main body crosses its border: a jump into it, out
     of it, back over it or forward past it takes the jump's whole span with it, so a label loop
-    (LBL: ... GOTOB LBL) around a construct is lowered whole, as its loop. `body`: the main
-    body's nodes, or (index, node) pairs (a compact body's nodes other than its runs)."""
-    pairs = list(enumerate(body)) if type(body) is list else list(body)
+    (LBL: ... GOTOB LBL) around a construct is lowered whole, as its loop. `pairs`: (index,
+    node) of the nodes to look at instead of the body's (a compact body's other than its runs)."""
+    if pairs is None:
+        pairs = list(enumerate(body))
     where: dict[str, int] = {}
     for i, node in pairs:
         for lab in _labels([node]):

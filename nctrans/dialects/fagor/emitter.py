@@ -257,7 +257,7 @@ class FagorEmitter(FagorSpelling, Emitter):
         self._reset()
         self.out.append(f"%{_program_header(p)}")
         self.prologue()
-        self.nodes(self._restart_as_loop(p.body))
+        self.nodes(self._restart_as_loop(p.body if type(p.body) is list else list(p.body)))
         return "\n".join(self.out) + "\n"
 
     def _restart_as_loop(self, body: list) -> list:

@@ -105,12 +105,12 @@ class IsoFamily(Dialect):
         from .frontend import parse_stream
         return parse_stream(text, file, self.lowering())
 
-    def parse_compact(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+    def parse_compact(self, text: str, file: str = "<stdin>", jumps: bool = False) -> ParseResult | None:
         """None for a member with a front end of its own (Fagor, ISO turning): parse() then."""
         if type(self).parse is not IsoFamily.parse:
             return None
         from .frontend import parse_compact
-        return parse_compact(text, file, self.lowering())
+        return parse_compact(text, file, self.lowering(), jumps=jumps)
 
     def emit(self, program) -> EmitResult:
         from .emitter import emit_program

@@ -925,7 +925,7 @@ def _parse_program(text: str, file: str, lowering: type[Lowering]):
     return ParseResult(program, diags)
 
 
-def parse_compact(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lowering):
+def parse_compact(text: str, file: str = "<stdin>", lowering: type[Lowering] = Lowering, jumps: bool = False):
     """A whole parse whose main body is held compact (base.CompactBody): each run of plain lines
     at its top level is one PlainRun (a span of the text, read again when it runs) instead of its
     Blocks (~1.2 KiB each), so a CAM body of millions of lines around a few loops and calls costs
@@ -933,7 +933,8 @@ def parse_compact(text: str, file: str = "<stdin>", lowering: type[Lowering] = L
     holds only where nothing jumps back into the main body: None when anything may (a GOTO or an
     M99 in it, M99 ending it (a restart), an M99 P return to one of its block numbers), or when
     nothing would be compacted
-    (without the native kernel there are no runs): parse_program then."""
+    (without the native kernel there are no runs): parse_program then. `jumps`: such a program is
+    held compact too, its runs split at the blocks jumps land on (dialects/compact_jumps.py)."""
     from nctrans.dialects.base import CompactBody, ParseResult
     if plainrun.native is None:
         return None
@@ -948,8 +949,15 @@ def parse_compact(text: str, file: str = "<stdin>", lowering: type[Lowering] = L
         if gc_was_enabled:
             gc.enable()
     items = program.body
-    if not any(type(x) is plainrun.PlainRun for x in items) or _jumps_into_main(program):
+    if not any(type(x) is plainrun.PlainRun for x in items):
         return None
+    if _jumps_into_main(program):
+        from nctrans.dialects.compact_jumps import split_at_targets
+        split = split_at_targets(program) if jumps else None
+        if split is None:
+            return None
+        program.body = CompactBody(split, jumps=True)
+        return ParseResult(program, diags)
     program.body = CompactBody(items)
     return ParseResult(program, diags)
 

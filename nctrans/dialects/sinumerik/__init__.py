@@ -83,9 +83,9 @@ class Sinumerik(Dialect):
         from nctrans.dialects.sinumerik.frontend import parse_stream
         return parse_stream(text, file)
 
-    def parse_compact(self, text: str, file: str = "<stdin>") -> ParseResult | None:
+    def parse_compact(self, text: str, file: str = "<stdin>", jumps: bool = False) -> ParseResult | None:
         from nctrans.dialects.sinumerik.frontend import parse_compact
-        return parse_compact(text, file)
+        return parse_compact(text, file, jumps=jumps)
 
     def emit(self, program) -> EmitResult:
         return _emit(program)

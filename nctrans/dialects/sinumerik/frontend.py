@@ -930,7 +930,7 @@ def parse_stream(text: str, file: str = "<stdin>") -> Optional[ParseResult]:
     return ParseResult(fp.program, fp.low.diags)
 
 
-def parse_compact(text: str, file: str = "<stdin>") -> Optional[ParseResult]:
+def parse_compact(text: str, file: str = "<stdin>", jumps: bool = False) -> Optional[ParseResult]:
     """A whole parse whose main body is held compact (base.CompactBody): each run of plain lines
     at the top level of the main program (outside loops, branches and PROC) is one PlainRun, a
     span of the text read again when it runs or is written, instead of its Blocks, so a CAM
@@ -938,7 +938,9 @@ def parse_compact(text: str, file: str = "<stdin>") -> Optional[ParseResult]:
     may jump to a place in the main body (a GOTO, CASE, REPEAT, contour reference or return
     there: the interpreter runs a compact body straight through, as a streamed one), when the
     file holds a PROC or ISO-mode section in its main program, or when nothing would be compacted
-    (without the native kernel there are no runs): parse() then."""
+    (without the native kernel there are no runs): parse() then. `jumps`: a program that jumps
+    into its main body is held compact too, its runs split at the blocks jumps land on
+    (dialects/compact_jumps.py); not one with an ISO-mode section."""
     from nctrans.dialects.base import CompactBody
     if plainrun.native is None:
         return None
@@ -947,11 +949,25 @@ def parse_compact(text: str, file: str = "<stdin>") -> Optional[ParseResult]:
         pass
     program = fp.program
     items = program.body
-    if not any(type(x) is plainrun.PlainRun for x in items) or _jumps_into_main(program) \
-            or fp.program.meta.get("entry") is not None:
+    if not any(type(x) is plainrun.PlainRun for x in items) or fp.program.meta.get("entry") is not None:
         return None
+    if _jumps_into_main(program):
+        from nctrans.dialects.compact_jumps import split_at_targets
+        split = split_at_targets(program) if jumps and not _iso_sections(program) else None
+        if split is None:
+            return None
+        program.body = CompactBody(split, jumps=True)
+        return ParseResult(program, fp.low.diags)
     program.body = CompactBody(items)
     return ParseResult(program, fp.low.diags)
+
+
+def _iso_sections(program: ir.Program) -> bool:
+    """Whether the main body switches to ISO dialect mode."""
+    from nctrans.ir import walk
+    return any(type(s) is ir.Passthrough and s.reason in ("ISO dialect mode", "ISO dialect section")
+               for b in walk.blocks([x for x in program.body if type(x) is not plainrun.PlainRun])
+               for s in b.body)
 
 
 def _jumps_into_main(program: ir.Program) -> bool:
