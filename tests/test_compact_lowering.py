@@ -239,19 +239,27 @@ def test_an_iso_restart_converts_to_a_sinumerik_loop_without_the_whole_parse(mon
     assert "LOOP" in out and "ENDLOOP" in out and "X29.125 Y29.25 Z-1.5" in out
 
 
+# jumps back and forward into the body, and what the writers follow along the flow (tool and
+# cutting edge, radius compensation, G90/G91 and per-word AC/IC, home returns, cycles, frames):
+# an analysis that sees a different flow on the compact body (a jump target, a back edge, the
+# modes of a construct lowered between runs) writes or refuses differently
 _SIN_JUMPS = st.sampled_from([
     "R5=0\nLBL1:\nG0 Z5\nR5=R5+1\nIF R5<2 GOTOB LBL1",
     "GOTOF SKIP\nG0 X9 Y9\nSKIP:",
     "IF R6==0 GOTOF N40",
+    "IF R8==0 GOTOB N20",
     "R7=2\nCASE R7 OF 1 GOTOF C1 2 GOTOF C2 DEFAULT GOTOF C1\nC1:\nG0 Z7\nC2:",
-    "G70", "G71", "T2 D1 M6",
+    "G70", "G71", "T2 D1 M6", "T3 M6", "D2", "D0", "G41 X5 Y5", "G42 X4 Y4", "G40 X0 Y0",
+    "G91 G0 X1\nG90", "G91", "G90", "G1 X=IC(2) Y=IC(1)", "G1 X=AC(5) Y=AC(3)", "G74 Z1=0",
+    "CYCLE81(5,0,1,-3)", "MCALL CYCLE81(5,0,1,-3)\nX4 Y4\nMCALL", "TRANS X5", "TRANS",
+    "G1 X5 Y5 RND=1", "G500", "G54",
 ])
 
 
 @st.composite
 def sinumerik_jumps(draw) -> str:
     parts = ["%_N_GEN_MPF", "DEF INT COUNT", "G71 G90 G17 G40 F500", "T1 D1 M6", "S6000 M3", "G0 X0 Y0 Z5"]
-    for _ in range(draw(st.integers(1, 4))):
+    for _ in range(draw(st.integers(1, 5))):
         lines = draw(_SIN_RUN)
         if draw(st.booleans()):
             lines = [f"N{10 * (k + 1)} {line}" for k, line in enumerate(lines)]
@@ -262,7 +270,7 @@ def sinumerik_jumps(draw) -> str:
     return "\n".join(parts) + "\n"
 
 
-@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(sinumerik_jumps())
 def test_generated_sinumerik_jumps_run_and_convert_as_parsed_whole(text):
     from nctrans import pipeline
@@ -273,26 +281,35 @@ def test_generated_sinumerik_jumps_run_and_convert_as_parsed_whole(text):
 
 
 _ISO_JUMPS = st.sampled_from([
-    "#5=#5+1\nIF[#5LT2]GOTO20", "GOTO30", "IF[#6EQ0]GOTO40", "G20", "G21", "T2 M6",
-    "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nG80",
+    "#5=#5+1\nIF[#5LT2]GOTO20", "GOTO30", "IF[#6EQ0]GOTO40", "#7=#7+1\nIF[#7LT2]GOTO10", "G20", "G21",
+    "T2 M6", "T3 M6\nG43 H3 Z50.", "G43 H1 Z50.", "G43 H2 Z40.", "G49", "G49 Z60.", "H2", "G44 H1 Z30.",
+    "D2", "G41 D1 X5. Y5.", "G42 D2 X4. Y4.", "G40 X0 Y0", "G91 G28 Z0\nG90", "G91 G0 X1.\nG90",
+    "G91", "G90", "G81 X1. Y1. Z-3. R1. F80.\nX4.\nG80", "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nG80",
+    "M98 P2000", "G52 X5. Y5.", "G52 X0 Y0", "G55", "G1 X5. Y5. ,R1.",
+    "#1=0\nWHILE[#1LT2]DO1\nG0 X[#1*5] Y0 Z5.\n#1=#1+1\nEND1",
 ])
+_ISO_SUBPROGRAM = st.sampled_from(["G91 G1 X1. F100.\nG90", "G43 H2 Z10.", "T4 M6", "G41 D2 X1. Y1.",
+                                   "G0 Z10."])
 
 
 @st.composite
 def iso_jumps(draw) -> str:
-    parts = ["%", "O1000", "G21 G90 G17 G40 G80 F500.", "T1 M6", "S6000 M3", "G0 X0 Y0 Z5.", "#5=0"]
-    for _ in range(draw(st.integers(1, 4))):
+    parts = ["%", "O1000", "G21 G90 G17 G40 G80 F500.", "T1 M6", "S6000 M3", "G0 X0 Y0 Z5.", "#5=0", "#7=0"]
+    if draw(st.booleans()):
+        parts.append("G43 H1 Z50.")
+    for _ in range(draw(st.integers(1, 5))):
         lines = draw(_PLAIN)
         if draw(st.booleans()):
             lines = [f"N{10 * (k + 1)} {line}" for k, line in enumerate(lines)]
         parts.extend(lines)
         parts.append(draw(_ISO_JUMPS))
     parts.extend(draw(_PLAIN))
-    parts += [draw(st.sampled_from(["M30", "M99"])), "%"]
+    parts.append(draw(st.sampled_from(["M30", "M99"])))
+    parts += ["O2000", draw(_ISO_SUBPROGRAM), "M99", "%"]
     return "\n".join(parts) + "\n"
 
 
-@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(iso_jumps())
 def test_generated_iso_jumps_run_and_convert_as_parsed_whole(text):
     from nctrans import pipeline
@@ -300,3 +317,41 @@ def test_generated_iso_jumps_run_and_convert_as_parsed_whole(text):
         return
     _same_records_with_jumps(text, "j.nc", "iso-m")
     _same_both_ways(text, "j.nc", "iso-m")
+
+
+# an ISO program restarted by M99 (Sinumerik: one LOOP around the body) whose line 19 (a Z move
+# after T2 M6, no length on, radius compensation not known) is refused and lowered to plain
+# motion: the lowered motion selects G49, so the loop changes the tool length, and the Z move of
+# line 6 at the loop's start sees a length that is not known there. The lowered motion is spilled
+# between runs in the compact body: the writer's flow analysis must see its modes as it sees the
+# whole parse's blocks (it saw only line 19's refusal)
+RESTART_OVER_LOWERED = (
+    "%\nO1000\nG21 G90 G17 G40 G80 F500.\nT1 M6\nS6000 M3\nG0 X0 Y0 Z5.\n#5=0\n"
+    "N10 G2 X7. Y0 I7. J0\nN20 G2 X7. Y0 I8. J0\nN30 G2 X7. Y0 I8. J0\nN40 G3 X14. Y0 I2. J0\n"
+    "#5=#5+1\nIF[#5LT2]GOTO20\nG3 X17. Y0 I6. J0\nG3 X7. Y0 I5. J0\nG3 X11. Y0 I9. J0\nT2 M6\n"
+    "G2 X13. Y0 I5. J0\nG0 X48.5 Y12 Z-9.25\nG2 X15. Y0 I6. J0\nG0 X48.5 Y12 Z-9.25\n"
+    "G0 X-39.5 Y-8 Z-3.25\nG2 X20. Y0 I6. J0\nG3 X7. Y0 I5. J0\nM99\n%\n")
+
+
+def test_a_restart_over_lowered_motion_refuses_as_parsed_whole(monkeypatch):
+    from nctrans import pipeline
+    assert pipeline.get_dialect("iso-m").parse_compact(RESTART_OVER_LOWERED, "r.nc", jumps=True).program.body.jumps
+    _same_both_ways(RESTART_OVER_LOWERED, "r.nc", "iso-m")
+    _no_whole_parse(monkeypatch)
+    done = api.transpile(RESTART_OVER_LOWERED, "iso-m", "sinumerik", file="r.nc", out=TextSink())
+    refused = sorted(d.line for d in done.diagnostics if d.rule == "NC402")
+    assert refused == [6, 19]
+    assert done.text is None
+
+
+# an ISO macro file (reads #6, which it never sets; M99 at its end) that jumps into its body: it is
+# written as a PROC with its argument letters from its whole body, so it is parsed whole
+MACRO_FILE_JUMPS = ("%\nO1000\nG21 G90 G17 G40 G80 F500.\nT1 M6\nG0 X0 Y0 Z5.\n" + cam(0, 10, numbered=True)
+                    + "IF[#6EQ0]GOTO40\nG1 X26.5 Y49 Z-1.25\nM99\n%\n")
+
+
+def test_a_macro_file_that_jumps_is_written_as_its_proc():
+    from nctrans import pipeline
+    assert pipeline.get_dialect("iso-m").parse_compact(MACRO_FILE_JUMPS, "m.nc", jumps=True) is None
+    out = api.transpile(MACRO_FILE_JUMPS, "iso-m", "sinumerik", file="m.nc").text
+    assert "PROC L1000(" in out

@@ -7,19 +7,33 @@ from __future__ import annotations
 from typing import Iterable, Iterator, Optional
 
 from nctrans.ir import nodes as n
+from nctrans.spilled import SpilledRun
 
 # The node lists a structure holds, in source order (If: then, orelse; loops: body).
 BODIES = ("then", "orelse", "body")
 
 
-def children(node) -> Iterator[list]:
-    """The node lists nested in a structure (nothing for a Block)."""
+def children(node) -> Iterator[Iterable]:
+    """The node lists nested in a structure (nothing for a Block). The plain motion of a construct
+    lowered in a compact program (nctrans.spilled.SpilledRun) holds the Blocks the whole parse
+    holds in its place, modes and all: they are read back a chunk at a time, so an analysis sees
+    them as it sees the whole parse's (a run of plain source lines holds only motion and feeds)."""
     if type(node) is n.Block:
+        return
+    if type(node) is SpilledRun:
+        yield _spilled_blocks(node)
         return
     for attr in BODIES:
         sub = getattr(node, attr, None)
         if sub:
             yield sub
+
+
+def _spilled_blocks(run: SpilledRun) -> Iterator[n.Block]:
+    part: Optional[SpilledRun] = run
+    while part is not None:
+        got, part = part.take(0)
+        yield from got
 
 
 def walk(nodes: Iterable) -> Iterator:

@@ -65,7 +65,7 @@ def _rewrite(program: n.Program, kind: type, rewrite: Callable[[object], list],
     elif type(body) is CompactBody:     # its runs are plain blocks: the structures between them
         items = nodes(body.items)
         if items is not body.items:
-            body = CompactBody(items)
+            body = CompactBody(items, body.jumps)
     subs = {}
     for name, sub in (program.subprograms or {}).items():
         new = nodes(sub.body)

@@ -953,7 +953,9 @@ def parse_compact(text: str, file: str = "<stdin>", lowering: type[Lowering] = L
         return None
     if _jumps_into_main(program):
         from nctrans.dialects.compact_jumps import split_at_targets
-        split = split_at_targets(program) if jumps else None
+        from nctrans.lower.macro_procs import macro_file
+        # a macro file (G65 arguments, M99) is written as a PROC from its whole body
+        split = split_at_targets(program) if jumps and not macro_file(program) else None
         if split is None:
             return None
         program.body = CompactBody(split, jumps=True)
