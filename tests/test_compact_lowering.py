@@ -247,7 +247,7 @@ _SIN_JUMPS = st.sampled_from([
     "R5=0\nLBL1:\nG0 Z5\nR5=R5+1\nIF R5<2 GOTOB LBL1",
     "GOTOF SKIP\nG0 X9 Y9\nSKIP:",
     "IF R6==0 GOTOF N40",
-    "IF R8==0 GOTOB N20",
+    "R8=R8+1\nIF R8<2 GOTOB N20",
     "R7=2\nCASE R7 OF 1 GOTOF C1 2 GOTOF C2 DEFAULT GOTOF C1\nC1:\nG0 Z7\nC2:",
     "G70", "G71", "T2 D1 M6", "T3 M6", "D2", "D0", "G41 X5 Y5", "G42 X4 Y4", "G40 X0 Y0",
     "G91 G0 X1\nG90", "G91", "G90", "G1 X=IC(2) Y=IC(1)", "G1 X=AC(5) Y=AC(3)", "G74 Z1=0",
@@ -281,7 +281,7 @@ def test_generated_sinumerik_jumps_run_and_convert_as_parsed_whole(text):
 
 
 _ISO_JUMPS = st.sampled_from([
-    "#5=#5+1\nIF[#5LT2]GOTO20", "GOTO30", "IF[#6EQ0]GOTO40", "#7=#7+1\nIF[#7LT2]GOTO10", "G20", "G21",
+    "#5=#5+1\nIF[#5LT2]GOTO20", "#8=#8+1\nIF[#8LT2]GOTO30", "IF[#6EQ0]GOTO40", "#7=#7+1\nIF[#7LT2]GOTO10", "G20", "G21",
     "T2 M6", "T3 M6\nG43 H3 Z50.", "G43 H1 Z50.", "G43 H2 Z40.", "G49", "G49 Z60.", "H2", "G44 H1 Z30.",
     "D2", "G41 D1 X5. Y5.", "G42 D2 X4. Y4.", "G40 X0 Y0", "G91 G28 Z0\nG90", "G91 G0 X1.\nG90",
     "G91", "G90", "G81 X1. Y1. Z-3. R1. F80.\nX4.\nG80", "G99 G73 X1. Y1. Z-5. R1. Q0.5 F100.\nG80",
@@ -294,7 +294,7 @@ _ISO_SUBPROGRAM = st.sampled_from(["G91 G1 X1. F100.\nG90", "G43 H2 Z10.", "T4 M
 
 @st.composite
 def iso_jumps(draw) -> str:
-    parts = ["%", "O1000", "G21 G90 G17 G40 G80 F500.", "T1 M6", "S6000 M3", "G0 X0 Y0 Z5.", "#5=0", "#7=0"]
+    parts = ["%", "O1000", "G21 G90 G17 G40 G80 F500.", "T1 M6", "S6000 M3", "G0 X0 Y0 Z5.", "#5=0", "#7=0", "#8=0"]
     if draw(st.booleans()):
         parts.append("G43 H1 Z50.")
     for _ in range(draw(st.integers(1, 5))):
