@@ -101,9 +101,13 @@ class ProgrammableFrame:
     """The frame between program and work coordinates."""
 
     __slots__ = ("local", "mirror", "mirror_axes", "scale", "rot", "extra", "extra_trans",
-                 "affine", "inverse", "identity", "mirror_swap", "settable")
+                 "affine", "inverse", "identity", "mirror_swap", "settable", "mirror_first")
 
-    def __init__(self) -> None:
+    def __init__(self, mirror_first: bool = False) -> None:
+        # the control's order of mirror and rotation (rules options.frame_order): False = the point
+        # is rotated, then scaled and mirrored (ISO, Sinumerik); True = scaled, mirrored, then
+        # rotated about a centre the mirror in force mirrored too (Fagor manual L10157-10160)
+        self.mirror_first = mirror_first
         self.local: dict[str, float] = {}                   # G52 / TRANS, every axis
         self.mirror: Optional[Affine] = None
         self.mirror_axes: dict[str, float] = {}           # mirrored axis -> pivot
@@ -174,6 +178,11 @@ class ProgrammableFrame:
                 # a Sinumerik AROT); only rotations put a matrix into the additive part
                 self.extra = ID_AFFINE
         elif additive:
+            if self.mirror_first and self.mirror is not None and pivot:
+                # "I and J are affected by the active mirror images" (Fagor, at the G73)
+                m, t = self.mirror
+                c = mat_vec(m, tuple(pivot.get(a, 0.0) for a in XYZ))
+                pivot = {a: c[i] + t[i] for i, a in enumerate(XYZ)}
             self.extra = compose(self.extra, _about(rotation(axis, deg), pivot))
         elif self.rot is not None and pivot.get("_chain"):
             self.rot = compose(self.rot, _about(rotation(axis, deg), pivot))
@@ -184,7 +193,7 @@ class ProgrammableFrame:
     def clear(self) -> None:
         """The neutral programmable frame; the settable frame's part stays."""
         keep = self.settable
-        self.__init__()
+        self.__init__(self.mirror_first)
         if keep is not None:
             self.set_settable(keep)
 
@@ -195,10 +204,11 @@ class ProgrammableFrame:
     # ---------------------------------------------------------------- use
     def _rebuild(self) -> None:
         aff = (IDENT, tuple(self.local.get(a, 0.0) for a in XYZ))
-        for part in (self.mirror, self.scale, self.rot):
+        order = ((self.rot, self.extra, self.mirror, self.scale) if self.mirror_first
+                 else (self.mirror, self.scale, self.rot, self.extra))
+        for part in order:
             if part is not None:
                 aff = compose(aff, part)
-        aff = compose(aff, self.extra)
         if self.settable is not None:
             aff = compose((self.settable, (0.0, 0.0, 0.0)), aff)
         self.affine = aff

@@ -59,7 +59,7 @@ from nctrans.interp.cycle_calls import CycleCallsMixin
 from nctrans.interp.flow import FlowMixin
 from nctrans.interp.motion import MotionMixin
 from nctrans.interp.native import NativeLaneMixin
-from nctrans.interp.offsets import OffsetsMixin
+from nctrans.interp.offsets import OffsetsMixin, mirror_before_rotation
 from nctrans.interp.records import RecordsMixin
 from nctrans.interp.statements import StatementsMixin
 from nctrans.interp.words import WordsMixin
@@ -116,7 +116,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.st = ModalState(defaults if isinstance(defaults, dict) else None)
         self.default_edge = _default_cutting_edge(program.dialect)
         self.ev = Evaluator()
-        self.frame = ProgrammableFrame()
+        self.frame = ProgrammableFrame(mirror_first=mirror_before_rotation(program.dialect))
         self.off = Offsets()
         self.travel_limits: Optional[ProgrammedLimits] = None     # set by the first TravelLimit
         self.settable = None            # settable_frames.SettableFrames where the dialect has them

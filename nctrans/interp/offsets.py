@@ -45,6 +45,13 @@ def additive_frames_compose(dialect: str) -> bool:
     return _frame_option(dialect, "additive_frames") == "current_system"
 
 
+def mirror_before_rotation(dialect: str) -> bool:
+    """Whether the dialect's control mirrors a point before it rotates it, the rotation centre
+    mirrored too (options.frame_order = "mirror_first": Fagor manual L10157-10160), rather than
+    rotating first (ISO, Sinumerik)."""
+    return _frame_option(dialect, "frame_order") == "mirror_first"
+
+
 def rotation_cancel_drops_added(dialect: str) -> bool:
     """Whether cancelling the rotation also cancels the rotations added to it
     (options.rotation_cancel = "with_added": Fagor `G73` alone after `G73 Q` increments)."""
