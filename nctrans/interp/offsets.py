@@ -52,6 +52,13 @@ def mirror_before_rotation(dialect: str) -> bool:
     return _frame_option(dialect, "frame_order") == "mirror_first"
 
 
+def mirror_refused_under_scale_or_rotation(dialect: str) -> bool:
+    """Whether the dialect's control alarms at a programmable mirror (on or off) while scaling
+    or a coordinate rotation is on (options.mirror_under_scale_or_rotation = "alarm": ISO G51.1
+    under G51/G68, seed L1715-1718)."""
+    return _frame_option(dialect, "mirror_under_scale_or_rotation") == "alarm"
+
+
 def rotation_cancel_drops_added(dialect: str) -> bool:
     """Whether cancelling the rotation also cancels the rotations added to it
     (options.rotation_cancel = "with_added": Fagor `G73` alone after `G73 Q` increments)."""
@@ -284,6 +291,14 @@ class OffsetsMixin:
                 f = {a.upper(): num(e, f"{a} scale", False) for a, e in s.values.items()}
                 fr.set_scale({a: v for a, v in f.items() if v is not None}, center())
         elif op == "mirror":
+            if (fr.rot is not None or fr.scale is not None) and mirror_refused_under_scale_or_rotation(
+                    self.program.dialect):
+                on = "scaling" if fr.rot is None else "coordinate rotation" if fr.scale is None else \
+                    "scaling and coordinate rotation"
+                self.diag("NC215", "error", f"programmable mirror {'cancel' if s.clear else 'on'} while {on} is "
+                          "on: the control refuses it (program the mirror before scaling and rotation and "
+                          "cancel it after them, seed L1715-1718); the analysed toolpath goes on with it "
+                          "applied as programmed")
             if s.clear:
                 keep = {a: v for a, v in fr.mirror_axes.items()
                         if s.values and a not in {k.upper() for k in s.values}}

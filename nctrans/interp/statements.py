@@ -162,6 +162,8 @@ class StatementsMixin:
 
     def _h_toolchange(self, s):
         st = self.st
+        if s.turret and st.tool is not None and st.tool == st.tool_selected:
+            return                              # the turret stays: only the offset changes
         self._rc_tool_change()
         if st.tool_selected is None:
             self.diag("NC105", "warning", "tool change without a selected tool")

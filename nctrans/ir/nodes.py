@@ -203,7 +203,10 @@ class ToolSelect:
 
 @node
 class ToolChange:
-    """M6 (or a T that changes the tool at once on dialects without M6)."""
+    """M6 (or a T that changes the tool at once on dialects without M6). `turret`: a lathe's T
+    word, which indexes the turret; naming the tool already at the cutting position changes only
+    its offset register (ISO T0101 then T0102), no tool."""
+    turret: bool = False
 
 
 @node

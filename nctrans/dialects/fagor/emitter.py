@@ -843,6 +843,8 @@ class FagorEmitter(FagorSpelling, Emitter):
                 return
             if s.angle is None or s.values:
                 raise NotExpressible("a rotation about a named axis")
+            if s.center is not None and not s.center:
+                raise NotExpressible("a rotation about the current position (ISO G68 without a centre)")
             centre = ""
             if s.center:
                 ci = s.center.get("X")

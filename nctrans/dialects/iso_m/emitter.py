@@ -32,6 +32,7 @@ from typing import Any, Optional
 
 from nctrans.diagnostics import at_span
 from nctrans.interp import corner_elements
+from nctrans.interp.frames import PLANE_AXES
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, flat_forms, format_number, rewrites
 from nctrans.ir import nodes as n
 from nctrans.ir import walk
@@ -1255,6 +1256,18 @@ class IsoEmitter(IsoSpelling, Emitter):
         other = self.frame_other
         trans_before = self.frame_trans
         self.track_frame(s)
+        if (s.op in ("trans", "rot", "scale", "mirror") and not s.clear and not s.local and s.center is None
+                and (s.op != "rot" or not set(s.values) - set("IJK"))):
+            # a frame that replaces the whole programmable frame (Sinumerik TRANS/ROT/SCALE/MIRROR):
+            # ISO keeps the components it does not name, so what may be active is cancelled first,
+            # each on its own line, rotation and scaling before the mirror (seed L1715-1718)
+            cancels = ([[self.code_word("nonmodal", "local_offset")] + [(k, k + "0.") for k in "XYZ"]]
+                       if s.op != "trans" and trans_before != {} else [])
+            if other:
+                cancels += self._cancel_others()
+            if cancels or s.op == "rot":
+                words = self._replacing(s)
+                return _Lines([*cancels, words]) if cancels else words
         if s.op == "all" and s.clear:
             # the whole programmable frame off (Sinumerik TRANS/ROT without values): cancel the
             # local shift, and rotation, scaling and mirroring when they may be active
@@ -1342,6 +1355,19 @@ class IsoEmitter(IsoSpelling, Emitter):
         words += [self.code_word("frame", "rot"), (first, first + "0."), (second, second + "0."),
                   ("R", self.addr("R", s.values[named[0]]))]
         return _Lines([*cancel, words]) if cancel else words
+
+    def _replacing(self, s: n.FrameOp) -> list:
+        """The one component a replacing frame sets, about the work zero (an ISO G68 without X Y
+        turns about the current position, so the centre is written)."""
+        if s.op == "rot" and s.angle is not None:
+            a1, a2, _ = PLANE_AXES[self.plane]
+            words = [self.code_word("frame", "rot"), (a1, a1 + "0."), (a2, a2 + "0.")]
+            words += [(k, self.addr(k, v)) for k, v in s.values.items()]
+            return words + [("R", self.addr("R", s.angle))]
+        if s.op == "trans":
+            self.lowered("programmable translation written as G52 local offset")
+        return self.w_FrameOp(n.FrameOp(s.op, s.values, {} if s.op != "trans" else None, s.angle,
+                                        local=s.op == "trans"))
 
     def _cancel_others(self) -> list:
         """Rotation, scaling and mirroring off, each on a line of its own."""

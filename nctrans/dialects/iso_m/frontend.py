@@ -428,7 +428,9 @@ class Lowering:
         self._drop_axes(b)
         angle = self.num("A", vals.pop("R")) if "R" in vals else None
         values = {k: self.num(k, vals.pop(k)) for k in "IJK" if k in vals}
-        b.out.append((B_NONMODAL, FrameOp("rot", values, center or None, angle)))
+        # no X Y: the centre is the current position (seed L1453), and G68 replaces no other
+        # frame component: an empty centre, never None (which a Sinumerik ROT has)
+        b.out.append((B_NONMODAL, FrameOp("rot", values, center, angle)))
 
     def _own_clear(self, b: _Blk) -> None:
         op = {"rot_off": "rot", "scale_off": "scale"}[b.owner]
@@ -445,7 +447,9 @@ class Lowering:
         for letter, axis in (("I", "X"), ("J", "Y"), ("K", "Z")):
             if letter in vals:
                 values[axis] = self._scale_factor(vals.pop(letter))
-        b.out.append((B_NONMODAL, FrameOp("scale", values, center or None)))
+        # no X Y Z: about the workpiece zero (seed L1625); an empty centre, as G51 replaces no
+        # other frame component (None is a Sinumerik SCALE's, which does)
+        b.out.append((B_NONMODAL, FrameOp("scale", values, center)))
 
     def _scale_factor(self, v: Any):
         """G51 P/I/J/K: integers count 0.001 (seed L1622); a written decimal point is the factor."""

@@ -7,10 +7,24 @@ expands them (nctrans.convert)."""
 from __future__ import annotations
 
 from nctrans.dialects.emit import NotExpressible
+from nctrans.dialects.iso_m.emitter import NotConvertible
 from nctrans.dialects.iso_m import emitter as iso
 from nctrans.ir import nodes as n
 
 _INC = {"X": "U", "Z": "W", "C": "H"}
+
+
+def _fagor_d(s: n.ModeChange) -> int | None:
+    """The register of a tool-length change spelt D<k> (Fagor's D selects length and radius)."""
+    code = s.code.strip().upper()
+    return int(code[1:]) if code[:1] == "D" and code[1:].isdigit() and int(code[1:]) < 100 else None
+
+
+def _register(e) -> int | None:
+    """A constant offset register 0..99, or None."""
+    if type(e) is n.Num and e.value == int(e.value) and 0 <= e.value < 100:
+        return int(e.value)
+    return None
 
 
 class TurningEmitter(iso.IsoEmitter):
@@ -34,6 +48,10 @@ class TurningEmitter(iso.IsoEmitter):
         if s.group == "distance":
             self.distance = s.value
             return []                   # system A: incremental words are U/W
+        if s.group == "tool_length" and _fagor_d(s) is not None:
+            # a Fagor D<k> (length and radius of register k) is the T word's register k
+            self.pos = {}
+            return self._select_register(_fagor_d(s), None)
         if s.group == "tool_length" and s.value in ("plus", "off"):
             self.lowered("tool length offset on/off: a lathe applies the offset the T word names")
             return []
@@ -68,10 +86,40 @@ class TurningEmitter(iso.IsoEmitter):
         return [(k, "X" + iso.format_number(2 * float(w[1:]), True)) if k == "X" else (k, w)
                 for k, w in words]
 
+    # T<tool><offset> selects the tool and its one offset register at once: the tool and register
+    # the T word in force wrote, and the registers the program chose for each kind of offset
+    # (length H, radius D) since; None/empty where not known (before any T, after a place reached
+    # from elsewhere)
+    t_tool: "int | None" = None
+    t_offset: "int | None" = None
+    t_chosen: dict = {}
+    block_offset: "int | None" = None
+
+    def forget(self) -> None:
+        super().forget()
+        self.t_tool = self.t_offset = None
+        self.t_chosen = {}
+
+    def statements(self, body) -> list[list[str]]:
+        # a D in the block of its T goes into that T word (T1 D2 -> T0102; ISO T0102 stays T0102)
+        self.block_offset = next((_register(s.index) for s in body if type(s) is n.OffsetSelect
+                                  and _register(s.index) is not None), None)
+        if self.block_offset is None:
+            self.block_offset = next((_fagor_d(s) for s in body if type(s) is n.ModeChange
+                                      and s.group == "tool_length" and _fagor_d(s) is not None), None)
+        try:
+            return super().statements(body)
+        finally:
+            self.block_offset = None
+
     def w_ToolSelect(self, s):
         t = s.tool
         if type(t) is n.Num and t.value == int(t.value) and 0 <= t.value < 100:
-            return [("T", f"T{int(t.value):02d}{int(t.value):02d}")]
+            self.t_tool = int(t.value)
+            self.t_offset = self.t_tool if self.block_offset is None else self.block_offset
+            self.t_chosen = {}
+            return [("T", f"T{self.t_tool:02d}{self.t_offset:02d}")]
+        self.t_tool = self.t_offset = None
         raise NotExpressible("a tool number that is not 0..99")
 
     def w_ToolChange(self, s):
@@ -79,8 +127,34 @@ class TurningEmitter(iso.IsoEmitter):
         return []
 
     def w_OffsetSelect(self, s):
+        """An offset register (Sinumerik/Fagor D, ISO H or D) is the register of the T word: one
+        naming another register than the T word in force is written as the tool's T word with it.
+        Refused (NC402) where no T word can say it: no tool known before it, or an ISO mill's
+        length register H and radius register D that differ (a lathe's T word has one register
+        for both)."""
         self.pos = {}
-        return []                       # the T word carries the offset
+        k = _register(s.index)
+        if k is None:
+            raise NotExpressible("an offset register that is not a number 0..99 (ISO turning writes it "
+                                 "in the T word)")
+        return self._select_register(k, s.kind)
+
+    def _select_register(self, k: int, kind: "str | None") -> list:
+        if self.t_tool is None:
+            raise NotConvertible(f"offset register {k} with no tool known before it: ISO turning selects "
+                                 "the register with its tool in one word (T<tool><offset>), and which "
+                                 "tool is in the turret here is not in the program", f"D{k}")
+        if kind is not None:
+            other_kind = "radius" if kind == "length" else "length"
+            other = self.t_chosen.get(other_kind)
+            if other is not None and other != k:
+                raise NotConvertible(f"{kind} register {k} while the {other_kind} register {other} is in "
+                                     "force: a lathe's T word has one register for both", f"D{k}")
+            self.t_chosen[kind] = k
+        if k == self.t_offset:
+            return []                   # the T word in force already carries it
+        self.t_offset = k
+        return [("T", f"T{self.t_tool:02d}{k:02d}")]
 
     def w_SetPosition(self, s):
         self.pos = {}

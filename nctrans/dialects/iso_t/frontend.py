@@ -147,14 +147,14 @@ class TurningLowering(iso.Lowering):
         if type(v) is not Num or v.text is None or not v.text.lstrip("+").isdigit():
             self.warn_once("t-expr", "NC232", "warning", "T word by expression: taken as the tool "
                            "number, with no offset split", line)
-            return [s, ToolChange()]
+            return [s, ToolChange(turret=True)]
         digits = v.text.lstrip("+")
         num = int(digits)
         if len(digits) <= 2:
             tool, offset = num, num
         else:
             tool, offset = divmod(num, 100)
-        return [ToolSelect(Num(float(tool), None)), ToolChange(),
+        return [ToolSelect(Num(float(tool), None)), ToolChange(turret=True),
                 OffsetSelect("radius", Num(float(offset), None))]
 
     # ------------------------------------------------------------------ G handlers

@@ -698,8 +698,17 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             return
         if f.local:
             self.info("G52", "G52 local offset written as TRANS (replaces the programmable frame)")
+        if f.op == "mirror" and f.clear and f.values:
+            # ISO G50.1 X..: the mirror off on the axes named, the rest of the frame kept; MIRROR X0
+            # would switch it on (and replace the frame), MIRROR alone clears the whole frame
+            raise NotExpressible("a mirror cancelled on some axes (G50.1 X..) while the other frame "
+                                 "components stay")
+        if f.center is not None and not f.center and f.op == "rot":
+            raise NotExpressible("a rotation about the current position (ISO G68 without a centre)")
         pre, post = [], []
-        if f.center:
+        if f.center is not None and not f.center:
+            add = "_add"                # ISO G51 about the work zero: the other components stay
+        elif f.center:
             self.info("pivot", "frame pivot written as ATRANS to the pivot, the frame, ATRANS back")
             c = {k: self.expr(v.value) for k, v in f.center.items()}
             pre.append(f"{trans_add} " + " ".join(f"{k}={v}" for k, v in c.items()))
