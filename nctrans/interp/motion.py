@@ -74,7 +74,13 @@ class MotionMixin:
         turns = None if s.turns is None else self.ev.compile(s.turns)
         polar = None
         if s.polar:
-            polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
+            polar = {}
+            for k, v in s.polar.items():
+                # AP=IC(..): the angle from the last polar angle; AP=AC(..) as a plain AP
+                if (k == "angle" and type(v) is n.Func and v.name.upper() in ("IC", "AC")
+                        and len(v.args) == 1):
+                    k, v = ("angle_inc" if v.name.upper() == "IC" else "angle"), v.args[0]
+                polar[k] = self.ev.compile(v)
         via = self._words(s.via)
         ap = getattr(s, "aperture", None)
         aperture = None if ap is None else self.ev.compile(ap)
@@ -294,11 +300,13 @@ class MotionMixin:
 
     def _polar(self, vals, polar):
         """Polar words (radius, angle in the active plane about the pole: program zero until
-        G110/G111/G112 sets one). A word left out keeps its value from the current point."""
+        G110/G111/G112 sets one). A word left out keeps its value from the current point, and
+        AP=IC(..) adds to that angle (the last polar angle, [GK] Siemens Fundamentals)."""
         a1, a2, _ = PLANE_AXES[self.st.plane]
         r = self._value(polar["radius"], "polar radius") if "radius" in polar else None
         ang = self._value(polar["angle"], "polar angle") if "angle" in polar else None
-        if r is None and ang is None:
+        inc = self._value(polar["angle_inc"], "polar angle") if "angle_inc" in polar else None
+        if r is None and ang is None and inc is None:
             return vals
         c1, c2 = self.pole or (0.0, 0.0)
         p1, p2 = self.pos.get(a1, 0.0) - c1, self.pos.get(a2, 0.0) - c2
@@ -307,7 +315,8 @@ class MotionMixin:
         else:
             r *= self.st.scale
         if ang is None:
-            ang = math.degrees(math.atan2(p2, p1))
+            # the last polar angle: where the tool is, seen from the pole
+            ang = math.degrees(math.atan2(p2, p1)) + (inc or 0.0)
         rest = [w for w in vals if w[0] not in (a1, a2)]
         return rest + [(a1, c1 + r * math.cos(math.radians(ang)), "abs"),
                        (a2, c2 + r * math.sin(math.radians(ang)), "abs")]
