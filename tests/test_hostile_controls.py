@@ -105,9 +105,14 @@ def test_corner_elements_on_degenerate_geometry(tmp_path):
     by = _family(tmp_path, CORNERS, "iso-m")
     # a zero-length move beside the corner was a ZeroDivisionError (internal error) in every
     # command; the element is not inserted and that is said at its line
-    for name in ("zero-next.mpf", "zero-this.mpf"):
-        rc, text = by[("lint", name, False)]
-        assert located(text, "NC217", name, 5) and "no length in the plane" in text, text
+    rc, text = by[("lint", "zero-this.mpf", False)]
+    assert located(text, "NC217", "zero-this.mpf", 5) and "no length in the plane" in text, text
+    # a move of no length after the corner's block counts as a block without motion (issue #8):
+    # the rounding goes to the next block that moves, (8, 0) to (10, 2)
+    rc, text = by[("lint", "zero-next.mpf", False)]
+    assert rc == 0 and "NC217" not in text, text
+    rc, text = by[("toolpath", "zero-next.mpf", False)]
+    assert '"kind":"arc"' in text and '"end":{"X":10.0,"Y":2.0' in text, text
     rc, text = by[("lint", "zero-arc.mpf", False)]
     assert rc == 1 and located(text, "NC203", "zero-arc.mpf", 6), text       # an arc of radius 0
     rc, text = by[("lint", "iso-zero.nc", False)]

@@ -11,7 +11,10 @@ Which words exist, what they mean and what the control does when no contour elem
 data: `[options.corner_elements]` of the dialect's rules table (words -> round, round_modal,
 chamfer_length, chamfer_leg, feed, feed_modal; `missing_next` "alarm" (ISO seed L4000-4004) or
 "none" (Sinumerik [GK]: no element is inserted); `dummy_blocks`, the blocks without motion that
-may stand between; `feed_from`). The geometry is corners.py.
+may stand between, and `zero_length = "dummy"` where a G1 that moves nothing counts as one of
+them (Sinumerik: the element goes to the next block that moves); `feed_from`). The geometry is
+corners.py. A writer whose word cannot say how the source control inserts an element asks
+nctrans.lower.corner_fit, fed by `_mark`.
 
 Not inserted, said at the line of the word (NC217 warning, NC218 error where the control alarms):
 the next move is not G1/G2/G3 in the same plane, or moves outside the plane, the plane, the frame
@@ -71,6 +74,7 @@ class CornerStage:
     modal_feed: Optional[float] = None      # FRCM
     pending: Optional[Move] = None
     queued: list = field(default_factory=list)
+    still: set = field(default_factory=set)   # (file, line) of G1 blocks held back that move nothing
 
 
 def compile_word(it, s: n.Passthrough):
@@ -157,6 +161,12 @@ def _probe(it, m: Move) -> tuple:
 def move(it, kind, start, end, center, cw, turns, payload) -> None:
     """records._move with a corner stage: hold, join or pass on the move."""
     cs = it.corner
+    if cs.pending is not None and kind == "linear" and start == end and _stands_still_as_dummy(it, cs):
+        # a G1 that moves nothing counts as a block without motion in the plane: the element
+        # goes to the next block that moves, as long as few enough stand between
+        cs.still.add((payload[0], payload[1]))
+        if not _too_many_between(it, cs):
+            return
     new = Move(kind, start, end, center, cw, turns, payload, it.span)
     new.corner = _carried(it, cs, kind)
     p = cs.pending
@@ -181,13 +191,29 @@ def record(it, rec) -> bool:
     if cs is None or cs.pending is None:
         return False
     cs.queued.append(rec)
-    p = cs.pending
-    allowed = int(settings(p.corner[3]).get("dummy_blocks", 0))
-    lines = {(r.file, r.line) for r in cs.queued}
+    _too_many_between(it, cs)
+    return True
+
+
+def _too_many_between(it, cs: CornerStage) -> bool:
+    """Whether more blocks without motion in the plane stand between the held move and the next
+    one than the control allows (the held move then goes, uninserted)."""
+    allowed = int(settings(cs.pending.corner[3]).get("dummy_blocks", 0))
+    lines = {(r.file, r.line) for r in cs.queued} | cs.still
     if len(lines) > allowed:
         flush(it, f"{'a block' if not allowed else f'more than {allowed} blocks'} without motion "
               "in the plane stands between it and the next contour move")
-    return True
+        return True
+    return False
+
+
+def _stands_still_as_dummy(it, cs: CornerStage) -> bool:
+    """A move of no length that the held element's control counts as a block without motion
+    (rules corner_elements.zero_length = "dummy"), unless it programs an element of its own."""
+    if settings(cs.pending.corner[3]).get("zero_length") != "dummy":
+        return False
+    b = cs.block
+    return not (b is not None and b[2] is it.span)
 
 
 def flush(it, why: str = "no contour move follows it") -> None:
@@ -216,6 +242,7 @@ def finish(it) -> None:
 
 
 def _replay(it, cs: CornerStage) -> None:
+    cs.still = set()
     queued, cs.queued = cs.queued, []
     for rec in queued:
         it._push_record(rec)
@@ -238,6 +265,14 @@ def _not_inserted(it, m: Move, why: str, control_does: str = "") -> None:
         rule, severity, control = "NC217", "warning", "the control inserts none"
     it.diag(rule, severity, f"the {_NOUN[kind]} ({value:g}) is not in the analysed toolpath: {why} "
             f"({control}; the analysed toolpath runs the corner sharp)", m.span)
+
+
+def _mark(it, m: Move) -> None:
+    """Note the element's block for a writer that asks which elements it cannot write as the
+    same word (nctrans.lower.corner_fit sets `corner_unfit` on the interpreter it runs)."""
+    sink = it.__dict__.get("corner_unfit")
+    if sink is not None and m.span is not None:
+        sink.add((m.span.file, m.span.line))
 
 
 def _in_plane(m: Move, a1: str, a2: str) -> bool:
@@ -297,6 +332,8 @@ def _join(it, p: Move, new: Move) -> Move:
         if corner is None:
             reduced = settings(dialect).get("too_large") == "reduced"
             _not_inserted(it, p, why, "the control shrinks it to fit" if reduced else "")
+            if reduced:
+                _mark(it, p)
     if corner is None:
         _emit(it, p)
         _replay(it, it.corner)
@@ -306,6 +343,8 @@ def _join(it, p: Move, new: Move) -> Move:
         out = dict(like)
         out[a1], out[a2] = point
         return out
+    if it.corner.still:
+        _mark(it, p)                    # inserted across blocks that move nothing
     t1 = at(corner.first_end, p.end)
     t2 = at(corner.second_start, p.end)
     _emit(it, replace(p, end=t1))

@@ -1895,7 +1895,25 @@ class IsoEmitter(IsoSpelling, Emitter):
             raise NotConvertible(f"{s.dialect} {s.reason} {s.text.strip()!r} (the next block is not a "
                                  "contour move, which ISO requires after ,R / ,C: the corner is written "
                                  "as the arc or line it inserts)", s.text.strip())
+        if self._corner_unlike_here(s):
+            raise NotConvertible(f"{s.dialect} {s.reason} {s.text.strip()!r} (the source control shrinks "
+                                 "it to fit or inserts it after blocks that move nothing, where the ISO "
+                                 f"control alarms at {own.get(kind, kind)}: the corner is written as the "
+                                 "arc or line it inserts)", s.text.strip())
         return "," + self.addr(word.lstrip(","), s.value)
+
+    def _corner_unlike_here(self, s: n.Passthrough) -> bool:
+        """Whether the source control inserts this block's element in a way the ISO word cannot say
+        (nctrans.lower.corner_fit: too large, or across blocks that move nothing)."""
+        src = corner_elements.settings(s.dialect)
+        mine = corner_elements.settings(self.dialect)
+        if all(src.get(k) in (None, mine.get(k)) for k in ("too_large", "zero_length")):
+            return False
+        from nctrans.dialects.emit import CONVERSION_MACHINE
+        from nctrans.lower.corner_fit import unfit_corners
+        get = CONVERSION_MACHINE.get()
+        span = self.span
+        return span is not None and (span.file, span.line) in unfit_corners(self.program, get() if get else None)
 
     def _spindle_position(self, s: n.Passthrough) -> list:
         """Sinumerik SPOS/SPOSA: M19 positions the spindle at setting data 43240 M19_SPOS (ISO seed

@@ -1,0 +1,35 @@
+"""Which corner elements of the source its control inserts in a way a target's same word cannot say.
+
+A Sinumerik control shrinks a rounding or chamfer too large for the blocks around it (rules
+`too_large = "reduced"` [GK]) and puts an element across blocks that move nothing (`zero_length =
+"dummy"`); an ISO control alarms at the same `,R` / `,C`. Whether an element fits is a question of the
+geometry at the corner, which only the interpreter knows, so a writer of such a target asks here
+before it writes the word: the source runs once (records dropped, memory flat) and the blocks whose
+element did not fit or spans such blocks come back as (file, line). The writer then lowers that
+construct (the interpreter writes the arc it inserts) or, where nctrans does not model what the
+control does (the shrink), the lowering refuses it at its line (NC402 after NC219).
+"""
+from __future__ import annotations
+
+import os
+from typing import Any
+
+from nctrans.ir import nodes as n
+
+_LAST: list[Any] = [None, frozenset()]          # (program, its answer): one conversion at a time
+
+
+def unfit_corners(program: n.Program, machine=None) -> frozenset:
+    """(file, line) of every block whose corner element the source control inserts so."""
+    if _LAST[0] is program:
+        return _LAST[1]
+    from nctrans import pipeline
+    from nctrans.interp.interpreter import Interpreter
+    source_dir = os.path.dirname(program.file) if program.file and program.file != "<stdin>" else None
+    it = Interpreter(program, machine, diagnostics=[],
+                     resolver=pipeline.make_resolver(source_dir or None, program.dialect))
+    it.corner_unfit = set()
+    for _ in it.run():
+        pass
+    _LAST[:] = [program, frozenset(it.corner_unfit)]
+    return _LAST[1]
