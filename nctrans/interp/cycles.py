@@ -485,13 +485,8 @@ class CycleTable:
         """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle); a
         control profile of the dialect's rules table may override it (`cycle_positioning`)."""
         if profile:
-            from nctrans.rules import load_table
-            from nctrans.tables import TableError
-            try:
-                options = load_table(dialect).options
-            except TableError:          # a dialect without a rules table has no profiles
-                options = {}
-            own = ((options.get("profiles") or {}).get(profile) or {}).get("cycle_positioning")
+            from nctrans.rules import option
+            own = ((option(dialect, "profiles") or {}).get(profile) or {}).get("cycle_positioning")
             if own in ("clear_level", "current"):
                 return own
         return self.positioning.get(dialect, self.positioning.get("default", "clear_level"))
