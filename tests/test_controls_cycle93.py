@@ -102,7 +102,8 @@ def test_inside_groove_cuts_away_from_the_axis():
 
 @pytest.mark.parametrize("call, width, rule", [
     ("CYCLE93(40, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", None, "NC113"),    # no tool width
-    ("CYCLE93(40, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 2, 1)", 3.0, "NC113"),     # face groove
+    ("CYCLE93(10, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 2, 1)", 3.0, "NC114"),     # face, past the axis
+    ("CYCLE93(40, -10, 8, 4, 0, 0, 10, 0, 0, 0, 0, 0, 0, 2, 0, 6, 1)", 3.0, "NC113"),    # ANG2 on a face groove
     ("CYCLE93(40, -10, 8, 4, 5, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", 3.0, "NC113"),     # STA1
     ("CYCLE93(40, -10, 8, 4, 0, 10, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", 3.0, "NC113"),    # ANG1
     ("CYCLE93(40, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 9, 1)", 3.0, "NC114"),     # VARI 9
@@ -118,6 +119,42 @@ def test_what_is_not_modelled_or_alarms_moves_nothing_and_says_so(call, width, r
     assert got == []
     said = [d for d in diags if d.line == 4 and d.severity != "info"]
     assert [d.rule for d in said] == [rule] and "CYCLE93" in said[0].message
+
+
+def test_face_groove_in_a_right_hand_face_by_hand():
+    # VARI 6: face, outside, starting point on the right: the groove runs from radius 20 (SPD 40
+    # under DIAMON) towards the axis to radius 14 (WIDG 6) and goes into the face Z0 towards -Z
+    # (DIAG 3); _VRT 1 puts the start point at Z1. Tool 3 wide (its first edge on the outer side),
+    # no allowances, IDEP 0: plunges at u 0 and 3 (radius 20 and 17) to Z-3. Finishing: the first
+    # edge down the outer flank (radius 20) to the base and along it to the middle (radius 17); the
+    # second edge (3 further in) down the inner flank at radius 14 (the first edge at 17) and along
+    # the base until the first edge is back at radius 20; out, and the cycle ends at the start point.
+    got, diags, _ = _run("CYCLE93(40, 0, 6, 3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 6, 1)")
+    assert not [d for d in diags if d.severity != "info"]
+    r, f = "rapid", "linear"
+    want = [(r, 20, 1), (f, 20, -3), (r, 20, 1), (r, 17, 1), (f, 17, -3), (r, 17, 1),
+            (r, 20, 1), (f, 20, 0), (f, 20, -3), (f, 17, -3), (r, 17, 1),
+            (f, 17, 0), (f, 17, -3), (f, 20, -3), (r, 20, 1)]
+    assert got == [(k, pytest.approx(x), pytest.approx(z)) for k, x, z in want]
+
+
+def test_inside_face_groove_starting_left_goes_into_plus_z():
+    # VARI 4: face, inside (the groove lies away from the axis, towards +X from SPD), starting point
+    # on the left (the groove goes into the face Z-5 towards +Z): radius 10 (SPD 20) .. 13, 2 deep
+    # (base at Z-3), start point at Z-6. Tool 3 = WIDG: one plunge, then both edges at radius 10.
+    got, diags, _ = _run("CYCLE93(20, -5, 3, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 4, 0)")
+    assert not [d for d in diags if d.severity != "info"]
+    r, f = "rapid", "linear"
+    want = [(r, 10, -6), (f, 10, -3), (r, 10, -6), (f, 10, -5), (f, 10, -3), (r, 10, -6),
+            (f, 10, -5), (f, 10, -3), (r, 10, -6)]
+    assert got == [(k, pytest.approx(x), pytest.approx(z)) for k, x, z in want]
+
+
+def test_face_groove_with_corners_converted_to_iso_turning_is_equivalent():
+    text = _text("CYCLE93(40, 0, 8, 3, 0, 0, 0, 0.5, -0.5, 0, 0.5, 0.1, 0.2, 1, 0.2, 16, 0)")
+    conv = api.transpile(text, "sinumerik", "iso-t", machine=_lathe(3.0))
+    assert conv.text is not None and "CYCLE93" not in conv.text
+    assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-t", machine=_lathe(3.0))
 
 
 def test_converted_to_iso_turning_is_equivalent():
@@ -162,7 +199,7 @@ corner = st.one_of(st.just(0.0), st.floats(-2, -0.1), st.floats(0.1, 2))
 
 @settings(max_examples=80, deadline=None)
 @given(st.floats(2, 30), st.floats(0.5, 12), st.floats(0.3, 1.0), st.floats(0, 0.5), st.floats(0, 0.5),
-       st.one_of(st.just(0.0), st.floats(0.2, 5)), st.sampled_from([1, 3, 5, 7, 11, 13, 15, 17]),
+       st.one_of(st.just(0.0), st.floats(0.2, 5)), st.sampled_from([1, 2, 3, 4, 5, 6, 7, 8, 11, 12, 13, 14, 15, 16, 17, 18]),
        corner, corner, corner, corner, st.floats(0, 2), st.floats(-50, 50))
 def test_grooves_stay_in_the_outline_reach_the_depth_and_end_at_the_start(
         W, D, frac, fal1, fal2, idep, vari, rco1, rco2, rci1, rci2, vrt, spl):
@@ -173,23 +210,28 @@ def test_grooves_stay_in_the_outline_reach_the_depth_and_end_at_the_start(
     c = {}
     for name, v in (("o1", rco1), ("o2", rco2), ("i1", rci1), ("i2", rci2)):
         c[name] = ("radius" if v > 0 else "chamfer", _legs(v, chr_))
+    face = vari % 2 == 0
+    s = -1.0 if vari % 10 >= 5 else 1.0
+    e = -1.0 if vari % 10 in (3, 4, 7, 8) else 1.0
     try:
         rough, finish = groove_passes(p, tw)
     except MillingError as err:                     # refused only where the groove cannot be cut so
         assert err.rule == "NC114"
         assert (c["o1"][1] + c["i1"][1] > D or c["o2"][1] + c["i2"][1] > D or c["i1"][1] + c["i2"][1] > W
-                or tw > W - c["i1"][1] - c["i2"][1] - 1e-9 or tw > W - 2 * fal2 - 1e-9 or fal1 >= D - 1e-9)
+                or tw > W - c["i1"][1] - c["i2"][1] - 1e-9 or tw > W - 2 * fal2 - 1e-9 or fal1 >= D - 1e-9
+                or (face and e > 0 and W + c["o2"][1] > 20.0 - 1e-9))   # an outside face groove past the axis
         return
-    s = -1.0 if vari % 10 >= 5 else 1.0
-    e = -1.0 if vari % 10 in (3, 7) else 1.0
+    v = vrt or 1.0
 
     def local(xz):
+        if face:                                    # u along X away from the start point, w into Z
+            return e * (20.0 - xz[0]), s * (xz[1] - spl)
         return s * (xz[1] - spl), e * (20.0 - xz[0])
 
-    v = vrt or 1.0
+    start = (20.0, spl - s * v) if face else (20.0 + e * v, spl)
     steps = groove_steps(p, tw)
-    assert steps[0] == ("rapid", pytest.approx((20.0 + e * v, spl)))     # the start point
-    assert steps[-1] == ("rapid", pytest.approx((20.0 + e * v, spl)))    # ... where it ends
+    assert steps[0] == ("rapid", pytest.approx(start))     # the start point
+    assert steps[-1] == ("rapid", pytest.approx(start))    # ... where it ends
     here = local(steps[0][1])
     deepest = 0.0
     for k, step in enumerate(steps):

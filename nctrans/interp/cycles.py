@@ -445,6 +445,15 @@ class UndercutTables:
 
 
 @dataclass
+class GrooveVariant:
+    """rules/cycles.toml [cycle93_vari]: one CYCLE93 VARI ones digit (nctrans.interp.grooving)."""
+    __pydantic_config__ = {"extra": "forbid"}
+    face: bool
+    inside: bool
+    right: bool
+
+
+@dataclass
 class CycleTable:
     """rules/cycles.toml: Siemens standard cycles, hole patterns and CYCLE800 (schema for pydantic)."""
     __pydantic_config__ = {"extra": "forbid"}
@@ -461,6 +470,7 @@ class CycleTable:
     milling_param: dict[str, MillingParam] = field(default_factory=dict)
     milling_model: dict[str, float] = field(default_factory=dict)
     undercut: UndercutTables = field(default_factory=UndercutTables)
+    cycle93_vari: dict[str, GrooveVariant] = field(default_factory=dict)
 
     @classmethod
     def from_data(cls, d: dict) -> "CycleTable":
@@ -479,7 +489,8 @@ class CycleTable:
                    milling=[MillingCycle(**m) for m in d.get("milling", [])],
                    milling_param={k: MillingParam(**v) for k, v in d.get("milling_param", {}).items()},
                    milling_model=dict(d.get("milling_model", {})),
-                   undercut=_undercut_tables(d.get("undercut", {})))
+                   undercut=_undercut_tables(d.get("undercut", {})),
+                   cycle93_vari={k: GrooveVariant(**v) for k, v in d.get("cycle93_vari", {}).items()})
 
     def position_at(self, dialect: str, profile: Optional[str] = None) -> str:
         """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle); a

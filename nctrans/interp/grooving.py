@@ -10,9 +10,14 @@ Facts [GK] (Siemens 840D/810D turning cycles manual; the seeds do not document C
 - SPD is the groove's starting point in the facing axis X (a diameter under DIAMON, as X is
   programmed), SPL in the longitudinal axis Z; WIDG and DIAG are unsigned, DIAG a radius;
 - VARI ones digit 1..8: longitudinal (odd) or face (even), outside (1, 2, 5, 6) or inside (3, 4,
-  7, 8), the starting point on the left (1..4: the groove lies towards +Z from SPL) or on the
-  right (5..8: towards -Z); tens digit 0: a chamfer's value is its length along the chamfer
-  (CHF), 1: the length of its legs (CHR);
+  7, 8), the starting point on the left (1..4) or on the right (5..8); tens digit 0: a chamfer's
+  value is its length along the chamfer (CHF), 1: the length of its legs (CHR);
+- the three choices say where the starting point lies against the groove: left = on the groove's
+  -Z side (the groove lies towards +Z from SPL), right = on its +Z side; outside = on its +X side
+  (the groove lies towards the axis from SPD), inside = on its -X side. A longitudinal groove runs
+  along Z (WIDG) and goes into X (DIAG); a face groove runs along X and goes into Z: VARI 6 is
+  the usual face groove in a right-hand end face, entered from +Z and running from SPD towards
+  the axis (the Siemens VARI picture read this way [GK]; the seeds have no picture);
 - RCO1/RCO2 round or chamfer the groove's outer corners (on the contour), RCI1/RCI2 its corners
   at the base, 1 on the starting point's side: a positive value is a radius, a negative one a
   chamfer;
@@ -35,9 +40,12 @@ Modelling choices [NC] (the manual leaves them to the control):
   _VRT (1 mm when 0) with G0; between plunges the tool goes out to the start point's level;
 - roughing leaves the allowances measured paraxially, and a plunge never reaches into a rounded or
   chamfered base corner (it stops above the corner where the tool spans it);
-- not modelled, refused at the call's line and moving nothing (NC113): face grooves (VARI 2, 4,
-  6, 8: which side of SPD the groove lies on is not established here), an inclined contour
-  (STA1 not 0), flank angles ANG1/ANG2, MCALL.
+- not modelled, refused at the call's line and moving nothing (NC113): an inclined contour
+  (STA1 not 0: the sense in which the angle turns the groove is not documented in the seeds),
+  flank angles ANG1/ANG2 (whether WIDG is the width at the base or on the contour is not
+  documented in the seeds), MCALL;
+- a groove or clearance that would take the path across the turning axis (X below 0) alarms
+  (NC114).
 """
 from __future__ import annotations
 
@@ -61,13 +69,16 @@ def impossible(message: str) -> MillingError:
 
 
 def variant(vari: float) -> tuple[bool, bool, bool, bool]:
-    """VARI -> (face, inside, starting point on the right, chamfers as leg length CHR)."""
+    """VARI -> (face, inside, starting point on the right, chamfers as leg length CHR); the ones
+    digit from rules/cycles.toml [cycle93_vari]."""
+    from nctrans.interp.cycles import cycle_table
     v = int(vari) if math.isfinite(vari) else 0
     ones, tens = v % 10, v // 10
-    if v != vari or not 1 <= ones <= 8 or tens not in (0, 1):
+    row = cycle_table().cycle93_vari.get(str(ones))
+    if v != vari or row is None or tens not in (0, 1):
         raise impossible(f"with VARI {vari:g} (1..8 and 11..18: longitudinal or face, outside or inside, "
                          "starting point left or right; tens digit the chamfer measure)")
-    return ones % 2 == 0, ones in (3, 4, 7, 8), ones >= 5, tens == 1
+    return row.face, row.inside, row.right, tens == 1
 
 
 def _leg(value: float, chr_: bool) -> tuple[str, float]:
@@ -119,15 +130,15 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
         if not math.isfinite(v):
             raise impossible(f"with {k} not a finite number")
     face, inside, right, chr_ = variant(p.get("VARI", 0.0))
-    if face:
-        raise unmodelled("as a face groove (VARI 2, 4, 6, 8): not modelled; nctrans models longitudinal "
-                         "grooves (VARI 1, 3, 5, 7)")
     if abs(p.get("STA1", 0.0)) > EPS:
-        raise unmodelled(f"on an inclined contour (STA1 {p['STA1']:g}): not modelled; nctrans models "
-                         "grooves in a contour parallel to the axis (STA1 0)")
-    if abs(p.get("ANG1", 0.0)) > EPS or abs(p.get("ANG2", 0.0)) > EPS:
-        raise unmodelled("with flank angles ANG1/ANG2: not modelled; nctrans models flanks square to "
-                         "the contour")
+        raise unmodelled(f"on an inclined contour (STA1 {p['STA1']:g}): not modelled (the sense in which the "
+                         "angle turns the groove is not documented in the seeds); nctrans models grooves in a "
+                         "contour parallel (longitudinal) or square (face) to the axis, STA1 0")
+    for name in ("ANG1", "ANG2"):
+        if abs(p.get(name, 0.0)) > EPS:
+            raise unmodelled(f"with flank angle {name} {p[name]:g}: not modelled (whether WIDG is the width at "
+                             "the base or on the contour is not documented in the seeds); nctrans models "
+                             "flanks square to the contour")
     W, D = abs(p.get("WIDG", 0.0)), abs(p.get("DIAG", 0.0))
     if W <= EPS or D <= EPS:
         raise impossible("without a groove width WIDG or depth DIAG")
@@ -148,14 +159,18 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
         raise impossible(f"with a tool {tw:g} wide, or allowances FAL1/FAL2, that leave nothing to rough "
                          "(the control stops with an alarm)")
     groove = _Outline(W, D, o1, o2, i1, i2)
-    s = 1.0 if not right else -1.0                 # +u along +Z when the starting point is left
-    e = -1.0 if inside else 1.0                    # +w towards the axis outside, away from it inside
+    s = 1.0 if not right else -1.0                 # the groove lies towards +Z of SPL when the starting point is left
+    e = -1.0 if inside else 1.0                    # ... towards the axis (-X) of SPD when it is outside
     r0, spl = p.get("SPD", 0.0), p.get("SPL", 0.0)
-    if not inside and D > r0 + EPS:
-        raise impossible(f"with a groove {D:g} deep in a radius of {r0:g} (past the axis)")
+    # (u, w) -> (X radius, Z): longitudinal grooves run along Z (u) and go into X (w); face grooves
+    # run along X (u) and go into Z (w)
+    u_dir, w_dir = ((-e, 0.0), (0.0, s)) if face else ((0.0, s), (-e, 0.0))
+    reach = D if not face else W + o2[1]
+    if not inside and reach > r0 + EPS:
+        raise impossible(f"with a groove reaching {reach:g} towards the axis from a radius of {r0:g} (past the axis)")
 
     def at(u: float, w: float) -> tuple[float, float]:
-        return (r0 - e * w, spl + s * u)
+        return (r0 + u * u_dir[0] + w * w_dir[0], spl + u * u_dir[1] + w * w_dir[1])
 
     steps: list[Step] = []
     roughing: list[Step] = []
@@ -231,6 +246,9 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
     here = min(u2, W - i2[1]) - tw
     go("rapid", here, -vrt)
     go("rapid", 0.0, -vrt)
+    if any(st[0] != "dwell" and st[1][0] < -EPS for st in roughing + steps):
+        raise impossible(f"with a path that crosses the turning axis (X below 0): the groove or its "
+                         f"clearance _VRT {vrt:g} does not fit the radius {r0:g}")
     return roughing, steps
 
 
