@@ -177,8 +177,9 @@ def test_iso_length_set_again_after_a_tool_change_stays_structural_on_fagor():
 
 def test_iso_g49_under_radius_compensation_is_not_a_fagor_d0():
     # a Fagor D0 ends length and radius compensation (8065 manual, tool offsets); an ISO G49 under
-    # G41 ends the length only: never written as D0 there. The analysis says at the G49 that the
-    # held compensated move before it takes the new length (not modelled exactly: NC220)
+    # G41 ends the length only: never written as D0 there. The analysis models the change (the held
+    # compensated move before it keeps the old length) and says at the G49 that LinuxCNC refuses it
+    # (NC122, info)
     import nctrans
     text = ("%\nO1\nG21 G17 G90 G94\nT1 M6\nG43 H1 Z50.\nG0 X-10. Y0\nG1 Z-1. F100.\nG41 D1 X0 Y0\n"
             "G1 X20.\nG49\nG1 Y20.\nG40 X30. Y30.\nG0 Z50.\nM30\n%\n")
@@ -187,5 +188,5 @@ def test_iso_g49_under_radius_compensation_is_not_a_fagor_d0():
     assert said and said[0][1] == 10
     assert conv.text is None or "flattened" in conv.text
     lint = [(d.rule, d.line) for d in nctrans.lint(text, dialect="iso-m", machine=_GEOMETRY)]
-    assert ("NC220", 10) in lint
-    assert ("NC220", 10) not in [(d.rule, d.line) for d in nctrans.lint(text, dialect="iso-m")]
+    assert ("NC122", 10) in lint and ("NC220", 10) not in lint
+    assert ("NC122", 10) not in [(d.rule, d.line) for d in nctrans.lint(text, dialect="iso-m")]

@@ -351,7 +351,7 @@ def _join(it, p: Move, new: Move) -> Move:
     cs = it.corner
     pay = new.payload
     file, line = p.payload[0], p.payload[1]
-    element_payload = (file, line, feed if feed is not None else pay[2], pay[3], pay[4], pay[5], plane)
+    element_payload = (file, line, feed if feed is not None else pay[2], pay[3], pay[4], pay[5], plane, pay[7])
     it._emit_move(corner.kind, t1, t2, corner.center, corner.cw, None, element_payload)
     _replay(it, cs)
     return replace(new, start=t2)

@@ -151,6 +151,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.comp = None
         self.comp_radius = 0.0
         self.comp_exit = False
+        self.comp_tool_z = None         # tool length of the last move out of cutter compensation (records.py)
         self.modal_call = None          # (SubCall, args snapshot, depth)
         self.cycle_params: dict[str, float] = {}
         self.cycle_initial: Optional[float] = None

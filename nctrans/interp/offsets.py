@@ -120,14 +120,23 @@ class OffsetsMixin:
             z = self.machine.length_offset(int(idx)) if idx else 0.0
             if st.length_mode == "minus":
                 z = -z
-        if self.comp is not None and z != self.off.tool_z:
-            # the compensated move held before this block is written when the next one comes,
-            # with the offsets then in force: said, not silently shifted (LinuxCNC refuses it)
-            self.diag("NC220", "warning", "a tool length change under cutter radius compensation is "
-                      "not modelled exactly: the compensated move before this block is analysed "
-                      "with the new length (LinuxCNC refuses the change; end the compensation first)")
-        self.off.set_tool(z)
-        self._resync()
+        if self.comp is not None:
+            # Under cutter radius compensation the move before this block is still held (its end
+            # waits for the next move's corner): it keeps the length it was programmed with (its
+            # payload carries it, records.py), and the program point is that move's end, not the
+            # last emitted (compensated) machine point, so the change applies from the next move.
+            held, changed = self._to_machine(self.pos), z != self.off.tool_z
+            self.off.set_tool(z)
+            tot = self.off.total
+            self.pos = self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in held.items()})
+            if changed and self.program.dialect == "iso-m":
+                self.diag("NC122", "info", "a tool length change under cutter radius compensation: "
+                          "modelled as the control applies it (the held compensated move keeps the "
+                          "old length, the next move takes the new one); LinuxCNC refuses it (end the "
+                          "compensation first)")
+        else:
+            self.off.set_tool(z)
+            self._resync()
         if self.travel_limits is not None:      # limits on the tool tip follow its length
             self._send_limits()
 

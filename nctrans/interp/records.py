@@ -81,12 +81,27 @@ class RecordsMixin:
         sp = self.span
         st = self.st
         return (sp.file if sp else self.program.file, sp.line if sp else 1, st.feed, st.feed_mode,
-                st.spindle_speed, st.tool, st.plane)
+                st.spindle_speed, st.tool, st.plane, self.off.tool_z)
+
+    def _machine_at(self, p: dict[str, float], tool_z: float) -> dict[str, float]:
+        """The machine point of program point `p` under the tool length `tool_z` (the one in force
+        when a move held by cutter compensation was programmed; the rest of the offsets as now)."""
+        m = self._to_machine(p)
+        shift = tool_z - self.off.tool_z
+        if shift and "Z" in m:
+            m["Z"] += shift
+        return m
 
     def _finish_move(self, kind, start, end, center, cw, turns, payload, start_given=False) -> None:
-        file, line, feed, feed_mode, speed, tool, plane = payload
-        mend = self._to_machine(end)
-        mstart = self._to_machine(start) if start_given else self.mpos
+        file, line, feed, feed_mode, speed, tool, plane, tool_z = payload
+        if start_given:                 # out of cutter compensation: a move held past a length change
+            # ends where it was programmed to; the next starts where the one before it ended
+            mend = self._machine_at(end, tool_z)
+            mstart = self._machine_at(start, tool_z if self.comp_tool_z is None else self.comp_tool_z)
+            self.comp_tool_z = tool_z
+        else:
+            mend = self._to_machine(end)
+            mstart = self.mpos
         if len(mstart) != len(mend):
             mstart = {**{a: mend[a] for a in mend if a not in mstart}, **mstart}
         if kind == "rapid":
@@ -103,7 +118,7 @@ class RecordsMixin:
             cprog = {a1: center[0], a2: center[1], an: end.get(an, 0.0)}
             full = dict(end)
             full.update(cprog)
-            mfull = self._to_machine(full)
+            mfull = self._machine_at(full, tool_z) if start_given else self._to_machine(full)
             mc = {a1: mfull[a1], a2: mfull[a2], an: mfull[an]}
             rec.center = mc
             rec.plane = plane
@@ -114,6 +129,8 @@ class RecordsMixin:
         self.out.append(rec)
         if self.hook is not None:
             tot = self.off.total
+            if tool_z != self.off.tool_z:   # work coordinates as the move was programmed
+                tot = {**tot, "Z": tot.get("Z", 0.0) + tool_z - self.off.tool_z}
             work = {a: v - tot.get(a, 0.0) for a, v in mend.items()}
             wc = None if mc is None else {a: v - tot.get(a, 0.0) for a, v in mc.items()}
             self._hookq.append((work, wc))
@@ -135,6 +152,7 @@ class RecordsMixin:
             if r < 0:           # a negative stored radius swaps the side
                 side, r = ("right" if side == "left" else "left"), -r
             self.comp = self._compensator(side, r)     # lathe.py: the tool-nose tip
+            self.comp_tool_z = None                    # the entry starts where it was programmed
         self._comp_out(self.comp.push(pm))
         return True
 
