@@ -144,6 +144,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.spindle_stopped = False
         self.spindle_reported = False
         self.spindle_angle = None         # where SPOS/M19 left the spindle (spindle_position.py)
+        self.master_spindle = 1           # SETMS(n) (spindle_position.py); None: not known
         self.thread_start = 0.0           # SD 42000 THREAD_START_ANGLE (thread_starts.py)
         self.comp_d_reported = False      # NC208 once per G41/G42 without a D word
         self.last_from: Optional[dict] = None     # previous move (tangent of Sinumerik CT)

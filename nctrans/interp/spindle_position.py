@@ -14,12 +14,23 @@ probe). An
 IC angle from a spindle that was turning (or whose angle is not known) leaves the angle unknown:
 the event's angle is NaN (left out of the JSON record, compared as unknown by equiv, refused by
 --flatten) and
-NC220 says so. Spindles other than the master (`SPOS[2]=`) stay NC220,
-not modelled (nctrans models one spindle).
+NC220 says so.
+
+nctrans models one spindle, the master. Which spindle is the master is state: SETMS(n) makes
+spindle n the master, SETMS alone gives the role back to the configured one, spindle 1 [GK:
+machine data 20090 SPIND_DEF_MASTER_SPIND, 1 by default; the seeds do not describe SETMS]. A
+spindle word written with its number reaches the master only where that number is the master's:
+`S2=500` under master 1, `SPOS[1]=90` or `S1=300` after SETMS(2) are NC220 at their line, not
+the master's speed or angle (`S2=500` used to set the master's speed). `SPOS[n]` with n other
+than 1 stays NC220 even where n is the master (the writers would otherwise take it for the
+master's without the SETMS); plain `S`, `SPOS=` address whichever spindle is the master. The
+seed's SPOS[2] examples (L21470-21482) position a following spindle under synchronised spindle
+coupling (COUPON), an overlay on the coupled motion nctrans does not model either.
 """
 from __future__ import annotations
 
 import math
+import re
 
 from nctrans.ir import nodes as n
 
@@ -50,6 +61,9 @@ def compile_position(it, s: n.Passthrough):
 def position(d) -> None:
     """Run one SPOS/SPOSA: stop the spindle at the angle and record the event."""
     it, s, incremental, value = d
+    if "[" in s.text.split("=", 1)[0] and it.master_spindle != 1:
+        _not_the_master(it, s, 1)               # SPOS[1]= after SETMS(n)
+        return
     angle = it._value(value, s.address)
     if angle is None:
         return                                  # _value reported why
@@ -74,3 +88,53 @@ def stop_at(it, angle: float) -> None:
     it.spindle_angle = None if math.isnan(angle) else angle
     rigid_tap.spindle_programmed(it)
     it._record("spindle", spindle_dir="orient", spindle=it.st.spindle_speed, spindle_angle=angle)
+
+
+# ---------------------------------------------------------------------------------------------
+# The master spindle (SETMS) and speeds written with a spindle number
+
+_SETMS = re.compile(r"\s*SETMS\s*(?:\(\s*([^)]*?)\s*\))?\s*$", re.IGNORECASE)
+
+
+def is_setms(s: n.Passthrough) -> bool:
+    return s.dialect == "sinumerik" and _SETMS.match(s.text) is not None
+
+
+def set_master(d) -> None:
+    """SETMS(n): spindle n is the master from here; SETMS: the configured master (1) again. A
+    number that is not a constant leaves the master unknown (None): every numbered spindle word
+    is then NC220 until the next SETMS."""
+    it, s = d
+    arg = (_SETMS.match(s.text).group(1) or "").strip()
+    before = it.master_spindle
+    if not arg:
+        it.master_spindle = 1
+    elif arg.isdigit() and int(arg) >= 1:
+        it.master_spindle = int(arg)
+    else:
+        it.master_spindle = None
+        it.diag("NC220", "warning", f"{s.text.strip()!r}: the master spindle is not a constant; spindle "
+                "words written with a spindle number are not modelled until the next SETMS")
+        return
+    if it.master_spindle != before:
+        # one spindle's state is kept (speed, direction, angle): it now belongs to another spindle
+        it.diag("NC220", "warning", f"{s.text.strip()!r} makes spindle {it.master_spindle} the master: its "
+                "speed, direction and angle are not known here; the analysed toolpath keeps those of "
+                f"spindle {before} until S, M3/M4/M5 or SPOS set them")
+
+
+def _not_the_master(it, s, number: int) -> None:
+    master = it.master_spindle
+    which = f"the master is spindle {master}" if master is not None else "the master is not known"
+    text = s.text.strip() if isinstance(s, n.Passthrough) else f"S{number}="
+    it.diag("NC220", "warning", f"{text!r} addresses spindle {number}, and {which} (SETMS): nctrans "
+            "models the master spindle only; not modelled, the analysed toolpath leaves it out")
+
+
+def numbered_speed(d) -> None:
+    """S<n>=: the master's speed where n is the master, else NC220 (never the master's speed)."""
+    it, s, f = d
+    if s.spindle == it.master_spindle:
+        it._h_speed(f)
+    else:
+        _not_the_master(it, s, s.spindle)

@@ -116,6 +116,8 @@ class StatementsMixin:
         self._rc_feed_set()
 
     def _c_speed(self, s: n.SpindleSpeed):
+        if s.spindle != 1 or getattr(s, "addressed", False):     # S2=: spindle_position.py
+            return (spindle_position.numbered_speed, (self, s, self.ev.compile(s.value)))
         return (self._h_speed, self.ev.compile(s.value))
 
     def _h_speed(self, f):
@@ -223,6 +225,8 @@ class StatementsMixin:
             return (rigid_tap.compensating_chuck, self)
         if spindle_position.is_modelled(s):
             return (spindle_position.position, spindle_position.compile_position(self, s))
+        if spindle_position.is_setms(s):
+            return (spindle_position.set_master, (self, s))
         if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")) or \
                 s.reason in unmodelled.REPORTED_AS_ERROR:
             return (self._h_known, None)

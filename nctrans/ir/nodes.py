@@ -187,6 +187,7 @@ class Feed:
 class SpindleSpeed:
     value: Expr
     spindle: int = 1
+    addressed: bool = False      # written with its spindle number (Sinumerik S2=): not "the master"
 
 
 @node

@@ -416,8 +416,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             if st.cycle_active and st.speed != s.value and self.cycle_takes("pitch"):
                 st.cycle_pending = True
             st.speed = s.value
-        out.words.append(self.word("S", s.value) if s.spindle == 1 else
-                         f"S{s.spindle}={self.expr(s.value)}")
+        plain = s.spindle == 1 and not getattr(s, "addressed", False)   # S1= stays S1= (SETMS)
+        out.words.append(self.word("S", s.value) if plain else f"S{s.spindle}={self.expr(s.value)}")
 
     def w_SpindleLimit(self, s: ir.SpindleLimit, out: "_Line") -> None:
         out.words.append(f"LIMS={self.expr(s.value)}")

@@ -471,7 +471,7 @@ class Lowerer:
         elif letter == "F":
             w.feed = num
         elif letter == "S":
-            w.speed.append((1, num))
+            w.speed.append((1, num, False))
         elif letter == "T":
             w.out.append(ir.ToolSelect(num))
         elif letter == "D":
@@ -499,7 +499,7 @@ class Lowerer:
             else:
                 setattr(w, part, value)
         elif name == "S" or re.fullmatch(r"S\d+", name):
-            w.speed.append((int(name[1:] or 1), value))
+            w.speed.append((int(name[1:] or 1), value, bool(name[1:])))
         elif name == "T" or re.fullmatch(r"T\d+", name):
             w.out.append(ir.ToolSelect(value))
         elif name == "D":
@@ -726,8 +726,8 @@ class Lowerer:
             w.out.append(ir.Dwell(secs, revs))
         if w.feed is not None:
             w.out.append(ir.Feed(w.feed))
-        for sp, v in w.speed:
-            w.out.append(ir.SpindleSpeed(v, sp))
+        for sp, v, addressed in w.speed:
+            w.out.append(ir.SpindleSpeed(v, sp, addressed))
         if w.target or w.center or w.via or w.polar or w.radius is not None or w.aperture is not None \
                 or w.turns is not None or w.indirect or w.thread_start is not None:
             w.out.append(ir.Motion(dict(w.target), dict(w.center) or None, w.radius, w.turns,
