@@ -29,7 +29,11 @@ LinuxCNC G33.1 (ISO milling, what `--flatten --profile linuxcnc` writes for a ta
 K<lead>` taps spindle-synchronised to the point, reverses the spindle, taps back to where it began
 and turns the spindle the first way again [GK: LinuxCNC G-code reference; rs274 prints one
 RIGID_TAP]. Recorded as CYCLE84's tap without a dwell: the move in, the reversed spindle, the move
-out, the spindle restored. LinuxCNC's overrun past the point on reversal is not modelled.
+out, the spindle restored. LinuxCNC's overrun past the point on reversal is not modelled: rs274
+(LinuxCNC's interpreter, the judge here) prints one `RIGID_TAP(x, y, z)` to the programmed point
+(`G33.1 Z-20 K1.5` from Z5: RIGID_TAP(.., -20)), and how far the tap runs on while the spindle
+decelerates and reverses is the motion controller's, set by the machine's spindle acceleration,
+which no program states. The toolpath's bottom is the programmed point.
 
 Fagor G63, interpolated (rigid) tapping (seed L8556-8780, spec 9.8): `G63 Z.. S±n` moves with the
 spindle interpolated, lead = F / S (F per revolution under G95), the spindle turning by the sign of
