@@ -152,7 +152,8 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.comp = None
         self.comp_radius = 0.0
         self.comp_exit = False
-        self.comp_tool_z = None         # tool length of the last move out of cutter compensation (records.py)
+        self.comp_total = None          # offsets of the cutter compensation episode (records.py)
+        self.comp_pos_machine = None    # machine point of the compensated program point (records.py)
         self.modal_call = None          # (SubCall, args snapshot, depth)
         self.cycle_params: dict[str, float] = {}
         self.cycle_initial: Optional[float] = None

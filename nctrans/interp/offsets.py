@@ -77,10 +77,25 @@ class OffsetsMixin:
         }
 
     def _resync(self) -> None:
-        """Program point from the machine point (after an offset or frame change)."""
+        """Program point from the machine point (after an offset or frame change). Under cutter
+        radius compensation the move before is still held (its end waits for the next move's
+        corner): the machine point is that move's programmed end under the offsets it was
+        programmed with (records.py), not the last emitted, compensated one; the held move keeps
+        those offsets, and the change applies from the next move."""
         tot = self.off.total
-        work = {a: v - tot.get(a, 0.0) for a, v in self.mpos.items()}
+        held = getattr(self, "comp", None) is not None and self.comp_pos_machine is not None
+        m = self.comp_pos_machine if held else self.mpos
+        work = {a: v - tot.get(a, 0.0) for a, v in m.items()}
         self.pos = self.frame.to_program(work)
+        if held:
+            self._said_offset_change()
+
+    def _said_offset_change(self) -> None:
+        if self.program.dialect == "iso-m":
+            self.diag("NC122", "info", "an offset change under cutter radius compensation: modelled as "
+                      "the control applies it (the held compensated move keeps the offsets it was "
+                      "programmed with, the next move takes the new ones); LinuxCNC refuses tool length, "
+                      "coordinate system and axis offset changes there (end the compensation first)")
 
     def _to_machine(self, p: dict[str, float]) -> dict[str, float]:
         w = p if self.frame.identity else self.frame.to_work(p)
@@ -120,21 +135,7 @@ class OffsetsMixin:
             z = self.machine.length_offset(int(idx)) if idx else 0.0
             if st.length_mode == "minus":
                 z = -z
-        if self.comp is not None:
-            # Under cutter radius compensation the move before this block is still held (its end
-            # waits for the next move's corner): it keeps the length it was programmed with (its
-            # payload carries it, records.py), and the program point is that move's end, not the
-            # last emitted (compensated) machine point, so the change applies from the next move.
-            held, changed = self._to_machine(self.pos), z != self.off.tool_z
-            self.off.set_tool(z)
-            tot = self.off.total
-            self.pos = self.frame.to_program({a: v - tot.get(a, 0.0) for a, v in held.items()})
-            if changed and self.program.dialect == "iso-m":
-                self.diag("NC122", "info", "a tool length change under cutter radius compensation: "
-                          "modelled as the control applies it (the held compensated move keeps the "
-                          "old length, the next move takes the new one); LinuxCNC refuses it (end the "
-                          "compensation first)")
-        else:
+        if z != self.off.tool_z or self.comp is None:   # (under G41/G42 _resync says NC122)
             self.off.set_tool(z)
             self._resync()
         if self.travel_limits is not None:      # limits on the tool tip follow its length
@@ -217,11 +218,15 @@ class OffsetsMixin:
         work = self.frame.to_work(target)
         g92 = dict(self.off.g92)
         wo = self.off.work
+        held = self.comp is not None and self.comp_pos_machine is not None
+        here = self.comp_pos_machine if held else self.mpos     # (a held compensated move: _resync)
         for a, _, _ in vals:
             tl = self.off.tool_z if a == "Z" else 0.0
-            g92[a] = self.mpos.get(a, 0.0) - wo.get(a, 0.0) - tl - work[a]
+            g92[a] = here.get(a, 0.0) - wo.get(a, 0.0) - tl - work[a]
         self.off.set_g92(g92)
         self.pos = target
+        if held:
+            self._said_offset_change()
 
     def _h_resetpos(self, s):
         self.off.set_g92({})

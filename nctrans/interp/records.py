@@ -13,6 +13,10 @@ from nctrans.interp.cutter_comp import PlannedMove
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.toolpath import ToolpathRecord
 
+def _minus(p: dict[str, float], shift: dict[str, float]) -> dict[str, float]:
+    return {a: v - shift.get(a, 0.0) for a, v in p.items()}
+
+
 class RecordsMixin:
     """Moves and other records into `out`; cutter compensation glue."""
 
@@ -81,24 +85,19 @@ class RecordsMixin:
         sp = self.span
         st = self.st
         return (sp.file if sp else self.program.file, sp.line if sp else 1, st.feed, st.feed_mode,
-                st.spindle_speed, st.tool, st.plane, self.off.tool_z)
+                st.spindle_speed, st.tool, st.plane, self.off.total)
 
-    def _machine_at(self, p: dict[str, float], tool_z: float) -> dict[str, float]:
-        """The machine point of program point `p` under the tool length `tool_z` (the one in force
-        when a move held by cutter compensation was programmed; the rest of the offsets as now)."""
-        m = self._to_machine(p)
-        shift = tool_z - self.off.tool_z
-        if shift and "Z" in m:
-            m["Z"] += shift
-        return m
+    def _machine_at(self, p: dict[str, float], total: dict[str, float]) -> dict[str, float]:
+        """The machine point of program point `p` under the offsets `total` (work offset, G92, tool
+        length: those in force when a move held by cutter compensation was programmed)."""
+        w = p if self.frame.identity else self.frame.to_work(p)
+        return {a: v + total.get(a, 0.0) for a, v in w.items()}
 
     def _finish_move(self, kind, start, end, center, cw, turns, payload, start_given=False) -> None:
-        file, line, feed, feed_mode, speed, tool, plane, tool_z = payload
-        if start_given:                 # out of cutter compensation: a move held past a length change
-            # ends where it was programmed to; the next starts where the one before it ended
-            mend = self._machine_at(end, tool_z)
-            mstart = self._machine_at(start, tool_z if self.comp_tool_z is None else self.comp_tool_z)
-            self.comp_tool_z = tool_z
+        file, line, feed, feed_mode, speed, tool, plane, total = payload
+        if start_given:                 # out of cutter compensation: in the episode's coordinates,
+            mend = self._machine_at(end, total)         # under its offsets (_comp_move)
+            mstart = self._machine_at(start, total)
         else:
             mend = self._to_machine(end)
             mstart = self.mpos
@@ -118,7 +117,7 @@ class RecordsMixin:
             cprog = {a1: center[0], a2: center[1], an: end.get(an, 0.0)}
             full = dict(end)
             full.update(cprog)
-            mfull = self._machine_at(full, tool_z) if start_given else self._to_machine(full)
+            mfull = self._machine_at(full, total) if start_given else self._to_machine(full)
             mc = {a1: mfull[a1], a2: mfull[a2], an: mfull[an]}
             rec.center = mc
             rec.plane = plane
@@ -129,17 +128,35 @@ class RecordsMixin:
         self.out.append(rec)
         if self.hook is not None:
             tot = self.off.total
-            if tool_z != self.off.tool_z:   # work coordinates as the move was programmed
-                tot = {**tot, "Z": tot.get("Z", 0.0) + tool_z - self.off.tool_z}
             work = {a: v - tot.get(a, 0.0) for a, v in mend.items()}
             wc = None if mc is None else {a: v - tot.get(a, 0.0) for a, v in mc.items()}
             self._hookq.append((work, wc))
 
     def _comp_move(self, kind, start, end, center, cw, turns, payload=None) -> bool:
+        """A move into cutter compensation. The compensator works in the program coordinates of
+        the episode, those of its first move: after an offset change (tool length, work offset,
+        G92) the moves are shifted back into them and emitted under the episode's offsets, which
+        puts them where the new offsets do; so the move held before the change (its end waits for
+        the next move's corner) keeps the offsets it was programmed with, and the corner between
+        it and the next move is computed on the path the machine runs."""
+        payload = payload or self._payload()
+        if self.comp is None and not self.comp_exit:
+            self.comp_total = payload[7]            # the episode's offsets
+        total = self.comp_total if self.comp_total is not None else payload[7]
+        if payload[7] is not total and payload[7] != total:
+            shift = self._program_shift(total, payload[7])
+            start, end = _minus(start, shift), _minus(end, shift)
+            if center is not None:
+                a1, a2, _ = PLANE_AXES[self.st.plane]
+                center = (center[0] - shift.get(a1, 0.0), center[1] - shift.get(a2, 0.0))
+            payload = payload[:7] + (total,)
         pm = PlannedMove(kind=kind, start=start, end=end,
                          center=None if center is None else self._center_dict(center, end),
                          direction=None if cw is None else ("cw" if cw else "ccw"),
-                         turns=turns, payload=payload or self._payload())
+                         turns=turns, payload=payload)
+        # the machine point of the programmed end: where the program point is while the move is
+        # held (offsets.py _resync, an offset change before the next move)
+        self.comp_pos_machine = self._machine_at(end, total)
         if self.comp_exit:
             comp, self.comp, self.comp_exit = self.comp, None, False
             if comp is not None:
@@ -152,9 +169,18 @@ class RecordsMixin:
             if r < 0:           # a negative stored radius swaps the side
                 side, r = ("right" if side == "left" else "left"), -r
             self.comp = self._compensator(side, r)     # lathe.py: the tool-nose tip
-            self.comp_tool_z = None                    # the entry starts where it was programmed
         self._comp_out(self.comp.push(pm))
         return True
+
+    def _program_shift(self, episode: dict[str, float], now: dict[str, float]) -> dict[str, float]:
+        """How far the program coordinates moved when the offsets went from `episode` to `now`
+        (the same point of the machine: program point now = in the episode + this)."""
+        d = {a: episode.get(a, 0.0) - now.get(a, 0.0) for a in {**episode, **now}}
+        if self.frame.identity:
+            return d
+        zero = self.frame.to_program({a: 0.0 for a in d})
+        moved = self.frame.to_program(d)
+        return {a: moved[a] - zero[a] for a in d}
 
     def _center_dict(self, center, end) -> dict[str, float]:
         a1, a2, an = PLANE_AXES[self.st.plane]
