@@ -6,8 +6,10 @@ files) converted to ISO milling. Each conversion is one of:
 - structural: converted with the program's structure kept (at most single constructs lowered to
   plain motion, each an NC401 at its line) and the output reads back in the target with no error;
 - flattened: converted only as plain motion for the whole program;
-  Constructs of a subprogram file ISO has no counterpart for are written as an alarm at their
-  place (NC412; counted per file with -v): the file is structural, but stops there until ported;
+  A construct the target cannot express and that cannot be lowered to plain motion (in a
+  subprogram file converted to ISO; in any program converted to Sinumerik) is written as an alarm
+  at its place (NC412, the same count both ways; listed per file with -v): the file is structural,
+  but stops there until ported;
 - refused: not converted (NC4xx or other errors name why), or the output does not read back clean.
 `structure_share()` is what tests/test_structure_share.py asserts the issue's thresholds on.
 Not timed; no assertions here.
@@ -35,7 +37,8 @@ class Outcome:
     state: str                      # structural | flattened | refused
     why: str = ""
     lowered_constructs: int = 0     # per-construct lowerings to plain motion (NC401 "lowered to plain motion")
-    refused_in_place: int = 0       # constructs written as an alarm at their place (NC412, subprogram files)
+    refused_in_place: int = 0       # constructs written as an alarm at their place (NC412)
+    first_in_place: int = 0         # the source line of the first of them
 
 
 @dataclass
@@ -81,8 +84,9 @@ def classify(path: Path, source: str, target: str) -> Outcome:
         return Outcome(path.name, "refused", f"output does not read back: line {errs[0].line} "
                        f"[{errs[0].rule}] {errs[0].message}"[:200])
     constructs = sum(1 for d in conv.diagnostics if CONSTRUCT_NOTE in d.message)
-    in_place = sum(1 for d in conv.diagnostics if d.rule == "NC412")
-    return Outcome(path.name, "structural", lowered_constructs=constructs, refused_in_place=in_place)
+    in_place = [d.line for d in conv.diagnostics if d.rule == "NC412"]
+    return Outcome(path.name, "structural", lowered_constructs=constructs, refused_in_place=len(in_place),
+                   first_in_place=min(in_place, default=0))
 
 
 def structure_share(corpus: Path = CORPUS) -> list[Share]:
@@ -116,7 +120,8 @@ def main() -> int:
                     print(f"  {s.source}->{s.target} {o.state:<10} {o.file}: {o.why}")
                 elif o.refused_in_place:
                     print(f"  {s.source}->{s.target} structural {o.file}: {o.refused_in_place} "
-                          "constructs refused in place (NC412 alarm lines)")
+                          f"constructs refused in place (NC412 alarm lines), the first at line "
+                          f"{o.first_in_place}")
     return 0
 
 

@@ -94,6 +94,35 @@ def _macro_refusal(program: Program, why: str) -> Diagnostic:
                       "convert the programs that call it with --flatten instead", program.file, line, 1)
 
 
+# Why a macro file's construct is refused in place rather than lowered (NC412 wording).
+MACRO_IN_PLACE_NOTE = ("in a macro file (it has no toolpath until a G65 call passes its arguments, so "
+                       "no part of it is lowered to plain motion)")
+
+
+def _refused_in_place(program: Program, target: Dialect, refusals: list[Diagnostic],
+                      where: str):
+    """The target's emission of `program` with each refused construct (NC402, `refusals`) written
+    as an alarm at its place (NC412) and the rest structural, for a target that refuses in place
+    (Dialect.refuses_in_place): the last resort after lowering the construct, and the whole
+    program, to plain motion failed. The control stops at the alarm, so nothing after it runs on
+    that path and nothing is guessed. None when the target does not, when a refusal is over the
+    held limit (--flatten streams it), or when the emission still refuses something (a syntax
+    error is never refused in place)."""
+    if not getattr(target, "refuses_in_place", False) or not refusals:
+        return None
+    if any(HELD_LIMIT_NOTE in d.message for d in refusals):
+        return None
+    at = {}
+    for d in refusals:
+        why = d.message.split("; it cannot be lowered", 1)[0].split("; it is a macro file", 1)[0]
+        at[(d.file, d.line)] = f"{why} {where}".rstrip() if (d.file, d.line) not in at else at[(d.file, d.line)]
+    meta = {**(program.meta or {}), "refuse_in_place": at}
+    again = target.emit(dataclasses.replace(program, meta=meta))
+    if any(_is_refusal(d) for d in again.diagnostics):
+        return None
+    return again
+
+
 def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list[Diagnostic]):
     """(emission, diagnostics) of the whole program lowered to plain motion, the last resort when
     a construct cannot be lowered on its own; (None, [the held-limit error]) when that is refused
@@ -214,6 +243,12 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
     if refusals and library is not None:
         diags.extend(result.diagnostics)
         diags.append(_library_refusal(program, library, target.name))
+    elif refusals and macro is not None and not flattened and not strict_mode and (
+            in_place := _refused_in_place(program, target, refusals, MACRO_IN_PLACE_NOTE)) is not None:
+        # a macro file is a subprogram: no construct of it is lowered alone, nor the whole file;
+        # where the target refuses in place, each construct it cannot express is an alarm there
+        diags.extend(in_place.diagnostics)
+        result = in_place
     elif refusals and macro is not None and not flattened:
         # a macro file is a subprogram: no construct of it is lowered alone, nor the whole file
         diags.extend(dataclasses.replace(d, message=f"{d.message}; {macro}; port that construct by hand, "
@@ -242,10 +277,19 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
         if whole is not None and whole[0] is None and whole[1]:
             remaining = [dataclasses.replace(d, message=f"{d.message}; {whole[1][0].message}")
                          for d in remaining]
+        in_place = None
+        if remaining and not too_large and not (whole is not None and whole[0] is not None):
+            in_place = _refused_in_place(lowered if lowered is not None else program, target,
+                                         remaining, "")
         if whole is not None and whole[0] is not None:
             # some construct could not be lowered on its own: the whole program as plain motion
             diags.extend(whole[1])
             result, flattened = whole[0], True
+        elif in_place is not None:
+            # nor the whole program: each construct left is an alarm at its place (NC412)
+            diags.extend(notes)
+            diags.extend(in_place.diagnostics)
+            result = in_place
         else:
             diags.extend(others)
             diags.extend(notes)

@@ -484,7 +484,10 @@ def _compare_runs(A: _Run, B: _Run, sa: _Stream, sb: _Stream, tol: float) -> Opt
         if A.count - A.low > LOOKAHEAD or B.count - B.low > LOOKAHEAD:     # the windows
             return _out_of_step(A, B, ab, ba, tol)
     fa, fb = ab.failed, ba.failed
-    if fa is None:                          # all of A lies along B: does B stop where A does?
+    # each lies along the other and B's toolpath ends with this motion while A's goes on: B
+    # stopped on A's path (a prefix of it, even where A then turns back a little), said as B's end
+    b_stops_on_a = fb is None and sb.peek() is None and sa.peek() is not None
+    if fa is None and not b_stops_on_a:     # all of A lies along B: does B stop where A does?
         q, beyond = _beyond(B, ab.j, A.last_point(), tol)
         B.drain()
         if math.dist(A.last_point(), B.last_point()) > tol:

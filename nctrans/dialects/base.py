@@ -140,6 +140,9 @@ class Dialect:
     # Subprogram files: endings tried, in this order, after the name as written and before the
     # dialect's own `extensions`; see subprogram_files.
     subprogram_endings: ClassVar[tuple[str, ...]] = ()
+    # True when emit() honours program.meta["refuse_in_place"] ((file, line) -> why): those
+    # constructs are written as an alarm at their place (NC412), see nctrans.convert
+    refuses_in_place: ClassVar[bool] = False
 
     def __init_subclass__(cls, register: bool = True, **kwargs) -> None:
         super().__init_subclass__(**kwargs)

@@ -31,7 +31,7 @@ from nctrans import limits
 from nctrans.diagnostics import Diagnostic
 from nctrans.interp import corner_elements
 from nctrans.interp.interpreter import Interpreter
-from nctrans.lower.flatten import ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Walker
+from nctrans.lower.flatten import ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Walker, takes_unknown_path
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks, walk
 
@@ -44,6 +44,14 @@ SEGMENT_UNMODELLED = UNMODELLED_RULES + ("NC220",)
 
 # why a segment holding a G10 (DataSetting) is not lowered alone (also the streamed lowering's)
 OFFSET_DATA_WHY = "it writes offset data (G10) that the rest of the program runs with"
+
+
+def _blocks_lowering(d: Diagnostic) -> bool:
+    """A run diagnostic inside a segment after which its plain motion would not be the source's:
+    something left out (SEGMENT_UNMODELLED), the step budget, or a path taken for a value only the
+    machine knows (flatten.takes_unknown_path: `IF[#1005EQ1]GOTO10` run as if false)."""
+    return (d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error")
+            or takes_unknown_path(d))
 
 
 class _AllRefused(Exception):
@@ -690,7 +698,7 @@ class SegmentHook:
             if state["frame"] and seg.why_not is None:
                 seg.why_not = "a programmable frame, G92 or local offset is active where it ends"
             for d in self.diags[seg.diag_mark:]:
-                if d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error"):
+                if _blocks_lowering(d):
                     seg.why_not = seg.why_not or d.message
             self.current = None
             return
@@ -729,7 +737,7 @@ class SegmentHook:
         for seg in self.segments:
             if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
                 for d in self.diags[seg.diag_mark:]:
-                    if d.rule in SEGMENT_UNMODELLED or (d.rule == "NC205" and d.severity == "error"):
+                    if _blocks_lowering(d):
                         seg.why_not = seg.why_not or d.message
 
 

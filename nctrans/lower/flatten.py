@@ -576,7 +576,7 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
             yield from fl.blocks
             fl.blocks.clear()
         if stop_when_incomplete and len(interp_diags) > seen:
-            if any(_incomplete(d) for d in interp_diags[seen:]):
+            if any(_incomplete(d) or takes_unknown_path(d) for d in interp_diags[seen:]):
                 break
             seen = len(interp_diags)
     if fl.taps is not None:
@@ -612,7 +612,19 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
             diagnostics.append(Diagnostic("NC402", "error", f"--flatten output would be incomplete: "
                                           f"{d.message}", d.file, d.line, d.column, d.end_line,
                                           d.end_column))
+        elif stop_when_incomplete and takes_unknown_path(d):
+            diagnostics.append(Diagnostic("NC402", "error", f"plain motion would take one path for "
+                                          f"a value only the machine knows: {d.message}", d.file,
+                                          d.line, d.column, d.end_line, d.end_column))
     walker.report()
+
+
+def takes_unknown_path(d: Diagnostic) -> bool:
+    """A run diagnostic saying the path taken depends on a value unknown to the analysis (NC107 as
+    a warning: a condition taken as false, a word ignored; a probe result, a PLC input): plain
+    motion written from that run would fix one path the machine may not take. `--flatten` asks for
+    it and says so (the warning stays); a lowering nctrans chooses on its own refuses it."""
+    return d.rule == "NC107" and d.severity == "warning"
 
 
 def _incomplete(d: Diagnostic) -> bool:

@@ -379,5 +379,7 @@ def _whole_stream(reparse, target, write, reset, machine, resolver, whole_notes:
         return None
     if done.text is None:
         reset()
+        if getattr(target, "refuses_in_place", False):
+            return None     # convert() writes what is left as alarms in place (NC412), parsed whole
         return Conversion(None, before + whole_failure(remaining, done.diagnostics))
     return Conversion(done.text, [*whole_notes, *done.diagnostics], flattened=True)

@@ -64,6 +64,7 @@ class Sinumerik(Dialect):
     definition_files = (".def",)       # GUD modules _N_*GUD*_DEF (spec 1.8)
     streams = True                     # CAM programs: frontend.streamable
     subprogram_endings = (".spf", ".SPF", ".mpf", ".MPF", ".txt")
+    refuses_in_place = True            # emitter.SinumerikEmitter.refused_in_place
 
     def sniff(self, text: str) -> float:
         return sniff(text)

@@ -53,7 +53,7 @@ from nctrans.plainrun import RUNS
 from nctrans.dialects.iso_m.profiles import is_common
 from nctrans.interp import corner_elements
 from nctrans.interp.settable_frames import external_frame_variable
-from nctrans.interp.unmodelled import FRAME_NOT_MODELLED
+from nctrans.interp.unmodelled import FRAME_NOT_MODELLED, REPORTED_AS_ERROR
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 
 DIALECT = "sinumerik"
@@ -64,6 +64,9 @@ COMPUTED_GOTO_ALARM = 65000
 # a converted ISO macro file called without an argument it uses as a whole value (ISO: the word
 # is dropped when vacant; a PROC parameter not programmed would read 0)
 ARGUMENT_MISSING_ALARM = 65001
+# a construct refused at its place (NC412: no Sinumerik counterpart, and it cannot be lowered to
+# plain motion on its own): the control stops there until it is ported by hand
+NOT_CONVERTED_ALARM = 65002
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
 # address letters whose value may be an expression written `M=R501` (seed "Indirect programming":
@@ -136,6 +139,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.jump_regions: dict[int, dict] = {}  # per unit: label -> what jumps to it may change
         self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
         self.macro_file = None                 # an ISO macro file written as a PROC (run())
+        # (file, line) -> why: constructs convert() asks to refuse at their place (NC412)
+        self.in_place: dict = dict((program.meta or {}).get("refuse_in_place") or {})
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -1019,8 +1024,37 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         return f"DEF {scope}{typ} " + ", ".join(parts)
 
     # ---------------------------------------------------------------- structure
+    def refused_in_place(self, node) -> Optional[str]:
+        """The alarm line that stands for `node` when convert() asked to refuse it at its place
+        (NC412), else None. A block holding a syntax error is never refused in place: the source
+        is not a program there (it stays NC402)."""
+        span = getattr(node, "span", None)
+        why = self.in_place.get((span.file, span.line)) if span is not None else None
+        if why is None or (isinstance(node, ir.Block) and any(
+                isinstance(s, ir.Passthrough) and s.reason in REPORTED_AS_ERROR for s in node.body)):
+            return None
+        self.diags.append(at_span(
+            "NC412", "warning", f"{why}; refused in place: written as alarm SETAL({NOT_CONVERTED_ALARM}) "
+            "at its place, so the control stops there until it is ported by hand; the rest keeps "
+            "its structure", span))
+        return f'SETAL({NOT_CONVERTED_ALARM}, "NOT CONVERTED: SOURCE LINE {span.line}")'
+
     def block(self, b: ir.Block, ind: str) -> None:
         self.span = b.span
+        alarm = self.refused_in_place(b) if self.in_place else None
+        if alarm is not None:
+            # the block alone is the alarm; nothing falls through it, so what it would have
+            # changed (modes, edge state) is left as before it, as for a block never run
+            head = []
+            if b.skip is not None:      # skipped with its block, as the source block is
+                head.append("/" if b.skip == 0 else f"/{b.skip}")
+            if b.number is not None:
+                head.append(f"N{b.number}")
+            if b.label:
+                head.append(f"{b.label}:")
+            comment = [";" + b.comment] if b.comment is not None else []
+            self.lines.append(ind + " ".join(head + [alarm] + comment))
+            return
         if (b.label and b.label in self.targets) or (b.number and b.number in self.targets):
             self.pos = {}            # a jump target: the position depends on the path taken
             if self.edges is not None:
@@ -1186,6 +1220,10 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.block(n, ind)
                 continue
             deco, self.pending = self.pending, None
+            alarm = self.refused_in_place(n) if self.in_place else None
+            if alarm is not None:           # the structure whole, at its line (its first test)
+                self.ctl(ind, alarm, deco)
+                continue
             self.pos = {}            # loops and branches: positions depend on the path taken
             self.edge_step(ind)      # every path through the structure starts in step
             if self.edges is not None and not isinstance(n, ir.If):
