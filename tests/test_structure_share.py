@@ -18,7 +18,7 @@ bench_structure = importlib.util.module_from_spec(_SPEC)
 sys.modules["bench_structure"] = bench_structure        # its dataclasses look their module up
 _SPEC.loader.exec_module(bench_structure)
 
-FLOORS = {("iso-m", "sinumerik"): 27, ("sinumerik", "iso-m"): 29}
+FLOORS = {("iso-m", "sinumerik"): 33, ("sinumerik", "iso-m"): 29}
 
 
 @pytest.fixture(scope="module")
@@ -37,5 +37,20 @@ def test_structural_share_holds(shares, direction):
 
 def test_whole_program_lowering_is_the_last_resort(shares):
     # a construct is lowered alone; the whole program only where one cannot be (none now: the two
-    # ISO macro files that were are refused, a macro file has no toolpath of its own)
+    # ISO macro files that were have no toolpath of their own, their constructs are refused in place)
     assert sum(s.count("flattened") for s in shares.values()) == 0
+
+
+def test_refused_in_place_is_counted_the_same_way_both_ways(shares):
+    # NC412 alarm lines, per file, in either direction: the ISO programs that were refused whole for
+    # one construct (a Haas G47, an unknown G41.2, a G12, PLC inputs, macro-file constructs) keep
+    # their structure with the construct an alarm at its line; a template with placeholders (a
+    # syntax error) stays refused
+    iso = {o.file: o for o in shares[("iso-m", "sinumerik")].outcomes}
+    assert iso["kiely-haas-4x3-block.nc"].state == "structural"
+    assert iso["kiely-haas-4x3-block.nc"].refused_in_place == 1
+    assert iso["kiely-haas-4x3-block.nc"].first_in_place == 140
+    assert iso["lmhdpro-titan-tormach-ready-edited.nc"].first_in_place == 3332
+    assert iso["stcline-maze-G91-incremental.nc"].state == "refused"
+    sin = {o.file: o for o in shares[("sinumerik", "iso-m")].outcomes}
+    assert sin["nadj-418-SH400.SPF"].state == "structural" and sin["nadj-418-SH400.SPF"].first_in_place == 27
