@@ -87,11 +87,43 @@ def _macro_file_note(program: Program) -> Optional[str]:
             "known position)")
 
 
+def subprogram_file(program: Program) -> bool:
+    """Whether a program is a Sinumerik subprogram file (.SPF, or an `%_N_NAME_SPF` header): it
+    runs from its caller's position and modes (G90/G91, units, plane, offsets), not from the
+    power-on state a run of it alone starts in."""
+    meta = program.meta or {}
+    if meta.get("program_type"):
+        return meta["program_type"] == "SPF"
+    return program.dialect == "sinumerik" and str(program.file).lower().endswith(".spf")
+
+
+def _subprogram_file_note(program: Program) -> Optional[str]:
+    """Why a construct of a Sinumerik subprogram file is not lowered to plain motion, alone or with
+    the whole file (None for any other program): plain motion is computed from a run that starts
+    at the power-on state (G90, the origin), where the file runs from its caller's."""
+    if not subprogram_file(program):
+        return None
+    return ("it is in a subprogram file, which runs from its caller's position and G90/G91: plain "
+            "motion computed from the power-on state (G90, the origin) would not follow them, so "
+            "no part of the file is lowered; port that construct by hand, or convert the programs "
+            "that call it with --flatten")
+
+
 def _macro_refusal(program: Program, why: str) -> Diagnostic:
-    first = next((b for b in getattr(program.body, "items", program.body) if isinstance(b, Block)), None)
-    line = first.span.line if first is not None else 1
-    return Diagnostic("NC402", "error", f"{program.name or program.file} is not flattened: {why}; "
-                      "convert the programs that call it with --flatten instead", program.file, line, 1)
+    """NC402 at the first construct that reads a G65 argument (what plain motion would run
+    vacant), not at the file's first block."""
+    from nctrans.dialects.base import CompactBody
+    from nctrans.lower.macro_procs import first_argument_read
+    from nctrans.plainrun import PlainRun
+    body = program.body
+    if type(body) is CompactBody:       # its runs of plain lines read no variable
+        body = [x for x in body.items if type(x) is not PlainRun]
+    found = first_argument_read(body) if type(body) is list else None
+    span = found[0] if found is not None else None
+    here = f" (it reads the argument #{found[1]} first here)" if found is not None else ""
+    return Diagnostic("NC402", "error", f"{program.name or program.file} is not flattened{here}: {why}; "
+                      "convert the programs that call it with --flatten instead", program.file,
+                      span.line if span is not None else 1, span.col if span is not None else 1)
 
 
 # Why a macro file's construct is refused in place rather than lowered (NC412 wording).
@@ -254,6 +286,9 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
         diags.extend(dataclasses.replace(d, message=f"{d.message}; {macro}; port that construct by hand, "
                                          "or convert the programs that call it with --flatten")
                      if _is_refusal(d) else d for d in result.diagnostics)
+    elif refusals and not flattened and (called := _subprogram_file_note(program)) is not None:
+        diags.extend(dataclasses.replace(d, message=f"{d.message}; {called}") if _is_refusal(d) else d
+                     for d in result.diagnostics)
     elif refusals and not flattened and flatten_with is not None and not strict_mode:
         from nctrans.lower.constructs import lower_constructs
         lowered, notes, remaining = lower_constructs(program, refusals, target.name, machine=machine,

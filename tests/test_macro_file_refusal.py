@@ -45,7 +45,7 @@ def test_construct_of_a_macro_file_is_refused_in_place_to_sinumerik():
 def test_flatten_refuses_a_macro_file():
     conv = api.transpile(MACRO, read="iso-m", write="sinumerik", flatten=True)
     assert conv.text is None
-    assert [(d.rule, d.line) for d in _errors(conv)] == [("NC402", 2)]     # its first block
+    assert [(d.rule, d.line) for d in _errors(conv)] == [("NC402", 4)]     # where it reads #24
     assert "convert the programs that call it with --flatten" in _errors(conv)[0].message
 
 

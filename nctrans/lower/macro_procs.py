@@ -296,13 +296,22 @@ def ends_with_restart(body: list) -> bool:
 
 def reads_arguments(body: list) -> bool:
     """Whether a program reads ISO locals #1-#33 it never sets: the G65 arguments of a macro."""
+    return first_argument_read(body) is not None
+
+
+def first_argument_read(body: list) -> tuple[ir.Span | None, int] | None:
+    """(the span of the first node, in source order, that reads a G65 argument, its number): the
+    first read of a local #1-#33 the program never sets; None when it reads none."""
     read: set = set()
     written: set = set()
+    first: dict[int, ir.Span | None] = {}
+    where: list = [None]
 
     def expr(e) -> None:
         if isinstance(e, ir.Var):
             if e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
                 read.add(e.key)
+                first.setdefault(e.key, where[0])
             for i in e.indices or ():
                 expr(i)
         elif isinstance(e, (list, tuple)):
@@ -316,6 +325,7 @@ def reads_arguments(body: list) -> bool:
                 expr(getattr(e, f, None))
 
     for node in walk.walk(body):
+        where[0] = getattr(node, "span", None)
         if isinstance(node, ir.Block):
             for s in node.body:
                 if isinstance(s, ir.Assign):
@@ -328,7 +338,11 @@ def reads_arguments(body: list) -> bool:
         else:
             for attr in ("cond", "subject", "start", "end", "step"):
                 expr(getattr(node, attr, None))
-    return bool(read - written)
+    arguments = read - written
+    if not arguments:
+        return None
+    key = min(arguments, key=lambda k: (first[k].line if first[k] is not None else 0, k))
+    return first[key], key
 
 
 def macro_file(program: ir.Program) -> bool:

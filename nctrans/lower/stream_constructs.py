@@ -31,7 +31,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Iterator, Optional
 
-from nctrans.convert import Conversion, _is_refusal, _whole_note, _with_header, stream_chunks
+from nctrans.convert import Conversion, _is_refusal, _whole_note, _with_header, stream_chunks, subprogram_file
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import CannotStream
 from nctrans.interp.interpreter import Interpreter
@@ -318,8 +318,8 @@ def convert_constructs_stream(reparse: Callable[[], Optional[n.Program]], target
         return None
     others = [d for d in found if not _is_refusal(d)]
     first = reparse()
-    if first is None:
-        return None
+    if first is None or subprogram_file(first):
+        return None             # convert() says why a subprogram file's constructs are not lowered
     try:
         survey = _survey(_nodes(first.body), first.file, refusals)
     except _NotStraight:

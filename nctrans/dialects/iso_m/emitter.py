@@ -453,7 +453,9 @@ class IsoEmitter(IsoSpelling, Emitter):
             self.out.append(str(meta["archive_header"]))
         head = self._program_word(p.name, meta.get("program_number"))
         library = self._library_entry()
-        self.in_place = library is not None
+        # a subprogram file (a PROC library, a Sinumerik .SPF) is never lowered to plain motion
+        from nctrans.convert import subprogram_file
+        self.in_place = library is not None or subprogram_file(p)
         if library is not None:
             # a file that only defines a subprogram (a Sinumerik PROC file) is that subprogram:
             # O<its number>, the body, M99; callers elsewhere call the same number
@@ -1218,6 +1220,17 @@ class IsoEmitter(IsoSpelling, Emitter):
             # Sinumerik G74 (approach the reference point directly) arrives as a zero
             # incremental via point: ISO writes that as G91 G28 and restores G90 after the block.
             via = {k: n.AxisValue(av.value) for k, av in s.via.items()}
+            if self.distance_known is None:
+                from nctrans.dialects.base import CannotStream
+                raise CannotStream("an incremental reference-point approach before any G90/G91 of a "
+                                   "streamed program")
+            if not self.distance_known:
+                # the G90 written after it would be a guess (per_word: known on every path only)
+                raise NotConvertible(
+                    "an incremental reference-point approach (written G91 G28, then the G90/G91 in "
+                    "force again) where the G90/G91 in force is not known on every path (a jump "
+                    "target, a loop or branch, after a call, or a subprogram's start: its caller's)",
+                    "G91 G28")
             if self.distance == "absolute":
                 self.lowered("incremental reference-point approach written as G91 G28 ... then G90")
                 self.restore_absolute = True
