@@ -31,6 +31,8 @@ CONSTRUCT_NOTE = "lowered to plain motion here"
 # Words of the NC402 reason of a construct whose plain motion is over limits.MAX_LOWERED_BLOCKS: the
 # whole program lowered would be larger still, so it is not tried without --flatten (which streams).
 HELD_LIMIT_NOTE = "the most a conversion holds in memory"
+# ... and of a refusal whose whole-program lowering a budget stopped (whole_failure)
+BUDGET_NOTE = "lowering the whole program instead stops at line"
 
 
 class NeedsWholeParse(Exception):
@@ -138,12 +140,13 @@ def _refused_in_place(program: Program, target: Dialect, refusals: list[Diagnost
     (Dialect.refuses_in_place): the last resort after lowering the construct, and the whole
     program, to plain motion failed. The control stops at the alarm, so nothing after it runs on
     that path and nothing is guessed. None when the target does not, when a refusal is over the
-    held limit (--flatten streams it), or when the emission still refuses something (a syntax
-    error is never refused in place)."""
+    held limit or a budget stopped the lowering (a limit, not a missing mapping: said as it is),
+    or when the emission still refuses something (a syntax error is never refused in place) or
+    does not read back in the target."""
     if not getattr(target, "refuses_in_place", False) or not refusals:
         return None
-    if any(HELD_LIMIT_NOTE in d.message for d in refusals):
-        return None
+    if any(HELD_LIMIT_NOTE in d.message or BUDGET_NOTE in d.message for d in refusals):
+        return None         # a limit stopped the lowering, not a missing mapping: said as it is
     at = {}
     for d in refusals:
         why = d.message.split("; it cannot be lowered", 1)[0].split("; it is a macro file", 1)[0]
@@ -152,20 +155,26 @@ def _refused_in_place(program: Program, target: Dialect, refusals: list[Diagnost
     again = target.emit(dataclasses.replace(program, meta=meta))
     if any(_is_refusal(d) for d in again.diagnostics):
         return None
+    # what the refusals kept from being written before (another control's words the emitter
+    # passes through) must read back in the target, or the conversion stays refused
+    back = target.parse(again.text, program.file)
+    if any(d.severity == "error" for d in back.diagnostics):
+        return None
     return again
 
 
 def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list[Diagnostic]):
     """(emission, diagnostics) of the whole program lowered to plain motion, the last resort when
-    a construct cannot be lowered on its own; (None, [the held-limit error]) when that is refused
-    too (its other reasons are the refusals themselves; the limit is news to the user, so the
-    caller adds it to them)."""
+    a construct cannot be lowered on its own; (None, [the held-limit or step-budget error]) when
+    that is refused too (its other reasons are the refusals themselves; a limit is news to the
+    user, so the caller adds it to them)."""
     flat_diags: list[Diagnostic] = []
     flat = lower_for(flatten_with(flat_diags), target, flat_diags)
     again = target.emit(flat)
     found = [*(_whole_note(d, target) for d in refusals), *flat_diags, *again.diagnostics]
     if any(d.severity == "error" for d in found):
-        return None, [d for d in found if d.severity == "error" and HELD_LIMIT_NOTE in d.message]
+        return None, [d for d in found if d.severity == "error" and (
+            HELD_LIMIT_NOTE in d.message or d.rule == "NC205")]
     return again, found
 
 
@@ -175,7 +184,7 @@ def whole_failure(refusals: list[Diagnostic], whole: list[Diagnostic]) -> list[D
     stop = next((d for d in whole if d.rule == "NC205" and d.severity == "error"), None)
     if stop is None:
         return refusals
-    why = f"lowering the whole program instead stops at line {stop.line}: {stop.message}"
+    why = f"{BUDGET_NOTE} {stop.line}: {stop.message}"
     return [dataclasses.replace(d, message=f"{d.message}; {why}") for d in refusals]
 
 
@@ -310,8 +319,12 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
         whole = _lower_whole(program, target, flatten_with, remaining) \
             if remaining and not too_large and streamed is None else None
         if whole is not None and whole[0] is None and whole[1]:
-            remaining = [dataclasses.replace(d, message=f"{d.message}; {whole[1][0].message}")
-                         for d in remaining]
+            held = [d for d in whole[1] if HELD_LIMIT_NOTE in d.message]
+            if held:
+                remaining = [dataclasses.replace(d, message=f"{d.message}; {held[0].message}")
+                             for d in remaining]
+            else:
+                remaining = whole_failure(remaining, whole[1])
         in_place = None
         if remaining and not too_large and not (whole is not None and whole[0] is not None):
             in_place = _refused_in_place(lowered if lowered is not None else program, target,

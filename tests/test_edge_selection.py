@@ -6,6 +6,8 @@ source's modes (nctrans.lower.constructs._restore). Expected machine positions a
 in the comments: machine Z = programmed Z + the length in force."""
 from __future__ import annotations
 
+import re
+
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -49,6 +51,18 @@ def refused_at(conv):
     return sorted({d.line for d in conv.diagnostics if d.rule == "NC402"})
 
 
+def in_place_at(conv):
+    """Lines refused in place (NC412: an alarm there, nothing of the line written; the rest kept)."""
+    return sorted({d.line for d in conv.diagnostics if d.rule == "NC412"})
+
+
+def alarm_stops_before(text, conv, m=M):
+    """The conversion agrees with the source on everything before its alarm, where it stops."""
+    eq = same(text, conv, m)
+    stopped = [d for d in eq.diagnostics if d.rule == "NC221" and "alarm 65002" in d.message]
+    return not eq and eq.difference is not None and eq.difference.at_end and bool(stopped)
+
+
 # --------------------------------------------------------------------------- ISO -> Sinumerik
 
 def test_g49_switches_the_length_off_as_d0():
@@ -83,15 +97,23 @@ def test_the_tools_own_register_stays_the_edge_m6_brings():
 
 def test_register_1_under_another_tool_is_refused_at_its_line():
     # H1 is edge D1 of tool 1 only: with tool 2 in the spindle no edge gives 100
-    conv = convert("T2 M6\nG43 H1\nG0 X0 Y0 Z10\nM30\n")
-    assert conv.text is None and refused_at(conv) == [2]
+    # (no D is written for it: the line is an alarm in the Sinumerik program, NC412)
+    text = "T2 M6\nG43 H1\nG0 X0 Y0 Z10\nM30\n"
+    conv = convert(text)
+    assert refused_at(conv) == [] and in_place_at(conv) == [2]
+    assert body(conv.text)[1:3] == ["T2 M6", 'SETAL(65002, "NOT CONVERTED: SOURCE LINE 2")']
+    assert not [ln for ln in body(conv.text) if re.search(r"\bD[1-9]", ln)]
+    assert alarm_stops_before(text, conv)
 
 
 def test_the_length_a_tool_change_leaves_is_refused_where_a_move_shows_it():
     # ISO keeps H1 (tool 1's 100) after T2 M6; Sinumerik's M6 brings tool 2's edge. Nothing
     # shows it until Z moves at line 5
-    conv = convert("T1 M6\nG43 H1\nG0 Z10\nT2 M6\nG0 Z5\nM30\n")
-    assert conv.text is None and 5 in refused_at(conv)
+    text = "T1 M6\nG43 H1\nG0 Z10\nT2 M6\nG0 Z5\nM30\n"
+    conv = convert(text)
+    assert refused_at(conv) == [] and in_place_at(conv) == [5]
+    assert body(conv.text)[-3:] == ["T2 M6", 'SETAL(65002, "NOT CONVERTED: SOURCE LINE 5")', "M30"]
+    assert alarm_stops_before(text, conv)
 
 
 def test_negative_length_is_never_written_as_an_edge():
@@ -241,5 +263,8 @@ def test_programs_with_a_lowered_construct_stay_equivalent(text):
     conv = convert(text)
     if conv.text is None:           # refused: at a line of the program
         assert refused_at(conv) and all(line >= 1 for line in refused_at(conv)), conv.diagnostics
+        return
+    if in_place_at(conv):           # refused in place: the same up to the alarm
+        assert alarm_stops_before(text, conv), conv.text
         return
     assert same(text, conv), conv.text

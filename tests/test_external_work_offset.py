@@ -126,9 +126,15 @@ def test_g68_with_a_vector_is_reported_not_turned_in_the_plane():
 
 
 def test_g68_with_a_vector_is_refused_by_the_sinumerik_conversion(tmp_path):
-    conv = _convert("G21 G90 G17\nG68 X0 Y0 I0 J0 K1 R90\nG1 X10 F100\nG69\nM30\n", tmp_path)
-    assert conv.text is None
-    assert any(d.rule == "NC402" and d.line == 2 and "G68" in d.message for d in conv.diagnostics)
+    # never written as a rotation in the plane: refused at its line, in place (the alarm stands
+    # where it was; the control stops there), or whole with --strict
+    src = "G21 G90 G17\nG68 X0 Y0 I0 J0 K1 R90\nG1 X10 F100\nG69\nM30\n"
+    conv = _convert(src, tmp_path)
+    assert any(d.rule == "NC412" and d.line == 2 and "G68" in d.message for d in conv.diagnostics)
+    assert 'SETAL(65002, "NOT CONVERTED: SOURCE LINE 2")' in conv.text.splitlines()
+    assert "ROT" not in conv.text
+    strict = nctrans.transpile(src, read="iso-m", write="sinumerik", strict=True)
+    assert strict.text is None and any(d.line == 2 for d in strict.diagnostics if d.severity == "error")
 
 
 def test_g68_in_the_plane_still_rotates():

@@ -141,6 +141,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.macro_file = None                 # an ISO macro file written as a PROC (run())
         # (file, line) -> why: constructs convert() asks to refuse at their place (NC412)
         self.in_place: dict = dict((program.meta or {}).get("refuse_in_place") or {})
+        self.alarmed: set = set()              # the (file, line)s whose alarm is written
 
     # ---------------------------------------------------------------- diagnostics
     def info(self, key: str, msg: str) -> None:
@@ -1029,10 +1030,14 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         (NC412), else None. A block holding a syntax error is never refused in place: the source
         is not a program there (it stays NC402)."""
         span = getattr(node, "span", None)
-        why = self.in_place.get((span.file, span.line)) if span is not None else None
+        key = (span.file, span.line) if span is not None else None
+        why = self.in_place.get(key)
         if why is None or (isinstance(node, ir.Block) and any(
                 isinstance(s, ir.Passthrough) and s.reason in REPORTED_AS_ERROR for s in node.body)):
             return None
+        if key in self.alarmed:
+            return ""           # more blocks of that line (a lowered construct's): after its alarm
+        self.alarmed.add(key)
         self.diags.append(at_span(
             "NC412", "warning", f"{why}; refused in place: written as alarm SETAL({NOT_CONVERTED_ALARM}) "
             "at its place, so the control stops there until it is ported by hand; the rest keeps "
@@ -1042,6 +1047,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def block(self, b: ir.Block, ind: str) -> None:
         self.span = b.span
         alarm = self.refused_in_place(b) if self.in_place else None
+        if alarm == "":
+            return
         if alarm is not None:
             # the block alone is the alarm; nothing falls through it, so what it would have
             # changed (modes, edge state) is left as before it, as for a block never run
@@ -1052,7 +1059,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 head.append(f"N{b.number}")
             if b.label:
                 head.append(f"{b.label}:")
-            comment = [";" + b.comment] if b.comment is not None else []
+            # the source's comment stays with it (not a lowering's own "nctrans: ..." note)
+            comment = [";" + b.comment] if b.comment is not None and not b.comment.startswith("nctrans:") else []
             self.lines.append(ind + " ".join(head + [alarm] + comment))
             return
         if (b.label and b.label in self.targets) or (b.number and b.number in self.targets):
@@ -1222,7 +1230,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             deco, self.pending = self.pending, None
             alarm = self.refused_in_place(n) if self.in_place else None
             if alarm is not None:           # the structure whole, at its line (its first test)
-                self.ctl(ind, alarm, deco)
+                if alarm:
+                    self.ctl(ind, alarm, deco)
                 continue
             self.pos = {}            # loops and branches: positions depend on the path taken
             self.edge_step(ind)      # every path through the structure starts in step
