@@ -90,19 +90,18 @@ def _macro_file_note(program: Program) -> Optional[str]:
 
 
 def subprogram_file(program: Program) -> bool:
-    """Whether a program is a Sinumerik subprogram file (.SPF, or an `%_N_NAME_SPF` header): it
-    runs from its caller's position and modes (G90/G91, units, plane, offsets), not from the
-    power-on state a run of it alone starts in."""
-    meta = program.meta or {}
-    if meta.get("program_type"):
-        return meta["program_type"] == "SPF"
-    return program.dialect == "sinumerik" and str(program.file).lower().endswith(".spf")
+    """Whether a program is a subprogram file by its dialect's file types (Dialect.subprogram_file,
+    a Sinumerik .SPF): it runs from its caller's position and modes (G90/G91, units, plane,
+    offsets), not from the power-on state a run of it alone starts in."""
+    from nctrans.dialects.base import get
+    dialect = get(program.dialect)
+    return dialect is not None and dialect.subprogram_file(program)
 
 
 def _subprogram_file_note(program: Program) -> Optional[str]:
-    """Why a construct of a Sinumerik subprogram file is not lowered to plain motion, alone or with
-    the whole file (None for any other program): plain motion is computed from a run that starts
-    at the power-on state (G90, the origin), where the file runs from its caller's."""
+    """Why a construct of a subprogram file is not lowered to plain motion, alone or with the whole
+    file (None for any other program): plain motion is computed from a run that starts at the
+    power-on state (G90, the origin), where the file runs from its caller's."""
     if not subprogram_file(program):
         return None
     return ("it is in a subprogram file, which runs from its caller's position and G90/G91: plain "
@@ -147,10 +146,10 @@ def _refused_in_place(program: Program, target: Dialect, refusals: list[Diagnost
         return None
     if any(HELD_LIMIT_NOTE in d.message or BUDGET_NOTE in d.message for d in refusals):
         return None         # a limit stopped the lowering, not a missing mapping: said as it is
-    at = {}
-    for d in refusals:
+    at: dict = {}
+    for d in refusals:          # what the construct is, without why it was not lowered
         why = d.message.split("; it cannot be lowered", 1)[0].split("; it is a macro file", 1)[0]
-        at[(d.file, d.line)] = f"{why} {where}".rstrip() if (d.file, d.line) not in at else at[(d.file, d.line)]
+        at.setdefault((d.file, d.line), f"{why} {where}".rstrip())
     meta = {**(program.meta or {}), "refuse_in_place": at}
     again = target.emit(dataclasses.replace(program, meta=meta))
     if any(_is_refusal(d) for d in again.diagnostics):

@@ -198,6 +198,12 @@ class Dialect:
         """0..1: how much `text` looks like this dialect (0 when the dialect does not sniff)."""
         return 0.0
 
+    def subprogram_file(self, program: Program) -> bool:
+        """Whether `program` is a subprogram file by this dialect's file types (it runs from its
+        caller's position and modes, never from the power-on state); False when the dialect's
+        files do not say."""
+        return False
+
     def subprogram_stems(self, name: str) -> list[str]:
         """File names without ending that may hold the called program `name`, most likely first."""
         return [name, name.upper()]

@@ -69,6 +69,14 @@ class Sinumerik(Dialect):
     def sniff(self, text: str) -> float:
         return sniff(text)
 
+    def subprogram_file(self, program) -> bool:
+        """An .SPF file, or a program whose archive header says `%_N_NAME_SPF` (an MPF is a main
+        program)."""
+        meta = program.meta or {}
+        if meta.get("program_type"):
+            return meta["program_type"] == "SPF"
+        return str(program.file).lower().endswith(".spf")
+
     def subprogram_stems(self, name: str) -> list[str]:
         """L10 -> L10, and an archive name %_N_NAME_SPF -> NAME as well."""
         stems = super().subprogram_stems(name)
