@@ -331,7 +331,15 @@ def test_corpus_conversion_is_equivalent_with_its_kept_calls(path):
     if path.name in SPILLED_ARGUMENTS:
         pytest.xfail(SPILLED_ARGUMENTS[path.name])
     want = _records(source, path.parent, "sinumerik")
-    got = _records(get("iso-m").parse(conv.text, path.name + ".nc").program, path.parent, "iso-m")
+    ran: list = []
+    got = _records(get("iso-m").parse(conv.text, path.name + ".nc").program, path.parent, "iso-m", ran)
+    if any(d.rule == "NC412" for d in conv.diagnostics):
+        # a subprogram file's construct refused in place (a .SPF without PROC too): the run stops
+        # at its alarm, after agreeing with the source on everything before it
+        assert any(d.rule == "NC221" and f"alarm {NOT_CONVERTED_ALARM}" in d.message for d in ran)
+        diff = equivalence.compare(want, got)
+        assert diff is None or diff.at_end, diff.format()
+        return
     if len(got) < PREFIX and got[-1].kind == "stop" and not (want and want[-1].kind == "stop"):
         # M17 in a main program file: M99 is its return in ISO too, but run on its own as a main
         # program the ISO interpreter reads M99 as the end of one pass
