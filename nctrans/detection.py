@@ -146,7 +146,8 @@ def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[
                 # plain word blocks (G0 X10, M30) are valid in the ending's own dialect too: they
                 # speak for another dialect only next to one of its own constructs
                 for n in names:
-                    if n not in owners and not specific[n]:
+                    family = getattr(base.get(n), "family_evidence", None)
+                    if n not in owners and not (specific[n] and specific.get(family or n, 1.0)):
                         evidence[n] = 0.0
     total = sum(evidence.values())
     scores = {n: (e / total if total else 0.0) for n, e in evidence.items()}

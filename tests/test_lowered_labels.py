@@ -51,8 +51,9 @@ def test_a_jump_into_a_lowered_stretch_keeps_its_label(tmp_path):
 def test_a_lowered_stretch_holding_an_unmodelled_mode_is_refused(tmp_path):
     # G16 (polar coordinates) is not modelled: lowering line 2 alone to plain motion wrote the
     # polar X10 Y90 as a Cartesian point and said nothing but NC401 info. The stretch is refused,
-    # so the program is flattened as a whole, which says NC220 at G16's line.
+    # so the program is flattened as a whole, which says NC220 at G16's line; that flattened
+    # program would still read X10 Y90 as Cartesian, so it is refused there too (NC402, issue #8)
     text = "G0 X0 Y0\nG16\nG0 X10 Y90\nG15\nM30\n"
     out = convert(tmp_path, text, "iso-m", "sinumerik")
-    assert out.returncode == 0, out.stderr
-    assert ":2:1: warning[NC220] G16 is not modelled" in out.stderr
+    assert out.returncode == 1, out.stderr
+    assert ":2:1: error[NC402]" in out.stderr and "G16 is not modelled" in out.stderr, out.stderr

@@ -128,6 +128,10 @@ class Dialect:
     # here (COMMENT_SHAPES), and `sniff` (a coarse 0..1 look at the whole head).
     markers: ClassVar[tuple[Marker, ...]] = ()
     comment_evidence: ClassVar[dict[str, tuple[float, int]]] = {}
+    # the dialect whose own constructs this one's markers need beside them to count against an
+    # ending another dialect owns: iso-t's markers (G96, G18, T0101) tell a lathe from a mill,
+    # and a Sinumerik lathe program in a .mpf has them too (nctrans.detection)
+    family_evidence: ClassVar[Optional[str]] = None
     # True when parse_stream can parse lazily (programs that run straight through).
     streams: ClassVar[bool] = False
     # Endings (lower case) of definition files beside a program whose declarations it may read.

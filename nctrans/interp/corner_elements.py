@@ -167,9 +167,13 @@ def move(it, kind, start, end, center, cw, turns, payload) -> None:
         cs.still.add((payload[0], payload[1]))
         if not _too_many_between(it, cs):
             return
+        it.corner = cs                  # the flush may have let the stage go; this move uses it
     new = Move(kind, start, end, center, cw, turns, payload, it.span)
     new.corner = _carried(it, cs, kind)
     p = cs.pending
+    if p is not None and cs.queued and _too_many_between(it, cs, it.span):
+        p = None                        # gone uninserted: blocks without motion stood between
+        it.corner = cs                  # (the flush may have let the stage go; this move uses it)
     if p is not None:
         cs.pending = None
         new = _join(it, p, new)
@@ -191,15 +195,19 @@ def record(it, rec) -> bool:
     if cs is None or cs.pending is None:
         return False
     cs.queued.append(rec)
-    _too_many_between(it, cs)
+    _too_many_between(it, cs, it.span)
     return True
 
 
-def _too_many_between(it, cs: CornerStage) -> bool:
+def _too_many_between(it, cs: CornerStage, own: Optional[n.Span] = None) -> bool:
     """Whether more blocks without motion in the plane stand between the held move and the next
-    one than the control allows (the held move then goes, uninserted)."""
+    one than the control allows (the held move then goes, uninserted). The records of `own`, the
+    block running (a spindle speed that constant surface speed sets before its move), are not
+    counted yet: whether that block moves is known at its move."""
     allowed = int(settings(cs.pending.corner[3]).get("dummy_blocks", 0))
     lines = {(r.file, r.line) for r in cs.queued} | cs.still
+    if own is not None:
+        lines.discard((own.file, own.line))
     if len(lines) > allowed:
         flush(it, f"{'a block' if not allowed else f'more than {allowed} blocks'} without motion "
               "in the plane stands between it and the next contour move")

@@ -162,6 +162,7 @@ class MotionMixin:
             return
         self.moved = True
         vals = self._eval_words(words)
+        self._polar_arc = bool(polar)
         if polar:
             vals = self._polar(vals, polar)
         if self.modal_cycle is not None and st.cycle == "off" and not machine:
@@ -470,6 +471,15 @@ class MotionMixin:
                 c1, c2 = arcs.center_from_radius(s1, s2, e1, e2, r * st.scale, cw, inch)
             else:
                 cvals = self._eval_words(center)
+                if not cvals and self.__dict__.get("_polar_arc"):
+                    # G2/G3 with a polar end point turns about the pole (Sinumerik G110-G112,
+                    # Fagor G30) [GK: Siemens Fundamentals, polar coordinates]
+                    c1, c2 = self.pole or (0.0, 0.0)
+                    err = arcs.check_center(s1, s2, e1, e2, c1, c2, inch)
+                    if err:
+                        raise arcs.ArcError(err)
+                    self._move("arc", end, (c1, c2), cw, nturns)
+                    return
                 if not cvals:
                     raise arcs.ArcError("arc without centre or radius")
                 c1, c2 = s1, s2

@@ -52,6 +52,7 @@ from nctrans.interp.unmodelled import modelled, no_motion_effect
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans.ir.walk import walk
+from nctrans.ir.vocabulary import UNMODELLED_MODES
 from nctrans.lower.flat_tapping import TEMPLATES, TapWriter
 from nctrans.toolpath import ToolpathRecord
 
@@ -628,5 +629,8 @@ def takes_unknown_path(d: Diagnostic) -> bool:
 
 
 def _incomplete(d: Diagnostic) -> bool:
-    """A run diagnostic after which the flattened program lacks motion the source has."""
-    return d.rule in UNMODELLED_RULES or (d.rule == "NC205" and "budget" in d.message)
+    """A run diagnostic after which the flattened program lacks motion the source has, or has
+    other motion: a mode the interpreter records but does not model (ISO G16 polar input: its
+    words were read as Cartesian coordinates; ir.vocabulary.UNMODELLED_MODES)."""
+    return d.rule in UNMODELLED_RULES or (d.rule == "NC205" and "budget" in d.message) or (
+        d.rule == "NC220" and any(left_out in d.message for left_out in UNMODELLED_MODES.values()))

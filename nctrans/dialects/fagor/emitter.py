@@ -605,6 +605,9 @@ class FagorEmitter(FagorSpelling, Emitter):
 
     def w_PolarPole(self, s: n.PolarPole, word, new_line, rest: list):
         val = self.value
+        # until a pole is written again, polar words cannot be written: a pole this writer refuses
+        # is lowered alone, and Fagor's polar origin would stay where it was
+        self.pole_unwritten = True
         if s.relative_to == "last_point" and not s.target and not s.polar:
             word("", self.code_for("polar_pole"), alone=True)
         elif s.relative_to == "zero" and not s.polar and len(s.target) <= 2:
@@ -618,6 +621,7 @@ class FagorEmitter(FagorSpelling, Emitter):
                  alone=True)
         else:
             raise NotExpressible(f"a polar pole relative to the {s.relative_to.replace('_', ' ')}")
+        self.pole_unwritten = False
 
     def w_SetPosition(self, s: n.SetPosition, word, new_line, rest: list):
         val = self.value
@@ -755,6 +759,9 @@ class FagorEmitter(FagorSpelling, Emitter):
         if s.polar:
             if self.distance != "absolute":
                 raise NotExpressible("polar coordinates in incremental mode")
+            if getattr(self, "pole_unwritten", False):
+                raise NotExpressible("polar coordinates about a pole that was written as plain motion "
+                                     "(Fagor's polar origin is not there)")
             if "radius" in s.polar:
                 word("R", "R" + val(s.polar["radius"]))
             if "angle" in s.polar:

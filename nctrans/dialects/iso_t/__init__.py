@@ -39,6 +39,7 @@ class IsoTurning(IsoFamily):
     # outweighs them (a mill program gives iso-t nothing, so detection between others is unchanged).
     markers = LATHE_MARKERS
     comment_evidence: dict = {}
+    family_evidence = "iso-m"
     machine_kind = "lathe"
 
     def sniff(self, text: str) -> float:
