@@ -59,3 +59,24 @@ def test_a_computed_master_number_leaves_numbered_words_unmodelled():
 ])
 def test_same_with_and_without_the_native_kernel(text):
     assert _run(text, kernel=True) == _run(text, kernel=False)
+
+
+@pytest.mark.parametrize("kernel", [True, False])
+def test_a_numbered_spindle_function_is_spindle_ns_not_the_masters(kernel):
+    # M1=3 is spindle 1 clockwise: the master's only while spindle 1 is the master. After SETMS(2)
+    # it was read as the master's M3 (a cw record for the master that never started)
+    text = ("G0 X0 Y0 Z10\nS1000 M1=3\nSETMS(2)\nS600 M1=5\nG1 X10 F100\nSETMS\nM1=4\nM30\n")
+    events, said = _run(text, kernel)
+    # line 4: S600 is the master's speed (spindle 2, direction kept as spindle 1's: SETMS said);
+    # its M1=5 stops spindle 1, not the master; line 7: M1=4 after SETMS is the master's again
+    assert events == [(2, 1000.0, "cw", None), (4, 600.0, "cw", None), (7, 600.0, "ccw", None)]
+    assert ("NC220", 4) in said and ("NC220", 2) not in said and ("NC220", 7) not in said
+
+
+def test_a_numbered_spindle_function_keeps_its_number_when_written_back():
+    from nctrans import api
+    text = "SETMS(2)\nS500 M1=3\nG1 X10 F100\nM1=5\nM30\n"
+    out = api.transpile(text, read="sinumerik", write="sinumerik").text
+    # written as plain M3/M5 it would start and stop spindle 2, the master after SETMS(2)
+    assert [ln for ln in out.splitlines() if "M1=" in ln or ln.strip() in ("M3", "M5")] == \
+        ["S500 M1=3", "M1=5"]

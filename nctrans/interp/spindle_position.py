@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 import re
+from typing import Optional
 
 from nctrans.ir import nodes as n
 
@@ -129,6 +130,26 @@ def _not_the_master(it, s, number: int) -> None:
     text = s.text.strip() if isinstance(s, n.Passthrough) else f"S{number}="
     it.diag("NC220", "warning", f"{text!r} addresses spindle {number}, and {which} (SETMS): nctrans "
             "models the master spindle only; not modelled, the analysed toolpath leaves it out")
+
+
+_NUMBERED_M = re.compile(r"M(\d+)=", re.IGNORECASE)
+
+
+def numbered_mode(s: n.ModeChange) -> Optional[int]:
+    """The spindle number of a spindle function written with it (Sinumerik M1=3), else None."""
+    m = _NUMBERED_M.match(s.code)
+    return int(m.group(1)) if m else None
+
+
+def numbered_mode_change(d) -> None:
+    """M<n>=3/4/5/19: the master's function where n is the master, else NC220 (never the master's
+    direction: `M1=3` after SETMS(2) starts spindle 1, not the master)."""
+    it, s = d
+    number = numbered_mode(s)
+    if number == it.master_spindle:
+        it._h_mode(s)
+    else:
+        _not_the_master(it, n.Passthrough(s.code, "spindle function", "sinumerik"), number)
 
 
 def numbered_speed(d) -> None:

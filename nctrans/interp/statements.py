@@ -33,6 +33,8 @@ class StatementsMixin:
         }
 
     def _c_mode(self, s: n.ModeChange):
+        if s.group == "spindle" and spindle_position.numbered_mode(s) is not None:
+            return (spindle_position.numbered_mode_change, (self, s))     # M1=3 after SETMS(2)
         return (self._h_mode, s)
 
     def _h_mode(self, s: n.ModeChange):

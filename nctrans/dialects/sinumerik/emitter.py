@@ -69,6 +69,7 @@ ARGUMENT_MISSING_ALARM = 65001
 NOT_CONVERTED_ALARM = 65002
 _GOTO = {"forward": "GOTOF", "backward": "GOTOB", "any": "GOTO"}
 _SUB_NUM = re.compile(r"^O?(\d+)$", re.IGNORECASE)
+_NUMBERED_M = re.compile(r"M\d+=\d+", re.IGNORECASE)     # a spindle function with its spindle (M1=3)
 # address letters whose value may be an expression written `M=R501` (seed "Indirect programming":
 # every address takes a variable except N, G and L)
 _COMPUTED_WORDS = frozenset("MH")
@@ -381,6 +382,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         code = self.code_of(s)
         if code is None:
             raise NotExpressible(s.code or f"{s.group}={s.value}")
+        if g == "spindle" and self.p.dialect == DIALECT and _NUMBERED_M.fullmatch(s.code or ""):
+            code = s.code.upper()       # M1=3 stays spindle 1's after a SETMS(n), not the master's
         out.words.append(code)
 
     def cycle_mode(self, s: ir.ModeChange, out: "_Line") -> None:

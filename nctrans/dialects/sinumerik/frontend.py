@@ -517,7 +517,11 @@ class Lowerer:
             w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
         elif re.fullmatch(r"M\d+", name) and name == "M1" and isinstance(value, ir.Num) and \
                 f"M{value.value:g}" in ("M3", "M4", "M5", "M19"):
-            self.code(f"M{value.value:g}", w, text)          # M1=3: master spindle 1 clockwise
+            self.code(f"M{value.value:g}", w, text)          # M1=3: spindle 1 clockwise
+            if w.out and isinstance(w.out[-1], ir.ModeChange):
+                # spelt with its spindle number: spindle 1's, which is the master only until a
+                # SETMS(n) (interp/spindle_position.py); the writer keeps the number
+                w.out[-1] = ir.ModeChange(w.out[-1].group, w.out[-1].value, f"M1={value.value:g}")
         elif re.fullmatch(r"[A-Z]\d+", name):
             reason = self.pass_words.get(name[0], f"extended address {name[0]}")
             if name[0] == "M":
