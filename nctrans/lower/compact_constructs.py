@@ -54,30 +54,10 @@ def lower_compact(program: n.Program, refusals: list[Diagnostic], target_name: s
     live = [s for s in segments if s.why_not is None]
     if live:
         _run(program, view, structure, live, machine, resolver)
-    new_body: list = []
-    notes: list[Diagnostic] = []
-    done = 0
-    lowered_any = False
-    for seg in segments:
-        ended = c._settle(seg)
-        if seg.why_not is not None:
-            remaining.extend(c.refused(seg))
-            continue
-        first_line, last_line = _lines(view.slice(seg.first, seg.last))
-        notes.extend(c.lowered_notes(seg, target_name, first_line, last_line))
-        new_body.extend(view.slice(done, seg.first - 1))
-        seg.spill.add(seg.flattener.blocks)
-        seg.flattener.blocks.clear()
-        new_body.append(seg.spill.close())
-        units_follow = seg.last == len(view) - 1 or c._sets(view.node(seg.last + 1), "units")
-        restore = c._restore(seg, n.Span(program.file, last_line), units_follow) if not ended else None
-        if restore is not None and restore.body:
-            new_body.append(restore)
-        done = seg.last + 1
-        lowered_any = True
-    if not lowered_any:
+    new_body, notes = c.close_segments(segments, remaining, target_name, program.file, len(view),
+                                       view.slice, view.node, _lines, _spilled)
+    if new_body is None:
         return None, notes, remaining
-    new_body.extend(view.slice(done, len(view) - 1))
     return dataclasses.replace(program, body=CompactBody(new_body, program.body.jumps)), notes, remaining
 
 
@@ -177,6 +157,13 @@ def _blocks(nodes: list):
             yield from run_blocks(x)
         else:
             yield from blocks([x])
+
+
+def _spilled(seg: c.Segment) -> list:
+    """A segment's plain motion as the run of its spill (the flattener's last blocks added)."""
+    seg.spill.add(seg.flattener.blocks)
+    seg.flattener.blocks.clear()
+    return [seg.spill.close()]
 
 
 def _lines(nodes: list) -> tuple[int, int]:

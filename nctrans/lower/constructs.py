@@ -532,32 +532,53 @@ def lower_constructs(program: n.Program, refusals: list[Diagnostic], target_name
     live = [s for s in segments if s.why_not is None]
     if live:
         _run(program, live, machine, resolver)
+    new_body, notes = close_segments(
+        segments, remaining, target_name, program.file, len(program.body),
+        lambda lo, hi: program.body[lo:hi + 1], program.body.__getitem__, _lines,
+        lambda seg: seg.flattener.blocks)
+    if new_body is None:
+        return None, notes, remaining
+    return dataclasses.replace(program, body=new_body), notes, remaining
+
+
+def close_segments(segments: list[Segment], remaining: list[Diagnostic], target_name: str, file: str,
+                   size: int, slice_: Callable, node_at: Callable, lines_of: Callable,
+                   plain_of: Callable) -> tuple[Optional[list], list[Diagnostic]]:
+    """After the run, each segment in turn: a refused one adds its refusals to `remaining`; a
+    lowered one gives its NC401 notes and is replaced by its plain motion (`plain_of(seg)`: the
+    flattener's blocks, or the run they were spilled to) and the block that restores the modes
+    its end leaves. (the new body, None when nothing was lowered; the notes.) The body is seen
+    through its `size` nodes, `slice_(lo, hi)` (nodes lo..hi as items), `node_at(i)` and
+    `lines_of(items)` ((first, last) source line): a list or a compact view."""
     new_body: list = []
     notes: list[Diagnostic] = []
     done = 0
     lowered_any = False
-    for k, seg in enumerate(segments):
+    for seg in segments:
         ended = _settle(seg)
         if seg.why_not is not None:
             remaining.extend(refused(seg))
             continue
-        nodes = program.body[seg.first:seg.last + 1]
-        lines = [b.span.line for b in blocks(nodes)] or [nodes[0].span.line]
-        first_line, last_line = min(lines), max(lines)
+        first_line, last_line = lines_of(slice_(seg.first, seg.last))
         notes.extend(lowered_notes(seg, target_name, first_line, last_line))
-        new_body.extend(program.body[done:seg.first])
-        new_body.extend(seg.flattener.blocks)
-        last_span = n.Span(program.file, last_line)
-        units_follow = seg.last == len(program.body) - 1 or _sets(program.body[seg.last + 1], "units")
-        restore = _restore(seg, last_span, units_follow) if not ended else None
+        new_body.extend(slice_(done, seg.first - 1))
+        new_body.extend(plain_of(seg))
+        units_follow = seg.last == size - 1 or _sets(node_at(seg.last + 1), "units")
+        restore = _restore(seg, n.Span(file, last_line), units_follow) if not ended else None
         if restore is not None and restore.body:
             new_body.append(restore)
         done = seg.last + 1
         lowered_any = True
     if not lowered_any:
-        return None, notes, remaining
-    new_body.extend(program.body[done:])
-    return dataclasses.replace(program, body=new_body), notes, remaining
+        return None, notes
+    new_body.extend(slice_(done, size - 1))
+    return new_body, notes
+
+
+def _lines(nodes: list) -> tuple[int, int]:
+    """(first, last) source line of a segment's nodes: the lowest and highest of its blocks."""
+    lines = [b.span.line for b in blocks(nodes)] or [nodes[0].span.line]
+    return min(lines), max(lines)
 
 
 def _walk_check(seg: Segment, nodes: list, machine) -> None:
