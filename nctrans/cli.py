@@ -606,7 +606,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--summary", action="store_true",
                    help="print a short summary (counts, lengths, bounding box, tools, cycle time) instead")
     p.add_argument("--profile", metavar="NAME", help="control of the source's family that runs it (profiles of "
-                   "its rules table, e.g. iso-m linuxcnc); detected from the header comments when omitted")
+                   "its rules table, e.g. linuxcnc); detected from the header comments when omitted")
     p.add_argument("--fail-on", choices=("error", "warning", "info"), default="error",
                    help="exit 1 when a diagnostic at or above this severity was reported")
     _add_search_path(p)

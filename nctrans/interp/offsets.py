@@ -91,7 +91,8 @@ class OffsetsMixin:
             self._said_offset_change()
 
     def _said_offset_change(self) -> None:
-        if self.program.dialect == "iso-m":
+        from nctrans.rules import option
+        if option(self.program.dialect, "offset_change_under_comp") == "refused_by_oracle":
             self.diag("NC122", "info", "an offset change under cutter radius compensation: modelled as "
                       "the control applies it (the held compensated move keeps the offsets it was "
                       "programmed with, the next move takes the new ones); LinuxCNC refuses tool length, "

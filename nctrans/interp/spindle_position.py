@@ -98,7 +98,9 @@ _SETMS = re.compile(r"\s*SETMS\s*(?:\(\s*([^)]*?)\s*\))?\s*$", re.IGNORECASE)
 
 
 def is_setms(s: n.Passthrough) -> bool:
-    return s.dialect == "sinumerik" and _SETMS.match(s.text) is not None
+    """The dialect's master-spindle word (rules `[options] master_spindle_word`, Sinumerik SETMS)."""
+    from nctrans.rules import option
+    return option(s.dialect, "master_spindle_word") == "SETMS" and _SETMS.match(s.text) is not None
 
 
 def set_master(d) -> None:
@@ -149,7 +151,7 @@ def numbered_mode_change(d) -> None:
     if number == it.master_spindle:
         it._h_mode(s)
     else:
-        _not_the_master(it, n.Passthrough(s.code, "spindle function", "sinumerik"), number)
+        _not_the_master(it, n.Passthrough(s.code, "spindle function", it.program.dialect), number)
 
 
 def numbered_speed(d) -> None:
