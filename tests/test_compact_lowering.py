@@ -355,3 +355,14 @@ def test_a_macro_file_that_jumps_is_written_as_its_proc():
     assert pipeline.get_dialect("iso-m").parse_compact(MACRO_FILE_JUMPS, "m.nc", jumps=True) is None
     out = api.transpile(MACRO_FILE_JUMPS, "iso-m", "sinumerik", file="m.nc").text
     assert "PROC L1000(" in out
+
+
+def test_a_length_left_behind_at_a_jump_target_is_refused_at_its_line_for_fagor():
+    # found by the ISO jumps property: a stale H1 after T2 M6 that shows at the jump target N20 (a
+    # Fagor M06 applies the new tool's D1) ended in "internal error: NotExpressible"
+    text = ("%\nO1000\nG21 G90 G17 G40 G80 F500.\nT1 M6\nS6000 M3\nG0 X0 Y0 Z5.\n#5=0\n"
+            "G43 H1 Z50.\nG0 X0.5 Y0 Z-0.25\nT2 M6\nN10 G2 X1. Y0 I1. J0\nN20 G0 X0.5 Y0 Z-0.25\n"
+            "#5=#5+1\nIF[#5LT2]GOTO20\nM30\n%\n")
+    done = api.transpile(text, "iso-m", "fagor", file="j.nc")
+    assert done.text is None
+    assert ("NC402", 12) in [(d.rule, d.line) for d in done.diagnostics if d.severity == "error"]

@@ -315,7 +315,10 @@ class FagorEmitter(FagorSpelling, Emitter):
                 continue
             self.span = getattr(node, "span", self.span)
             if self.length_behind is not None and (t is not n.Block or _is_target(node, self.targets)):
-                self._length_shows(None)
+                try:                            # a structure or jump target lets the length show
+                    self._length_shows(None)
+                except NotExpressible as e:     # refused at its line, as inside a block
+                    self.refuse(str(e))
             if t is n.Block:
                 self.block(node)
             elif t is n.If:
