@@ -65,14 +65,7 @@ def _segments(program: n.Program, view: CompactView, refusals: list[Diagnostic]
               ) -> tuple[list[c.Segment], list[Diagnostic]]:
     """constructs._segments over the view: a refused line inside a run is that block's node."""
     index = view.line_index(program.file, {d.line for d in refusals if d.file == program.file})
-    found: list[c.Segment] = []
-    outside: list[Diagnostic] = []
-    for d in refusals:
-        i = index.get(d.line) if d.file == program.file else None
-        if i is None:
-            outside.append(d)
-            continue
-        found.append(c.Segment(i, i, [d]))
+    found, outside = c.placed(refusals, program.file, index)
     modal, stretch = _scan(view)
     return c._widened(found, modal, stretch), outside
 

@@ -341,16 +341,23 @@ def _jump_targets(nodes: list) -> set[str]:
 def _segments(program: n.Program, refusals: list[Diagnostic]) -> tuple[list[Segment], list[Diagnostic]]:
     """Group the refusals into segments of the main body; refusals outside it stay as they are."""
     body = program.body
-    index = _line_index(body, program.file)
+    found, outside = placed(refusals, program.file, _line_index(body, program.file))
+    return _widened(found, _modal_runs(body), _stretch_runs(body)), outside
+
+
+def placed(refusals: list[Diagnostic], file: str, index: dict[int, int]
+           ) -> tuple[list[Segment], list[Diagnostic]]:
+    """A one-node segment for each refusal at a line of the main body (`index`: line -> node),
+    and the refusals elsewhere (a subprogram's, another file's)."""
     found: list[Segment] = []
     outside: list[Diagnostic] = []
     for d in refusals:
-        i = index.get(d.line) if d.file == program.file else None
+        i = index.get(d.line) if d.file == file else None
         if i is None:
             outside.append(d)
-            continue
-        found.append(Segment(i, i, [d]))
-    return _widened(found, _modal_runs(body), _stretch_runs(body)), outside
+        else:
+            found.append(Segment(i, i, [d]))
+    return found, outside
 
 
 def _widened(found: list[Segment], modal_runs, stretch_runs) -> list[Segment]:
