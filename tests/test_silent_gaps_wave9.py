@@ -65,20 +65,12 @@ def test_polar_moves_after_a_pole_fagor_cannot_write_are_not_written_as_polar():
     assert conv.ok and nctrans.equiv(text, conv.text, read_a="sinumerik", read_b="fagor"), conv.text
 
 
-def test_iso_polar_input_g16_is_not_converted_as_cartesian(tmp_path):
-    # G16 (ISO seed 4.5) is recorded, not modelled: X10 Y30 is radius 10 at 30 degrees, (8.66, 5),
-    # on the control, but the analysed toolpath takes (10, 30). Lowered to plain motion it was
-    # written as X10 Y30 with exit 0; now the conversion refuses at the G16 line
-    import subprocess
-    import sys
-    src = tmp_path / "p.nc"
-    src.write_text("O2003\nG21 G17 G90\nT1 M6\nG0 X0 Y0 Z5 S1000 M3\nG16\nG1 X10 Y30 F100\nG15\nM30\n")
+def test_iso_polar_input_g16_is_not_converted_as_cartesian():
+    # G16 (ISO seed 4.5): X10 Y30 is radius 10 at 30 degrees, (8.660254, 5) (10 cos 30, 10 sin 30).
+    # It was written as the point X10 Y30 with exit 0, then refused; it is modelled now
+    # (polar_input.py) and converted as the Cartesian point it reaches
+    text = "O2003\nG21 G17 G90\nT1 M6\nG0 X0 Y0 Z5 S1000 M3\nG16\nG1 X10 Y30 F100\nG15\nM30\n"
     for target in ("sinumerik", "fagor"):
-        out = subprocess.run([sys.executable, "-m", "nctrans", "convert", str(src), "--to", target,
-                              "-o", str(tmp_path / f"o.{target}")], capture_output=True, text=True, timeout=120)
-        # refused at the G16 line: an error and no output, or refused in place (the output
-        # stops with an alarm there, NC412), never X10 Y30 written as a point
-        if out.returncode == 1:
-            assert "p.nc:5:1: error[NC402]" in out.stderr and not (tmp_path / f"o.{target}").exists()
-        else:
-            assert out.returncode == 0 and "p.nc:5:1: warning[NC412]" in out.stderr, out.stderr
+        conv = nctrans.transpile(text, read="iso-m", write=target)
+        assert conv.ok and "X8.660254 Y5" in conv.text and "Y30" not in conv.text, conv.text
+        assert nctrans.equiv(text, conv.text, read_a="iso-m", read_b=target)

@@ -23,7 +23,7 @@ SHARED_SCOPE_CALLS = frozenset(("m98", "m97", "shared"))   # m97: Haas local sub
 # or state whose restoring mid-path would need its own approach (cutter compensation, cycles).
 NOT_SAVED_GROUPS = frozenset(("spindle", "coolant", "tool_length", "cutter_comp", "cycle"))
 SAVED_ATTRS = ("motion", "plane", "incremental", "arc_absolute", "scale", "feed_scale", "feed_mode",
-               "work_offset", "cycle_retract")
+               "work_offset", "cycle_retract", "polar")
 
 
 class CallsMixin:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Optional
 
-from nctrans.interp import arcs, corner_elements, rigid_tap, thread_starts
+from nctrans.interp import arcs, corner_elements, polar_input, rigid_tap, thread_starts
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
@@ -101,7 +101,7 @@ class MotionMixin:
         st = self.st
         if (st.cycle != "off" or self.modal_cycle is not None or self.comp is not None
                 or self.comp_exit or st.comp_side != "off" or not self.frame.identity
-                or self.unmodelled_motion is not None or st.diameter
+                or self.unmodelled_motion is not None or st.diameter or st.polar
                 or self.css_surface is not None or self.spindle_stopped or self.watch
                 or self.corner is not None):
             return self._slow(d)
@@ -165,6 +165,10 @@ class MotionMixin:
         self._polar_arc = bool(polar)
         if polar:
             vals = self._polar(vals, polar)
+        elif st.polar:
+            vals = polar_input.cartesian(self, vals, machine)
+            if vals is None:
+                return
         if self.modal_cycle is not None and st.cycle == "off" and not machine:
             self._motion_plain(vals, d)
             if any(a in PLANE_AXES[st.plane][:2] for a, _, _ in vals):
@@ -507,6 +511,8 @@ class MotionMixin:
         every reference point, as LinuxCNC's default #5161.. / #5181..) on the named axes;
         with no axis words every axis goes home directly."""
         vals = self._eval_words(self._words(s.via))
+        if polar_input.guard(self, vals, "a home return through an intermediate point"):
+            return
         if vals:
             self._move("rapid", self._target(vals))
             axes = [a for a, _, _ in vals]

@@ -12,6 +12,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any, Optional
 
+from nctrans.interp import polar_input
 from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
 from nctrans.interp.frames import PLANE_AXES, ProgrammableFrame, rpy_ordered
 from nctrans.interp.state import LINEAR_AXES
@@ -213,7 +214,7 @@ class OffsetsMixin:
 
     def _h_setpos(self, s: n.SetPosition):
         vals = self._eval_words(self._words(s.target))
-        if not vals:
+        if not vals or polar_input.guard(self, vals, "setting the position"):
             return
         target = self._target(vals)
         work = self.frame.to_work(target)
@@ -235,6 +236,9 @@ class OffsetsMixin:
 
     def _h_frame(self, s: n.FrameOp):
         st = self.st
+        if st.polar and polar_input.guard(self, [(a,) for a in list(s.values) + list(s.center or ())],
+                                          "a frame or local offset with plane axis words"):
+            return
         scale = st.scale
         fr = self.frame
         op = s.op

@@ -18,7 +18,7 @@ class ModalState:
     __slots__ = ("groups", "motion", "plane", "incremental", "arc_absolute", "scale", "feed_scale", "feed_mode",
                  "feed", "spindle_speed", "spindle_dir", "tool", "tool_selected", "length_mode",
                  "length_index", "comp_side", "radius_index", "work_offset", "cycle",
-                 "cycle_retract", "coolant", "diameter")
+                 "cycle_retract", "coolant", "diameter", "polar")
 
     def __init__(self, defaults: Optional[dict[str, Any]] = None):
         self.groups: dict[str, str] = {}
@@ -43,6 +43,7 @@ class ModalState:
         self.cycle_retract = "initial"
         self.coolant = "off"
         self.diameter = False             # lathe: X words are diameters (ISO-T, Sinumerik DIAMON)
+        self.polar = False                # plane words are radius and angle (polar_input.py)
         for g, v in (defaults or {}).items():
             self.set(str(g), str(v))
 
@@ -78,3 +79,5 @@ class ModalState:
             self.coolant = value
         elif group == "diameter":
             self.diameter = value == "diameter"
+        elif group == "polar":
+            self.polar = value == "on"

@@ -122,5 +122,4 @@ UNMODELLED_LIMITS = frozenset(("protection zone",))
 # and constant surface speed are modelled by nctrans.interp.lathe (CSS on a lathe or in diameter mode;
 # on a mill it reports NC220 itself).
 UNMODELLED_MODES: dict[tuple[str, str], str] = {
-    ("polar", "on"): "polar coordinate mode: axis words are read as Cartesian coordinates",
 }

@@ -194,6 +194,8 @@ STRETCH_MODES = {
     # Sinumerik G500 (no settable offset): every later position is in the basic frame, not the
     # G54 an ISO control keeps, until another offset is selected
     "work_offset": frozenset(("G53",)),
+    # ISO G16: every later block's plane words are radius and angle (interp/polar_input.py)
+    "polar": frozenset(("on",)),
 }
 
 

@@ -1,0 +1,99 @@
+"""Polar coordinate input (the ISO mode G16, group `polar`): while it is on, the first axis word
+of the selected plane is a radius and the second an angle (ISO seed L3707-3747, spec iso 4.9).
+
+Why a module of its own: the mode rereads every dimension word of a block, so the motion, the
+set-position, frame and home-return handlers all ask it first.
+
+What the seed defines, and so what is modelled:
+- G90 in the block: the pole is the workpiece zero (L3723). A radius left out is the current
+  distance from the pole (L3730, the example's N20: sqrt(170.711^2 + 70.711^2) = 184.776); an
+  angle left out is the current angle about the pole (the same rule for the other word).
+- G91 with both words: the pole is the current position (L3724); the radius is absolute (L3747)
+  and the angle is measured from the plane's first axis: the example's N15 `G91 X100 Y0` from
+  (70.711, 70.711) ends at (170.711, 70.711), not 45 degrees on.
+- Words of other axes (the plane's third axis) are Cartesian as always.
+
+What it does not define, and so is refused at its line (NC117, the block moves nothing):
+- G91 with only the radius or only the angle (no reference for the angle, or a zero radius);
+- a circle (G2/G3) with a polar end point (the seed gives no centre rule);
+- a canned cycle position under G16: alarm 61814 unless the setting `_ZSFI[3]` is 1 (L2427,
+  L6385), and the seed does not say how the cycle reads it then;
+- G53, G28/G30, G92, G52, G68 or G51 with plane axis words under G16 (the seed names motion only).
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+from nctrans.interp.frames import PLANE_AXES
+
+RULE = "NC117"
+
+
+def active(interp) -> bool:
+    return interp.st.groups.get("polar") == "on"
+
+
+def refuse(interp, what: str) -> None:
+    code = interp.spelt_codes.get("polar") or "polar mode"
+    interp.diag(RULE, "warning", f"{what} under polar coordinate input ({code}) is not modelled: "
+                "the block moves nothing in the analysed toolpath (the seed does not define it)")
+
+
+def plane_words(interp, words) -> bool:
+    """Whether evaluated or compiled axis words name an axis of the active plane."""
+    a1, a2, _ = PLANE_AXES[interp.st.plane]
+    return any(w[0] in (a1, a2) for w in words)
+
+
+def guard(interp, words, what: str) -> bool:
+    """A non-motion statement with plane axis words under G16: refused (True) at its line."""
+    if active(interp) and plane_words(interp, words):
+        refuse(interp, what)
+        return True
+    return False
+
+
+def cartesian(interp, vals: list, machine: bool = False) -> Optional[list]:
+    """The block's evaluated words [(axis, value, mode)] with the plane's radius and angle
+    replaced by absolute Cartesian end coordinates; None when the block is refused (NC117)."""
+    st = interp.st
+    a1, a2, _ = PLANE_AXES[st.plane]
+    radius = angle = None
+    inc = st.incremental
+    for axis, v, mode in vals:
+        if axis == a1:
+            radius = v
+            inc = mode == "inc" if mode else st.incremental
+        elif axis == a2:
+            angle = v / st.scale            # _eval_words scaled it as a length
+            if radius is None:
+                inc = mode == "inc" if mode else st.incremental
+    if radius is None and angle is None:
+        return vals
+    if machine:
+        refuse(interp, "a move in machine coordinates")
+        return None
+    if st.motion not in ("rapid", "linear"):
+        refuse(interp, "a circle or other non-linear motion with polar words")
+        return None
+    if st.cycle != "off" or interp.modal_cycle is not None:
+        refuse(interp, "a canned cycle position (alarm 61814 unless _ZSFI[3] = 1)")
+        return None
+    cur1, cur2 = interp.pos.get(a1, 0.0), interp.pos.get(a2, 0.0)
+    if inc:
+        if radius is None or angle is None:
+            refuse(interp, "an incremental (G91) block with only the "
+                   + ("angle" if radius is None else "radius"))
+            return None
+        pole = (cur1, cur2)
+    else:
+        pole = (0.0, 0.0)
+        if radius is None:
+            radius = math.hypot(cur1, cur2)
+        if angle is None:
+            angle = math.degrees(math.atan2(cur2, cur1))
+    rad = math.radians(angle)
+    rest = [w for w in vals if w[0] not in (a1, a2)]
+    return rest + [(a1, pole[0] + radius * math.cos(rad), "abs"),
+                   (a2, pole[1] + radius * math.sin(rad), "abs")]
