@@ -103,9 +103,9 @@ def test_inside_groove_cuts_away_from_the_axis():
 @pytest.mark.parametrize("call, width, rule", [
     ("CYCLE93(40, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", None, "NC113"),    # no tool width
     ("CYCLE93(10, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 2, 1)", 3.0, "NC114"),     # face, past the axis
-    ("CYCLE93(40, -10, 8, 4, 0, 0, 10, 0, 0, 0, 0, 0, 0, 2, 0, 6, 1)", 3.0, "NC113"),    # ANG2 on a face groove
+    ("CYCLE93(40, -10, 8, 4, 0, 0, 90, 0, 0, 0, 0, 0, 0, 2, 0, 6, 1)", 3.0, "NC114"),    # ANG2 90 (< 89.999)
     ("CYCLE93(40, -10, 8, 4, 5, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", 3.0, "NC113"),     # STA1
-    ("CYCLE93(40, -10, 8, 4, 0, 10, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", 3.0, "NC113"),    # ANG1
+    ("CYCLE93(40, -10, 8, 4, 0, -10, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", 3.0, "NC114"),   # ANG1 < 0
     ("CYCLE93(40, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 9, 1)", 3.0, "NC114"),     # VARI 9
     ("CYCLE93(40, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 25, 1)", 3.0, "NC114"),    # VARI 25
     ("CYCLE93(40, -10, 2, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)", 3.0, "NC114"),     # tool too wide
@@ -164,52 +164,143 @@ def test_converted_to_iso_turning_is_equivalent():
     assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-t", machine=_lathe(4.0))
 
 
+def test_flank_angles_widen_the_groove_from_its_base_by_hand():
+    # [GK] WIDG is the width at the base, the flanks open outwards by ANG1/ANG2 from the normal of
+    # the contour, SPD/SPL is the edge where flank 1 meets the contour. VARI 5 (starting point
+    # right: u runs towards -Z from Z-10), radius 20 (SPD 40), WIDG 4, DIAG 3, ANG1 = ANG2 = 45:
+    # tan 45 = 1, so the base corners are at u 3 and 7 (depth 3), the other edge at u 10.
+    # Roughing (tool 3, no allowances, IDEP 0): plunges from u 0 to 10 - 3 = 7 in ceil(7/3) = 3
+    # steps: u 0, 7/3, 14/3, 7; each as deep as the tool's both ends may go: the floor is
+    # min(u, 3, 10 - u): u 0 -> min(0, 3) = 0 (none), 7/3 -> min(7/3, 3) = 7/3,
+    # 14/3 -> min(3, 10 - 23/3) = 7/3, 7 -> min(3, 0) = 0 (none). Radius 20 - 7/3 = 17.6667.
+    # Finishing: first edge from (20, -10) down flank 1 to the base corner (17, -13), along the
+    # base to the middle u 5 capped at 7 - 3 = 4 (Z-14), out. Second edge from the other edge u 10
+    # (first edge at u 7, Z-17) down flank 2 to u 7 (first edge u 4: (17, -14)), along the base
+    # until the second edge is at max(5, 3 + 3) = 6 (first edge u 3, Z-13), out, back to the start.
+    got, diags, _ = _run("CYCLE93(40, -10, 4, 3, 0, 45, 45, 0, 0, 0, 0, 0, 0, 0, 0, 5, 1)")
+    assert not [d for d in diags if d.severity != "info"]
+    r, f, x = "rapid", "linear", 20 - 7 / 3
+    want = [(r, 21, -10), (r, 21, -10 - 7 / 3), (f, x, -10 - 7 / 3), (r, 21, -10 - 7 / 3),
+            (r, 21, -10 - 14 / 3), (f, x, -10 - 14 / 3), (r, 21, -10 - 14 / 3),
+            (r, 21, -10), (f, 20, -10), (f, 17, -13), (f, 17, -14), (r, 21, -14),
+            (r, 21, -17), (f, 20, -17), (f, 17, -14), (f, 17, -13), (r, 21, -13), (r, 21, -10)]
+    assert got == [(k, pytest.approx(a), pytest.approx(b)) for k, a, b in want]
+
+
+def test_corners_on_sloping_flanks_by_hand():
+    # The groove above with VARI 15 (chamfers by their legs, CHR), RCO1 -1: a chamfer with legs 1
+    # on the contour and on flank 1: from u -1 (Z-9) to (sin 45, cos 45) = (0.707107, 0.707107),
+    # i.e. radius 20 - 0.707107 = 19.292893 at Z -10.707107. RCI2 1: a rounding at base corner 2
+    # (u 7, depth 3), where flank and base turn by 45 degrees: its tangent points lie
+    # tan(22.5) = 0.414214 from the corner: on flank 2 at (7.292893, 2.707107), on the base at
+    # (6.585786, 3); centre (6.585786, 2). The flat base now ends at 6.585786: the first edge
+    # stops at 6.585786 - 3 = 3.585786 (Z-13.585786). The second edge goes down flank 2 to the
+    # tangent point (first edge at u 4.292893: radius 17.292893, Z-14.292893), round the corner
+    # to (first edge) u 3.585786 at the base about u 3.585786, depth 2 (radius 18), along the base
+    # to u 3 (Z-13). Roughing is that of the groove above (the plunges do not reach the corners).
+    got, diags, recs = _run("CYCLE93(40, -10, 4, 3, 0, 45, 45, -1, 0, 0, 1, 0, 0, 0, 0, 15, 1)")
+    assert not [d for d in diags if d.severity != "info"]
+    r, f = "rapid", "linear"
+    want = [(r, 21, -9), (f, 20, -9), (f, 19.292893, -10.707107), (f, 17, -13), (f, 17, -13.585786),
+            (r, 21, -13.585786),
+            (r, 21, -17), (f, 20, -17), (f, 17.292893, -14.292893), ("arc", 17, -13.585786), (f, 17, -13),
+            (r, 21, -13), (r, 21, -10)]
+    assert got[7:] == [(k, pytest.approx(a, abs=1e-6), pytest.approx(b, abs=1e-6)) for k, a, b in want]
+    arc = next(rec for rec in recs if rec.kind == "arc")
+    assert (arc.center["X"], arc.center["Z"]) == (pytest.approx(18), pytest.approx(-13.585786))
+    # from lower left of the centre to straight below it, in the (Z right, X up) picture: ccw
+    assert arc.direction == "ccw"
+
+
 # ---------------------------------------------------------------------------------------------
 # Property: random grooves. Local coordinates: u along the groove from the starting point's edge,
-# w the depth (the finished groove is u in [0, W], w in [0, D] less its rounded/chamfered corners).
+# w the depth. The finished groove is the trapezoid with its base (WIDG) from u D tan ANG1 to that
+# + W at depth D and its flanks opening outwards to the contour (w 0), less the material its base
+# corners keep, plus what its top corners take off the part. Corner geometry worked out here
+# independently of the module: at each corner the two lines meet at 90 + ANG degrees (half angle
+# h = 45 + ANG / 2): a rounding r touches them r / tan h from the corner, its centre on the
+# bisector r / sin h from it; a chamfer's legs are L (CHR) or c / (2 sin h) (CHF, c its length).
 
-def _legs(v: float, chr_: bool) -> float:
-    return 0.0 if v == 0 else v if v > 0 else (-v if chr_ else -v / math.sqrt(2))
+
+def _inside(poly, p, tol=1e-9) -> bool:
+    """p inside the convex polygon `poly` (either orientation)."""
+    sides = [(b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+             for a, b in zip(poly, poly[1:] + poly[:1])]
+    return all(x >= -tol for x in sides) or all(x <= tol for x in sides)
 
 
-def _air(u: float, w: float, W: float, D: float, c: dict, tol: float = 1e-6) -> bool:
+def _corner_shape(v: float, chr_: bool, corner, d1, d2, ang: float):
+    """(kind, leg, zone): the corner element at `corner` between the unit directions d1, d2 of its
+    two lines (pointing away from it); zone = the kite or triangle it cuts off."""
+    if v == 0:
+        return ("none", 0.0, None)
+    h = math.radians(45 + ang / 2)
+    if v > 0:
+        leg = v / math.tan(h)
+    else:
+        leg = -v if chr_ else -v / (2 * math.sin(h))
+    p1 = (corner[0] + leg * d1[0], corner[1] + leg * d1[1])
+    p2 = (corner[0] + leg * d2[0], corner[1] + leg * d2[1])
+    if v < 0:
+        return ("chamfer", leg, (corner, p1, p2))
+    bis = (d1[0] + d2[0], d1[1] + d2[1])
+    nb = math.hypot(*bis)
+    dist = v / math.sin(h)
+    centre = (corner[0] + dist * bis[0] / nb, corner[1] + dist * bis[1] / nb)
+    return ("radius", leg, (corner, p1, centre, p2), centre, v)
+
+
+def _groove(W, D, a1, a2, rco1, rco2, rci1, rci2, chr_):
+    t1, t2 = math.tan(math.radians(a1)), math.tan(math.radians(a2))
+    b1, b2 = D * t1, D * t1 + W
+    top2 = b2 + D * t2
+    f1 = (math.sin(math.radians(a1)), math.cos(math.radians(a1)))     # flank 1 downwards
+    f2 = (-math.sin(math.radians(a2)), math.cos(math.radians(a2)))    # flank 2 downwards
+    return dict(W=W, D=D, t1=t1, t2=t2, b1=b1, b2=b2, top2=top2, a1=a1, a2=a2,
+                o1=_corner_shape(rco1, chr_, (0.0, 0.0), (-1.0, 0.0), f1, a1),
+                o2=_corner_shape(rco2, chr_, (top2, 0.0), (1.0, 0.0), f2, a2),
+                i1=_corner_shape(rci1, chr_, (b1, D), (-f1[0], -f1[1]), (1.0, 0.0), a1),
+                i2=_corner_shape(rci2, chr_, (b2, D), (-f2[0], -f2[1]), (-1.0, 0.0), a2))
+
+
+def _in_zone(c, p, tol=1e-6) -> bool:
+    """p in the part a corner element cuts off (between the sharp corner and the element)."""
+    if c[0] == "none":
+        return False
+    if c[0] == "chamfer":
+        return _inside(list(c[2]), p, -tol)
+    return _inside(list(c[2]), p, -tol) and math.dist(p, c[3]) > c[4] + tol
+
+
+def _air(u: float, w: float, g: dict, tol: float = 1e-6) -> bool:
     """True where no material is left once the groove is finished (outside the part included)."""
     if w <= tol:
         return True
-    if w > D + tol:
+    if w > g["D"] + tol:
         return False
-    for side, v in ((1, -u), (2, u - W)):            # v > 0: beyond the groove's edge, on the contour
-        kind, leg = c[f"o{side}"]
-        if v > tol:
-            if v > leg + tol or w > leg + tol:
-                return False
-            if kind == "radius":
-                return math.hypot(leg - v, leg - w) >= leg - tol
-            return w <= leg - v + tol
-    floor = D
-    for side, v in ((1, u), (2, W - u)):
-        kind, leg = c[f"i{side}"]
-        if v < leg:
-            floor = D - leg + (math.sqrt(max(leg * leg - (leg - v) ** 2, 0)) if kind == "radius" else v)
-    return w <= floor + tol
+    in_trapezoid = w * g["t1"] - tol <= u <= g["top2"] - w * g["t2"] + tol
+    if not in_trapezoid:                            # the part, unless a top corner took it off
+        return _in_zone(g["o1"], (u, w), -tol) or _in_zone(g["o2"], (u, w), -tol)
+    return not (_in_zone(g["i1"], (u, w)) or _in_zone(g["i2"], (u, w)))
 
 
 corner = st.one_of(st.just(0.0), st.floats(-2, -0.1), st.floats(0.1, 2))
+angle = st.one_of(st.just(0.0), st.floats(0, 70))
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=120, deadline=None)
 @given(st.floats(2, 30), st.floats(0.5, 12), st.floats(0.3, 1.0), st.floats(0, 0.5), st.floats(0, 0.5),
        st.one_of(st.just(0.0), st.floats(0.2, 5)), st.sampled_from([1, 2, 3, 4, 5, 6, 7, 8, 11, 12, 13, 14, 15, 16, 17, 18]),
-       corner, corner, corner, corner, st.floats(0, 2), st.floats(-50, 50))
+       corner, corner, corner, corner, st.floats(0, 2), st.floats(-50, 50), angle, angle)
 def test_grooves_stay_in_the_outline_reach_the_depth_and_end_at_the_start(
-        W, D, frac, fal1, fal2, idep, vari, rco1, rco2, rci1, rci2, vrt, spl):
+        W, D, frac, fal1, fal2, idep, vari, rco1, rco2, rci1, rci2, vrt, spl, ang1, ang2):
     tw = W * frac
-    p = dict(SPD=20.0, SPL=spl, WIDG=W, DIAG=D, RCO1=rco1, RCO2=rco2, RCI1=rci1, RCI2=rci2, FAL1=fal1,
-             FAL2=fal2, IDEP=idep, VARI=vari, VRT=vrt, DTB=0.2)
+    p = dict(SPD=20.0, SPL=spl, WIDG=W, DIAG=D, ANG1=ang1, ANG2=ang2, RCO1=rco1, RCO2=rco2, RCI1=rci1,
+             RCI2=rci2, FAL1=fal1, FAL2=fal2, IDEP=idep, VARI=vari, VRT=vrt, DTB=0.2)
     chr_ = vari > 10
-    c = {}
-    for name, v in (("o1", rco1), ("o2", rco2), ("i1", rci1), ("i2", rci2)):
-        c[name] = ("radius" if v > 0 else "chamfer", _legs(v, chr_))
+    g = _groove(W, D, ang1, ang2, rco1, rco2, rci1, rci2, chr_)
+    leg = {k: g[k][1] for k in ("o1", "o2", "i1", "i2")}
+    c1, c2 = math.cos(math.radians(ang1)), math.cos(math.radians(ang2))
     face = vari % 2 == 0
     s = -1.0 if vari % 10 >= 5 else 1.0
     e = -1.0 if vari % 10 in (3, 4, 7, 8) else 1.0
@@ -217,9 +308,10 @@ def test_grooves_stay_in_the_outline_reach_the_depth_and_end_at_the_start(
         rough, finish = groove_passes(p, tw)
     except MillingError as err:                     # refused only where the groove cannot be cut so
         assert err.rule == "NC114"
-        assert (c["o1"][1] + c["i1"][1] > D or c["o2"][1] + c["i2"][1] > D or c["i1"][1] + c["i2"][1] > W
-                or tw > W - c["i1"][1] - c["i2"][1] - 1e-9 or tw > W - 2 * fal2 - 1e-9 or fal1 >= D - 1e-9
-                or (face and e > 0 and W + c["o2"][1] > 20.0 - 1e-9))   # an outside face groove past the axis
+        assert (leg["o1"] + leg["i1"] > D / c1 - 1e-9 or leg["o2"] + leg["i2"] > D / c2 - 1e-9
+                or leg["i1"] + leg["i2"] > W - 1e-9 or tw > W - leg["i1"] - leg["i2"] - 1e-9
+                or tw > W - fal2 / c1 - fal2 / c2 - 1e-9 or fal1 >= D - 1e-9
+                or (face and e > 0 and g["top2"] + leg["o2"] > 20.0 - 1e-9))   # an outside face groove past the axis
         return
     v = vrt or 1.0
 
@@ -249,7 +341,7 @@ def test_grooves_stay_in_the_outline_reach_the_depth_and_end_at_the_start(
             pts = [(here[0] + (end[0] - here[0]) * t / 8, here[1] + (end[1] - here[1]) * t / 8) for t in range(9)]
         for u, w in pts:                            # the tool's cutting line: the first edge .. + width
             for j in range(9):
-                assert _air(u + tw * j / 8, w, W, D, c), (k, step, u + tw * j / 8, w)
+                assert _air(u + tw * j / 8, w, g), (k, step, u + tw * j / 8, w)
         deepest = max(deepest, end[1])
         here = end
     assert deepest == pytest.approx(D)               # the finishing reaches the base
@@ -274,3 +366,10 @@ def test_any_values_plan_or_refuse():
     for bad in (dict(WIDG=float("nan")), dict(IDEP=1e-6), dict(VARI=0.5), dict(DIAG=100.0), dict(VRT=float("inf"))):
         with pytest.raises(MillingError):
             groove_steps(dict(base, **bad), 3.0)
+
+
+def test_sloping_flanks_with_corners_converted_to_iso_turning_is_equivalent():
+    text = _text("CYCLE93(40, -20, 6, 3, 0, 20, 35, 0.5, -0.5, 0.4, -0.3, 0.1, 0.2, 1, 0.2, 15, 0)")
+    conv = api.transpile(text, "sinumerik", "iso-t", machine=_lathe(3.0))
+    assert conv.text is not None and "CYCLE93" not in conv.text
+    assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-t", machine=_lathe(3.0))

@@ -21,6 +21,12 @@ Facts [GK] (Siemens 840D/810D turning cycles manual; the seeds do not document C
 - RCO1/RCO2 round or chamfer the groove's outer corners (on the contour), RCI1/RCI2 its corners
   at the base, 1 on the starting point's side: a positive value is a radius, a negative one a
   chamfer;
+- ANG1 (the starting point's side) and ANG2 (the other side), 0 <= ANG < 89.999, are flank
+  angles: the flanks open outwards from the base by their angles to the contour's normal. WIDG is
+  the width at the base: the control alarms when the tool is wider than WIDG (alarm 61602), which
+  only says the tool does not fit if WIDG is the groove's narrowest width; SPD/SPL is the edge
+  where the starting point's flank meets the contour (the point STA1 draws the contour through).
+  The groove is then WIDG + DIAG (tan ANG1 + tan ANG2) wide on the contour;
 - roughing plunges paraxially into the groove in infeeds of at most IDEP, backs off for chip
   breaking after each, dwells DTB at the bottom, and steps across the groove by at most the tool's
   width, leaving FAL1 on the base and FAL2 on the flanks; finishing then runs the profile from each
@@ -38,12 +44,17 @@ Modelling choices [NC] (the manual leaves them to the control):
 - plunges are equally spaced at most the tool's width apart, from the starting point's side
   across; infeeds are equal, of at most IDEP (IDEP 0: one infeed); the chip-breaking back-off is
   _VRT (1 mm when 0) with G0; between plunges the tool goes out to the start point's level;
-- roughing leaves the allowances measured paraxially, and a plunge never reaches into a rounded or
-  chamfered base corner (it stops above the corner where the tool spans it);
+- roughing plunges are spread over the groove's whole opening on the contour; each goes as deep
+  as the tool's whole width may: FAL1 off the base, FAL2 square to each flank, never into a
+  rounded or chamfered base corner (the rough floor is concave, so its least over the tool's
+  width is at one of its ends); a plunge that would not go in at all (at a sloping flank's top)
+  is left out;
+- a corner on a sloping flank is a rounding tangent to flank and contour (or base), or a chamfer
+  with equal legs (nctrans.interp.corners, as RND/CHF/CHR);
 - not modelled, refused at the call's line and moving nothing (NC113): an inclined contour
-  (STA1 not 0: the sense in which the angle turns the groove is not documented in the seeds),
-  flank angles ANG1/ANG2 (whether WIDG is the width at the base or on the contour is not
-  documented in the seeds), MCALL;
+  (STA1 not 0: the manual [GK] turns the groove with the contour, but the tool does not turn;
+  whether DIAG is then square to the contour or paraxial, and which cutting edge finishes a
+  sloping base, are not documented), MCALL;
 - a groove or clearance that would take the path across the turning axis (X below 0) alarms
   (NC114).
 """
@@ -81,31 +92,113 @@ def variant(vari: float) -> tuple[bool, bool, bool, bool]:
     return row.face, row.inside, row.right, tens == 1
 
 
-def _leg(value: float, chr_: bool) -> tuple[str, float]:
-    """A corner value -> (kind, how far it reaches along each side of the corner)."""
+BIG = 1e6                                       # the far end of a profile line (the corner geometry's reach)
+
+
+class _Side:
+    """One side of the finished groove in local coordinates (u along the contour from the starting
+    point's edge, w the depth into the part): the contour, the flank and the base as lines, and
+    the top (RCO) and base (RCI) corner elements between them (nctrans.interp.corners: a rounding
+    tangent to both lines, or a chamfer with equal legs)."""
+
+    def __init__(self, top: tuple[float, float], bottom: tuple[float, float], outward: float,
+                 rco: float, rci: float, chr_: bool):
+        from nctrans.interp import corners
+        self.top, self.bottom = top, bottom
+        contour = corners.Element("linear", (top[0] + outward * BIG, 0.0), top)
+        flank = corners.Element("linear", top, bottom)
+        base = corners.Element("linear", bottom, (bottom[0] - outward * BIG, bottom[1]))
+        self.o = _corner(contour, flank, rco, chr_)
+        self.i = _corner(flank, base, rci, chr_)
+
+    def flank_used(self) -> float:
+        """How much of the flank the two corner elements take."""
+        return sum(math.dist(c, p) for c, p in ((self.top, self.o.second_start if self.o else self.top),
+                                                 (self.bottom, self.i.first_end if self.i else self.bottom)))
+
+    def base_end(self) -> float:
+        """u where the flat base begins on this side (the base corner's tangent point)."""
+        return self.i.second_start[0] if self.i else self.bottom[0]
+
+    def floor(self, u: float) -> Optional[float]:
+        """The depth of the finished base corner at u, where u lies under it; else None."""
+        c = self.i
+        if c is None:
+            return None
+        (u0, w0), (u1, w1) = c.first_end, c.second_start
+        if not min(u0, u1) - EPS <= u <= max(u0, u1) + EPS:
+            return None
+        if c.kind == "arc":
+            r = math.dist(c.center, c.first_end)
+            return c.center[1] + math.sqrt(max(r * r - (u - c.center[0]) ** 2, 0.0))
+        return w0 + (w1 - w0) * (u - u0) / (u1 - u0) if abs(u1 - u0) > EPS else max(w0, w1)
+
+
+def _corner(first, second, value: float, chr_: bool):
+    """The corner element RCO/RCI asks for between two profile lines: > 0 a rounding of that
+    radius, < 0 a chamfer (tens digit of VARI: 0 its length CHF, 1 its legs CHR); None for 0."""
+    from nctrans.interp import corners
     if abs(value) <= EPS:
-        return "none", 0.0
+        return None
     if value > 0:
-        return "radius", value
-    return "chamfer", -value if chr_ else -value / math.sqrt(2.0)
+        c, _ = corners.rounding(first, second, value)
+    elif chr_:
+        c, _ = corners.chamfer_legs(first, second, -value)
+    else:
+        c, _ = corners.chamfer_length(first, second, -value)
+    if c is None:
+        raise impossible(f"with a radius or chamfer {value:g} that does not fit the groove")
+    return c
 
 
 class _Outline:
     """The finished groove in local coordinates: u along the contour from the starting point's
-    edge (0) to the other edge (W), w the depth into the part (0 on the contour, D at the base)."""
+    edge (0) towards the other edge, w the depth into the part (0 on the contour, D at the base).
+    [GK] WIDG is the width at the base, the flanks open outwards by ANG1 (starting point's side)
+    and ANG2 from the normal of the contour, so the groove is WIDG + DIAG (tan ANG1 + tan ANG2)
+    wide on the contour; the starting point is the edge where flank 1 meets the contour."""
 
-    def __init__(self, width: float, depth: float, o1, o2, i1, i2):
+    def __init__(self, width: float, depth: float, ang1: float, ang2: float, rco1: float, rco2: float,
+                 rci1: float, rci2: float, chr_: bool):
         self.W, self.D = width, depth
-        self.o1, self.o2, self.i1, self.i2 = o1, o2, i1, i2
+        self.t1, self.t2 = math.tan(math.radians(ang1)), math.tan(math.radians(ang2))
+        self.c1, self.c2 = math.cos(math.radians(ang1)), math.cos(math.radians(ang2))
+        self.b1 = depth * self.t1                   # base corner on the starting point's side
+        self.b2 = self.b1 + width                   # ... on the other side
+        self.top2 = self.b2 + depth * self.t2       # the other edge on the contour
+        self.s1 = _Side((0.0, 0.0), (self.b1, depth), -1.0, rco1, rci1, chr_)
+        self.s2 = _Side((self.top2, 0.0), (self.b2, depth), 1.0, rco2, rci2, chr_)
 
     def floor(self, u: float) -> float:
-        """The depth of the finished base at u (less where a base corner is rounded or chamfered)."""
-        for (kind, leg), v in ((self.i1, u), (self.i2, self.W - u)):
-            if kind != "none" and v < leg:
-                if kind == "radius":
-                    return self.D - leg + math.sqrt(max(leg * leg - (leg - v) ** 2, 0.0))
-                return self.D - leg + v
-        return self.D
+        """The depth of the finished groove at u (less on a flank or a rounded or chamfered base
+        corner); 0 outside the groove's opening."""
+        w = self.D
+        if self.t1 > EPS:
+            w = min(w, u / self.t1)
+        elif u < -EPS:
+            return 0.0
+        if self.t2 > EPS:
+            w = min(w, (self.top2 - u) / self.t2)
+        elif u > self.top2 + EPS:
+            return 0.0
+        for side in (self.s1, self.s2):
+            f = side.floor(u)
+            if f is not None:
+                w = min(w, f)
+        return max(w, 0.0)
+
+    def rough_floor(self, u: float, fal1: float, fal2: float) -> float:
+        """The deepest a roughing plunge may reach at u: the finished floor less FAL1, and FAL2
+        off each flank (measured square to the flank)."""
+        w = self.floor(u) - fal1
+        lo, hi = fal2 / self.c1, self.top2 - fal2 / self.c2
+        if u < lo - EPS or u > hi + EPS:
+            return 0.0
+        if self.t1 > EPS:
+            w = min(w, (u - lo) / self.t1)
+        if self.t2 > EPS:
+            w = min(w, (hi - u) / self.t2)
+        return w
 
 
 def groove_steps(p: dict[str, float], tool_width: float) -> list[Step]:
@@ -131,14 +224,15 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
             raise impossible(f"with {k} not a finite number")
     face, inside, right, chr_ = variant(p.get("VARI", 0.0))
     if abs(p.get("STA1", 0.0)) > EPS:
-        raise unmodelled(f"on an inclined contour (STA1 {p['STA1']:g}): not modelled (the sense in which the "
-                         "angle turns the groove is not documented in the seeds); nctrans models grooves in a "
-                         "contour parallel (longitudinal) or square (face) to the axis, STA1 0")
-    for name in ("ANG1", "ANG2"):
-        if abs(p.get(name, 0.0)) > EPS:
-            raise unmodelled(f"with flank angle {name} {p[name]:g}: not modelled (whether WIDG is the width at "
-                             "the base or on the contour is not documented in the seeds); nctrans models "
-                             "flanks square to the contour")
+        raise unmodelled(f"on an inclined contour (STA1 {p['STA1']:g}): not modelled (the seeds do not "
+                         "document CYCLE93; the manual [GK] turns the groove with the contour but the tool "
+                         "does not turn: whether DIAG is then square to the contour or paraxial, and which "
+                         "cutting edge finishes a sloping base, is not documented); nctrans models grooves in "
+                         "a contour parallel (longitudinal) or square (face) to the axis, STA1 0")
+    ang1, ang2 = p.get("ANG1", 0.0), p.get("ANG2", 0.0)
+    for name, a in (("ANG1", ang1), ("ANG2", ang2)):
+        if not 0.0 <= a < 90.0 - 1e-3 + EPS:
+            raise impossible(f"with flank angle {name} {a:g} (0 <= {name} < 89.999 degrees [GK])")
     W, D = abs(p.get("WIDG", 0.0)), abs(p.get("DIAG", 0.0))
     if W <= EPS or D <= EPS:
         raise impossible("without a groove width WIDG or depth DIAG")
@@ -148,24 +242,27 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
     fal1, fal2 = abs(p.get("FAL1", 0.0)), abs(p.get("FAL2", 0.0))
     idep, dtb = abs(p.get("IDEP", 0.0)), max(p.get("DTB", 0.0), 0.0)
     vrt = abs(p.get("VRT", 0.0)) or 1.0
-    o1, o2 = _leg(p.get("RCO1", 0.0), chr_), _leg(p.get("RCO2", 0.0), chr_)
-    i1, i2 = _leg(p.get("RCI1", 0.0), chr_), _leg(p.get("RCI2", 0.0), chr_)
-    if o1[1] + i1[1] > D + EPS or o2[1] + i2[1] > D + EPS or i1[1] + i2[1] > W + EPS:
+    groove = _Outline(W, D, ang1, ang2, p.get("RCO1", 0.0), p.get("RCO2", 0.0), p.get("RCI1", 0.0),
+                      p.get("RCI2", 0.0), chr_)
+    s1, s2 = groove.s1, groove.s2
+    base1, base2 = s1.base_end(), s2.base_end()    # the flat base runs from base1 to base2
+    if (s1.flank_used() > D / groove.c1 + EPS or s2.flank_used() > D / groove.c2 + EPS
+            or base2 < base1 - EPS):
         raise impossible("with radii or chamfers larger than the groove's flanks or base")
-    if tw > W - i1[1] - i2[1] + EPS:
+    if tw > base2 - base1 + EPS:
         raise impossible(f"with a tool {tw:g} wide for a groove whose flat base is "
-                         f"{W - i1[1] - i2[1]:g} wide (the control stops with a tool width alarm)")
-    if tw > W - 2 * fal2 + EPS or fal1 >= D - EPS:
+                         f"{base2 - base1:g} wide (the control stops with a tool width alarm)")
+    if tw > W - fal2 / groove.c1 - fal2 / groove.c2 + EPS or fal1 >= D - EPS:
         raise impossible(f"with a tool {tw:g} wide, or allowances FAL1/FAL2, that leave nothing to rough "
                          "(the control stops with an alarm)")
-    groove = _Outline(W, D, o1, o2, i1, i2)
     s = 1.0 if not right else -1.0                 # the groove lies towards +Z of SPL when the starting point is left
     e = -1.0 if inside else 1.0                    # ... towards the axis (-X) of SPD when it is outside
     r0, spl = p.get("SPD", 0.0), p.get("SPL", 0.0)
     # (u, w) -> (X radius, Z): longitudinal grooves run along Z (u) and go into X (w); face grooves
     # run along X (u) and go into Z (w)
     u_dir, w_dir = ((-e, 0.0), (0.0, s)) if face else ((0.0, s), (-e, 0.0))
-    reach = D if not face else W + o2[1]
+    o2_reach = s2.o.first_end[0] if s2.o else groove.top2
+    reach = D if not face else o2_reach
     if not inside and reach > r0 + EPS:
         raise impossible(f"with a groove reaching {reach:g} towards the axis from a radius of {r0:g} (past the axis)")
 
@@ -186,15 +283,17 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
         cross = (a[1] - c[1]) * (b[0] - c[0]) - (a[0] - c[0]) * (b[1] - c[1])
         steps.append(("arc", b, c, cross < 0))
 
-    # roughing: plunges from the starting point's side across
-    lo, hi = fal2, W - fal2 - tw
+    # roughing: plunges from the starting point's side across the groove's opening; each goes as
+    # deep as the tool's whole width may (the rough floor is concave: its least over the tool's
+    # width is at one of the tool's ends)
+    lo, hi = fal2 / groove.c1, groove.top2 - fal2 / groove.c2 - tw
     n = max(0, math.ceil((hi - lo) / tw - 1e-9)) if hi > lo + EPS else 0
     if n > MAX_PASSES:
         raise impossible(f"with more than {MAX_PASSES} plunges")
     go("rapid", 0.0, -vrt)
     for k in range(n + 1):
         a = lo + (hi - lo) * k / n if n else lo
-        depth = min(groove.floor(a), groove.floor(a + tw)) - fal1
+        depth = min(groove.rough_floor(a, fal1, fal2), groove.rough_floor(a + tw, fal1, fal2))
         if depth <= EPS:
             continue
         m = max(1, math.ceil(depth / idep - 1e-9)) if idep > EPS else 1
@@ -211,40 +310,39 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
         go("rapid", a, -vrt)
 
     roughing, steps = steps, []
-    # finishing: the first edge down the starting point's flank to the middle of the base
-    u1 = min(W / 2, W - i2[1] - tw)                # the tool stays off the other base corner
-    go("rapid", -o1[1], -vrt)
-    go("linear", -o1[1], 0.0)
-    if o1[0] == "radius":
-        arc(0.0, o1[1], (-o1[1], o1[1]), (-o1[1], 0.0))
-    elif o1[0] == "chamfer":
-        go("linear", 0.0, o1[1])
-    go("linear", 0.0, D - i1[1])
-    if i1[0] == "radius":
-        arc(i1[1], D, (i1[1], D - i1[1]), (0.0, D - i1[1]))
-    elif i1[0] == "chamfer":
-        go("linear", i1[1], D)
-    if u1 > i1[1] + EPS:
-        go("linear", u1, D)
-    here = max(u1, i1[1])
-    go("rapid", here, -vrt)
-    # the second edge (tw ahead of the first) down the other flank to the middle
-    u2 = max(W / 2, i1[1] + tw)
-    go("rapid", W + o2[1] - tw, -vrt)
-    go("linear", W + o2[1] - tw, 0.0)
-    if o2[0] == "radius":
-        arc(W - tw, o2[1], (W + o2[1] - tw, o2[1]), (W + o2[1] - tw, 0.0))
-    elif o2[0] == "chamfer":
-        go("linear", W - tw, o2[1])
-    go("linear", W - tw, D - i2[1])
-    if i2[0] == "radius":
-        arc(W - i2[1] - tw, D, (W - i2[1] - tw, D - i2[1]), (W - tw, D - i2[1]))
-    elif i2[0] == "chamfer":
-        go("linear", W - i2[1] - tw, D)
-    if u2 < W - i2[1] - EPS:
-        go("linear", u2 - tw, D)
-    here = min(u2, W - i2[1]) - tw
-    go("rapid", here, -vrt)
+
+    def profile(side: _Side, shift: float, end_u: float, sense: float) -> None:
+        """Finish one side with one edge (the first edge's path is the edge's point less `shift`
+        along u): from the contour over the top corner, down the flank, over the base corner and
+        along the base (in the sense `sense` of u) to `end_u`, then out."""
+        def element(c) -> None:
+            if c.kind == "arc":
+                arc(c.second_start[0] - shift, c.second_start[1], (c.center[0] - shift, c.center[1]),
+                    (c.first_end[0] - shift, c.first_end[1]))
+            else:
+                go("linear", c.second_start[0] - shift, c.second_start[1])
+        o, i = side.o, side.i
+        u0 = o.first_end[0] if o else side.top[0]
+        go("rapid", u0 - shift, -vrt)
+        go("linear", u0 - shift, 0.0)
+        if o:
+            element(o)
+        flank_end = i.first_end if i else side.bottom
+        go("linear", flank_end[0] - shift, flank_end[1])
+        if i:
+            element(i)
+        here = side.base_end()
+        if (end_u - here) * sense > EPS:
+            go("linear", end_u - shift, D)
+            here = end_u
+        go("rapid", here - shift, -vrt)
+
+    # finishing: the first edge down the starting point's flank to the middle of the base (it
+    # stays off the other base corner), then the second edge (tw ahead of the first) down the
+    # other flank to the middle
+    middle = (groove.b1 + groove.b2) / 2
+    profile(s1, 0.0, min(middle, base2 - tw), 1.0)
+    profile(s2, tw, max(middle, base1 + tw), -1.0)
     go("rapid", 0.0, -vrt)
     if any(st[0] != "dwell" and st[1][0] < -EPS for st in roughing + steps):
         raise impossible(f"with a path that crosses the turning axis (X below 0): the groove or its "
