@@ -386,6 +386,27 @@ class Emitter(Spelling):
         """How NC402 names a node the dialect has no spelling for."""
         return f"the statement {type(node).__name__}"
 
+    def polar_words_check(self, s: n.Motion) -> None:
+        """Polar end points mean what the reading control's table says (nctrans.interp.polar_words):
+        a left-out angle or radius is the value last programmed or the current point's (option
+        `polar_memory`), and under incremental distance the words are increments or not (option
+        `polar_incremental`). Where the source's and this target's differ the words are written
+        only where they say the same point: both given, under absolute distance."""
+        from nctrans.rules import option
+
+        def semantics(dialect):
+            return (option(dialect, "polar_memory") or "position",
+                    option(dialect, "polar_incremental") or "never")
+        if not s.polar:
+            return
+        source, target = semantics(self.program.dialect), semantics(self.table_name)
+        if source[0] != target[0] and not {"angle", "radius"} <= set(s.polar):
+            raise NotExpressible("a polar end point with its angle or radius left out (the source "
+                                 "control takes the value it stored, this one reads another)")
+        if source[1] != target[1] and self.distance != "absolute":
+            raise NotExpressible("polar words under incremental distance (the two controls read "
+                                 "them differently)")
+
     # -------------------------------------------------------------- position and frame
     def forget(self) -> None:
         """A place reached from elsewhere (jump target, structure, call): positions and the

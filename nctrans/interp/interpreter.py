@@ -159,6 +159,9 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.cycle_initial: Optional[float] = None
         self.modal_cycle = None         # CycleCall with modal=True
         self.pole: Optional[tuple[float, float]] = None   # polar pole in the plane (program coords)
+        self.pole_set = False           # a pole was programmed (polar_words.py)
+        self.pole_refused: Optional[int] = None            # line of a pole that was refused (NC118)
+        self.polar_stored: Optional[tuple[float, float]] = None   # programmed (angle, radius)
         self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
         self.corner = None              # corner_elements.CornerStage while RND/CHF ... is in play
         self.contour_offset = 0.0       # Sinumerik OFFN (contour_offset.py)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Optional
 
-from nctrans.interp import arcs, corner_elements, polar_input, rigid_tap, thread_starts
+from nctrans.interp import arcs, corner_elements, polar_input, polar_words, rigid_tap, thread_starts
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
@@ -72,15 +72,7 @@ class MotionMixin:
         center = self._words(s.center)
         radius = None if s.radius is None else self.ev.compile(s.radius)
         turns = None if s.turns is None else self.ev.compile(s.turns)
-        polar = None
-        if s.polar:
-            polar = {}
-            for k, v in s.polar.items():
-                # AP=IC(..): the angle from the last polar angle; AP=AC(..) as a plain AP
-                if (k == "angle" and type(v) is n.Func and v.name.upper() in ("IC", "AC")
-                        and len(v.args) == 1):
-                    k, v = ("angle_inc" if v.name.upper() == "IC" else "angle"), v.args[0]
-                polar[k] = self.ev.compile(v)
+        polar = polar_words.compile_words(self, s.polar) if s.polar else None
         via = self._words(s.via)
         ap = getattr(s, "aperture", None)
         aperture = None if ap is None else self.ev.compile(ap)
@@ -164,7 +156,9 @@ class MotionMixin:
         vals = self._eval_words(words)
         self._polar_arc = bool(polar)
         if polar:
-            vals = self._polar(vals, polar)
+            vals = polar_words.end_point(self, vals, polar)
+            if vals is None:
+                return
         elif st.polar:
             vals = polar_input.cartesian(self, vals, machine)
             if vals is None:
@@ -303,53 +297,8 @@ class MotionMixin:
             self._lead_is_feed = v
         return v
 
-    def _polar(self, vals, polar):
-        """Polar words (radius, angle in the active plane about the pole: program zero until
-        G110/G111/G112 sets one). A word left out keeps its value from the current point, and
-        AP=IC(..) adds to that angle (the last polar angle, [GK] Siemens Fundamentals)."""
-        a1, a2, _ = PLANE_AXES[self.st.plane]
-        r = self._value(polar["radius"], "polar radius") if "radius" in polar else None
-        ang = self._value(polar["angle"], "polar angle") if "angle" in polar else None
-        inc = self._value(polar["angle_inc"], "polar angle") if "angle_inc" in polar else None
-        if r is None and ang is None and inc is None:
-            return vals
-        c1, c2 = self.pole or (0.0, 0.0)
-        p1, p2 = self.pos.get(a1, 0.0) - c1, self.pos.get(a2, 0.0) - c2
-        if r is None:
-            r = math.hypot(p1, p2)
-        else:
-            r *= self.st.scale
-        if ang is None:
-            # the last polar angle: where the tool is, seen from the pole
-            ang = math.degrees(math.atan2(p2, p1)) + (inc or 0.0)
-        rest = [w for w in vals if w[0] not in (a1, a2)]
-        return rest + [(a1, c1 + r * math.cos(math.radians(ang)), "abs"),
-                       (a2, c2 + r * math.sin(math.radians(ang)), "abs")]
-
     def _h_pole(self, s: n.PolarPole) -> None:
-        """G110/G111/G112: the pole relative to the last programmed point, the workpiece zero or
-        the last pole, whatever G90/G91 (spec 9.2); given by plane axis words or by polar words
-        about that point. Nothing moves."""
-        a1, a2, _ = PLANE_AXES[self.st.plane]
-        if s.relative_to == "last_point":
-            ref = (self.pos.get(a1, 0.0), self.pos.get(a2, 0.0))
-        elif s.relative_to == "pole":
-            ref = self.pole or (0.0, 0.0)
-        else:
-            ref = (0.0, 0.0)
-        if s.polar:
-            polar = {k: self.ev.compile(v) for k, v in s.polar.items()}
-            r = self._value(polar["radius"], "pole radius") if "radius" in polar else None
-            ang = self._value(polar["angle"], "pole angle") if "angle" in polar else None
-            r = (r or 0.0) * self.st.scale
-            ang = math.radians(ang or 0.0)
-            self.pole = (ref[0] + r * math.cos(ang), ref[1] + r * math.sin(ang))
-            return
-        d = {a1: 0.0, a2: 0.0}
-        for axis, v, _ in self._eval_words(self._words(s.target)):
-            if axis in d:
-                d[axis] = v
-        self.pole = (ref[0] + d[a1], ref[1] + d[a2])
+        polar_words.set_pole(self, s)
 
     def _machine_move(self, vals) -> None:
         """G53: the words are machine coordinates of the controlled point, this block only."""

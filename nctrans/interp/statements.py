@@ -6,7 +6,7 @@ A mixin of Interpreter. Spindle speed limits (SpindleLimit) are handled in lathe
 """
 from __future__ import annotations
 
-from nctrans.interp import computed_g, contour_offset, corner_elements, indirect_g, rigid_tap, spindle_position, unmodelled
+from nctrans.interp import computed_g, contour_offset, corner_elements, indirect_g, polar_words, rigid_tap, spindle_position, unmodelled
 from nctrans.interp.evaluate import constant
 from nctrans.interp.offsets import NORMAL
 from nctrans.interp.travel_limits import ProgrammedLimits
@@ -89,6 +89,8 @@ class StatementsMixin:
         elif g == "units":
             st.set(g, v)
         elif g == "plane":
+            if v != st.plane:
+                polar_words.plane_changed(self)
             st.set(g, v)
         elif g == "spindle_mode":
             st.set(g, v)

@@ -762,6 +762,7 @@ class FagorEmitter(FagorSpelling, Emitter):
         if s.polar:
             if self.distance != "absolute":
                 raise NotExpressible("polar coordinates in incremental mode")
+            self.polar_words_check(s)
             if getattr(self, "pole_unwritten", False):
                 raise NotExpressible("polar coordinates about a pole that was written as plain motion "
                                      "(Fagor's polar origin is not there)")

@@ -15,7 +15,8 @@ How Fagor meets the IR (spec §20.2):
   to labels generated after / at the end of the loop; `$DO .. $ENDDO c` is a RepeatUntil(not c).
 - D<n> selects offset n of the active tool: tool length compensation on (ModeChange tool_length),
   radius from offset n; D0 cancels both; M06 implies D1 (spec §8.9, §12.3). There is no G43/G44.
-- What changes the path but is not modelled (G30 polar origin, G36-G39, mirror G14 by axis, canned
+- Polar R/Q about the G30 origin are modelled (interp/polar_words.py, incremental under G91).
+- What changes the path but is not modelled (G36-G39, mirror G14 by axis, canned
   cycles whose parameters the programming manual does not define, #CS, #RTCP ...) is kept verbatim
   as Passthrough with NC415/NC416 at its line: never silently skipped.
 """
@@ -617,8 +618,6 @@ class Lowerer:
                 polar["radius"] = vals.pop("R")
             if "Q" in vals:
                 polar["angle"] = vals.pop("Q")
-            self.once("polar", "NC415", "info", "polar coordinates are analysed about the work zero in "
-                      "absolute terms (no G30 origin, no incremental R/Q)")
         if arc_once == "three_point":
             via = {a: ir.AxisValue(vals.pop(k)) for k, a in zip("IJK", "XYZ") if k in vals}
             out.append((B_MOTION - 1, ir.ModeChange("motion", "arc_3point", "G09")))

@@ -660,6 +660,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         if m.aperture is not None:
             ws.append(f"AR={self.expr(m.aperture)}")
         if m.polar:
+            self.polar_words_check(m)
             if "angle" in m.polar:
                 ws.append(f"AP={self.expr(m.polar['angle'])}")
             if "radius" in m.polar:
