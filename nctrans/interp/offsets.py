@@ -12,7 +12,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any, Optional
 
-from nctrans.interp import polar_input
+from nctrans.interp import episode_frame, polar_input
 from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
 from nctrans.interp.frames import PLANE_AXES, ProgrammableFrame, rpy_ordered
 from nctrans.interp.state import LINEAR_AXES
@@ -328,6 +328,7 @@ class OffsetsMixin:
                 for a, v in piv.items():
                     axes.setdefault(a, v)
                 fr.set_mirror(axes)
+        episode_frame.frame_changed_under_comp(self)
         self._resync()
 
     def _set_pframe(self, value: Any) -> None:

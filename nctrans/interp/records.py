@@ -8,7 +8,7 @@ A mixin of Interpreter.
 """
 from __future__ import annotations
 
-from nctrans.interp import corner_elements
+from nctrans.interp import corner_elements, episode_frame
 from nctrans.interp.cutter_comp import PlannedMove
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.toolpath import ToolpathRecord
@@ -90,7 +90,8 @@ class RecordsMixin:
     def _machine_at(self, p: dict[str, float], total: dict[str, float]) -> dict[str, float]:
         """The machine point of program point `p` under the offsets `total` (work offset, G92, tool
         length: those in force when a move held by cutter compensation was programmed)."""
-        w = p if self.frame.identity else self.frame.to_work(p)
+        fr = episode_frame.frame(self)
+        w = p if fr.identity else fr.to_work(p)
         return {a: v + total.get(a, 0.0) for a, v in w.items()}
 
     def _finish_move(self, kind, start, end, center, cw, turns, payload, start_given=False) -> None:
@@ -121,7 +122,8 @@ class RecordsMixin:
             mc = {a1: mfull[a1], a2: mfull[a2], an: mfull[an]}
             rec.center = mc
             rec.plane = plane
-            rec.direction = ("cw" if cw else "ccw") if not self.frame.mirror_swap else (
+            swap = (episode_frame.frame(self) if start_given else self.frame).mirror_swap
+            rec.direction = ("cw" if cw else "ccw") if not swap else (
                 "ccw" if cw else "cw")
             rec.turns = turns
         self.mpos = mend
@@ -142,8 +144,18 @@ class RecordsMixin:
         payload = payload or self._payload()
         if self.comp is None and not self.comp_exit:
             self.comp_total = payload[7]            # the episode's offsets
+            episode_frame.snapshot(self)            # and its frame
         total = self.comp_total if self.comp_total is not None else payload[7]
-        if payload[7] is not total and payload[7] != total:
+        if self.comp is not None and episode_frame.changed(self):   # a frame change: episode_frame.py
+            a1, a2, an = PLANE_AXES[self.st.plane]
+            start = episode_frame.to_episode(self, start, total, payload[7])
+            if center is not None:
+                c = episode_frame.to_episode(self, {a1: center[0], a2: center[1], an: end.get(an, 0.0)},
+                                             total, payload[7])
+                center = (c[a1], c[a2])
+            end = episode_frame.to_episode(self, end, total, payload[7])
+            payload = payload[:7] + (total,)
+        elif payload[7] is not total and payload[7] != total:
             shift = self._program_shift(total, payload[7])
             start, end = _minus(start, shift), _minus(end, shift)
             if center is not None:
