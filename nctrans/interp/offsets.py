@@ -14,7 +14,7 @@ from typing import Any, Optional
 
 from nctrans.interp import episode_frame, polar_input
 from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
-from nctrans.interp.frames import PLANE_AXES, ProgrammableFrame, rpy_ordered
+from nctrans.interp.frames import IDENT, PLANE_AXES, ProgrammableFrame, rpy_ordered
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
 
@@ -30,6 +30,12 @@ def copy_frame(src: ProgrammableFrame, dst: Optional[ProgrammableFrame] = None) 
         v = getattr(src, slot)
         setattr(dst, slot, dict(v) if type(v) is dict else v)
     return dst
+
+
+def _turns_off_zero(fr: ProgrammableFrame) -> bool:
+    """A rotation in force whose centre is not the work zero (its affine part shifts)."""
+    return any(part is not None and part[0] != IDENT and any(abs(t) > 1e-12 for t in part[1])
+               for part in (fr.rot, fr.extra))
 
 
 @lru_cache(maxsize=None)
@@ -310,6 +316,12 @@ class OffsetsMixin:
                 f = {a.upper(): num(e, f"{a} scale", False) for a, e in s.values.items()}
                 fr.set_scale({a: v for a, v in f.items() if v is not None}, center())
         elif op == "mirror":
+            if fr.mirror_first and _turns_off_zero(fr):
+                self.diag("NC216", "warning", "a mirror programmed (or cancelled) while a coordinate "
+                          "rotation about a centre other than the work zero is in force: the manual "
+                          "mirrors the centre by the mirrors active at the rotation (L10157-10160) and "
+                          "does not say whether a later mirror moves it; the analysed toolpath keeps the "
+                          "centre where the rotation put it (program the mirror before the rotation)")
             if (fr.rot is not None or fr.scale is not None) and mirror_refused_under_scale_or_rotation(
                     self.program.dialect):
                 on = "scaling" if fr.rot is None else "coordinate rotation" if fr.scale is None else \

@@ -64,7 +64,7 @@ STRUCTURE = (n.If, n.While, n.ForLoop, n.Loop, n.RepeatUntil, n.Case)
 # Diagnostics saying a construct was skipped and moved nothing (NC103 not modelled; NC224/NC225 a
 # milling cycle that cannot run here; NC219 a corner element the control inserts in a way not
 # modelled): output lowered from that run would lack its motion.
-UNMODELLED_RULES = ("NC103", "NC224", "NC225", "NC219", "NC117", "NC118", "NC119")
+UNMODELLED_RULES = ("NC103", "NC224", "NC225", "NC219", "NC117", "NC118", "NC119", "NC216")
 
 _M_FUNCTION = re.compile(r"^\s*(?:M\d+(?:\.\d+)?(?:\s*=\s*\d+)?\s*)+$", re.IGNORECASE)
 
