@@ -51,11 +51,12 @@ def test_a_jump_into_a_lowered_stretch_keeps_its_label(tmp_path):
 def test_a_lowered_stretch_holding_an_unmodelled_mode_is_refused(tmp_path):
     # G16 (polar coordinates): lowering line 2 alone to plain motion wrote the polar X10 Y90 as a
     # Cartesian point. G16 is modelled now and its stretch (to G15) is lowered whole: radius 10 at
-    # 90 degrees is (0, 10), written `G0 Y10` (X stays 0). A block under it that the seed leaves open (G91 with the angle only,
-    # NC117) moves nothing in the run, so the stretch is refused at G16's line
+    # 90 degrees is (0, 10), written `G0 Y10` (X stays 0). A block under it that the seed leaves
+    # open (a circle with polar words, NC117) moves nothing in the run, so the stretch is refused
+    # at G16's line
     out = convert(tmp_path, "G0 X0 Y0\nG16\nG0 X10 Y90\nG15\nM30\n", "iso-m", "sinumerik")
     assert out.returncode == 0 and "G0 Y10" in out.stdout and "Y90" not in out.stdout, out.stdout
-    text = "G0 X0 Y0\nG16\nG91 G0 Y90\nG15\nM30\n"
+    text = "G0 X0 Y0\nG16\nG2 X10 Y90 R10 F100\nG15\nM30\n"
     out = convert(tmp_path, text, "iso-m", "sinumerik")
     # refused at G16's line: an error, or refused in place (the output alarms there, NC412)
     assert (out.returncode == 1 and ":2:1: error[NC402]" in out.stderr) or (

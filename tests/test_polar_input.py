@@ -77,9 +77,33 @@ def test_incremental_pole_is_the_current_position():
     assert said == [] and ends(recs)[1:] == [(3, 10.0, 5.0), (4, 5.0, 5.0)]
 
 
+def test_incremental_angle_alone_turns_about_the_zero():
+    # the bolt circle: no radius word, so the pole is the workpiece zero (seed N20's comment) and
+    # the radius the current distance, 10; G91 Y30 adds 30 deg to the angle 0 programmed last (the
+    # current point's too): (10 cos 30, 10 sin 30) = (8.660, 5); again: 60 deg (5, 8.660)
+    recs, said = run("G17 G90 G0 X0 Y0\nG16 X10. Y0.\nG91 Y30.\nY30.\nG90 G15\nM30\n")
+    assert said == []
+    assert ends(recs)[1:] == [(2, 10.0, 0.0), (3, 8.66, 5.0), (4, 5.0, 8.66)]
+
+
+@pytest.mark.parametrize("text, line", [
+    # G91 radius, no angle: no angle about the new pole
+    ("G17 G90 G0 X0 Y0\nG16 X10. Y0.\nG91 X5.\nG90 G15\nM30\n", 3),
+    # after a move about the current point (10, 0) -> (10, 5): its angle about the zero (26.57 deg)
+    # is not the 90 deg programmed last: which one G91 Y30 adds to, the seed does not say
+    ("G17 G90 G0 X0 Y0\nG16 X10. Y0.\nG91 X5. Y90.\nY30.\nG90 G15\nM30\n", 4),
+    # the first polar block: no angle programmed yet
+    ("G17 G90 G0 X10 Y0\nG16\nG91 Y30.\nG90 G15\nM30\n", 3),
+    # a Cartesian move since the last polar angle: X keeps (10, 0)'s angle 0 or the point (0, 10)'s?
+    ("G17 G90 G0 X0 Y0\nG16 X10. Y0.\nG15\nX0 Y10.\nG16\nX5.\nG15\nM30\n", 6),
+])
+def test_a_kept_or_added_angle_the_seed_leaves_open_is_refused(text, line):
+    recs, said = run(text)
+    assert said == [(line, "NC117")]
+    assert line not in [r.line for r in recs]
+
+
 @pytest.mark.parametrize("block", [
-    "G91 Y30.",                         # G91 with the angle only: no radius rule
-    "G91 X5.",                          # G91 with the radius only: no angle reference
     "G2 X10. Y90. R10.",                # a circle with polar words
     "G81 X10. Y90. Z-5. R2. F100",      # a cycle position: alarm 61814 unless _ZSFI[3] = 1
     "G92 X0 Y0",                        # a dimension word that is no motion

@@ -121,9 +121,9 @@ def test_diameter_programming_is_no_effect_on_a_mill_only():
 
 
 def test_iso_unmodelled_modes_and_thread_are_reported():
-    recs, diags = run("G0 X1\nG34 X10 K1 F1\nX20\nG16\nG1 X5 F100\nM30\n", "iso-m")
-    # G34 X10 and X20 move nothing; G1 X5 starts from X1; G16 is modelled (polar_input.py): X5
-    # is radius 5 at the current angle 0 about the zero, (5, 0)
+    recs, diags = run("G0 X1\nG34 X10 K1 F1\nX20\nG16\nG1 X5 Y0 F100\nM30\n", "iso-m")
+    # G34 X10 and X20 move nothing; G1 X5 starts from X1; G16 is modelled (polar_input.py): X5 Y0
+    # is radius 5 at 0 deg about the zero, (5, 0)
     assert [(r.line, r.end["X"]) for r in moves(recs)] == [(1, 1.0), (5, 5.0)]
     msgs = {}
     for d in nc220(diags):

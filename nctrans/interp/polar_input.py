@@ -5,16 +5,22 @@ Why a module of its own: the mode rereads every dimension word of a block, so th
 set-position, frame and home-return handlers all ask it first.
 
 What the seed defines, and so what is modelled:
-- G90 in the block: the pole is the workpiece zero (L3723). A radius left out is the current
-  distance from the pole (L3730, the example's N20: sqrt(170.711^2 + 70.711^2) = 184.776); an
-  angle left out is the current angle about the pole (the same rule for the other word).
-- G91 with both words: the pole is the current position (L3724); the radius is absolute (L3747)
-  and the angle is measured from the plane's first axis: the example's N15 `G91 X100 Y0` from
-  (70.711, 70.711) ends at (170.711, 70.711), not 45 degrees on.
+- The pole: with the radius under G90, the workpiece zero (L3723); with the radius under G91, the
+  current position (L3724); with no radius word, the workpiece zero (the example's N20 comment: "No X
+  in block, pole is at workpiece zero"), and the radius is then the current distance from it (L3730:
+  sqrt(170.711^2 + 70.711^2) = 184.776).
+- The radius is absolute (L3747): the distance from the pole.
+- The angle follows G90/G91 (L3747). With the pole at the current point it is measured from the
+  first axis (the example's N15 `G91 X100 Y0` from (70.711, 70.711) ends at (170.711, 70.711), not
+  on at 45 degrees). About the zero, an angle left out (G90) or added to (G91: `G91 Y30` alone, the
+  bolt circle) is the current point's angle, where that is the angle last programmed about the zero.
 - Words of other axes (the plane's third axis) are Cartesian as always.
 
 What it does not define, and so is refused at its line (NC117, the block moves nothing):
-- G91 with only the radius or only the angle (no reference for the angle, or a zero radius);
+- G91 with a radius and no angle (no angle about the new pole);
+- an angle left out or added to about the zero where the current point's angle is not the one last
+  programmed (after a Cartesian move, a move about another pole, or as the first polar block):
+  keeping one or the other is not the seed's to say;
 - a circle (G2/G3) with a polar end point (the seed gives no centre rule);
 - a canned cycle position under G16: alarm 61814 unless the setting `_ZSFI[3]` is 1 (L2427,
   L6385), and the seed does not say how the cycle reads it then;
@@ -60,15 +66,14 @@ def cartesian(interp, vals: list, machine: bool = False) -> Optional[list]:
     st = interp.st
     a1, a2, _ = PLANE_AXES[st.plane]
     radius = angle = None
-    inc = st.incremental
+    inc_radius = inc_angle = st.incremental
     for axis, v, mode in vals:
         if axis == a1:
             radius = v
-            inc = mode == "inc" if mode else st.incremental
+            inc_radius = mode == "inc" if mode else st.incremental
         elif axis == a2:
             angle = v / st.scale            # _eval_words scaled it as a length
-            if radius is None:
-                inc = mode == "inc" if mode else st.incremental
+            inc_angle = mode == "inc" if mode else st.incremental
     if radius is None and angle is None:
         return vals
     if machine:
@@ -81,18 +86,29 @@ def cartesian(interp, vals: list, machine: bool = False) -> Optional[list]:
         refuse(interp, "a canned cycle position (alarm 61814 unless _ZSFI[3] = 1)")
         return None
     cur1, cur2 = interp.pos.get(a1, 0.0), interp.pos.get(a2, 0.0)
-    if inc:
-        if radius is None or angle is None:
-            refuse(interp, "an incremental (G91) block with only the "
-                   + ("angle" if radius is None else "radius"))
+    if radius is not None and inc_radius:
+        if angle is None:
+            refuse(interp, "an incremental (G91) radius without an angle (the angle about the new "
+                   "pole is not defined)")
             return None
-        pole = (cur1, cur2)
+        pole = (cur1, cur2)             # the pole is the current point
+        # the angle from the first axis: N15 `G91 X100 Y0` goes along +X, not on at 45 degrees
     else:
-        pole = (0.0, 0.0)
+        pole = (0.0, 0.0)               # G90 radius, or no radius: the workpiece zero
         if radius is None:
             radius = math.hypot(cur1, cur2)
-        if angle is None:
-            angle = math.degrees(math.atan2(cur2, cur1))
+        if angle is None or inc_angle:
+            # the angle the block keeps or adds to: the current point's about the zero, or the
+            # angle last programmed; the seed does not say which, so only where they agree
+            here = math.degrees(math.atan2(cur2, cur1))
+            last = interp.__dict__.get("polar_input_last")
+            if last is None or not last[1] or abs((here - last[0] + 180.0) % 360.0 - 180.0) > 1e-6:
+                refuse(interp, ("an angle left out" if angle is None else "an incremental (G91) angle")
+                       + " where the current point's angle about the zero is not the angle last "
+                       "programmed about it (the seed does not say which one counts)")
+                return None
+            angle = here if angle is None else here + angle
+    interp.polar_input_last = (angle, pole == (0.0, 0.0))
     rad = math.radians(angle)
     rest = [w for w in vals if w[0] not in (a1, a2)]
     return rest + [(a1, pole[0] + radius * math.cos(rad), "abs"),

@@ -88,6 +88,9 @@ class StatementsMixin:
             self._record("coolant", coolant=v)
         elif g == "units":
             st.set(g, v)
+        elif g == "polar":
+            st.set(g, v)
+            self.polar_input_last = None     # polar_input.py: no angle programmed in this mode yet
         elif g == "plane":
             if v != st.plane:
                 polar_words.plane_changed(self)
