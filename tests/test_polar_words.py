@@ -98,11 +98,19 @@ def test_fagor_pole_goes_back_to_the_zero_at_a_plane_change():
     assert said == [] and got[-2:] == [(4, 15.0, 10.0), (7, 5.0, 0.0)]
 
 
+# a plane change after the pole: Fagor's polar origin goes back to the zero, Sinumerik keeps G111's
+FAGOR_PLANE = "%PROGRAM\nG17 G90 G00 X0 Y0\nG30 I10 J10\nG01 R5 Q0 F100\nG18\nG17\nR5 Q0\nR5 Q90\nM30\n"
+SIN_PLANE = "G17 G90 G0 X0 Y0\nG111 X10 Y10\nG1 AP=0 RP=5 F100\nG18\nG17\nAP=0 RP=5\nAP=90 RP=5\nM30\n"
+
+
 @pytest.mark.parametrize("source, text, target", [
-    ("fagor", FAGOR, "sinumerik"), ("fagor", FAGOR, "iso-m"), ("sinumerik", STORED, "fagor")])
+    ("fagor", FAGOR, "sinumerik"), ("fagor", FAGOR, "iso-m"), ("sinumerik", STORED, "fagor"),
+    ("fagor", FAGOR_PLANE, "sinumerik"), ("sinumerik", SIN_PLANE, "fagor")])
 def test_polar_words_between_controls_that_read_them_differently(source, text, target):
-    # Sinumerik keeps the programmed radius, Fagor reads the point's, and Fagor's G91 R/Q are
-    # increments: written where both words say the same point, lowered (NC401) elsewhere
+    # Sinumerik keeps the programmed radius, Fagor reads the point's, Fagor's G91 R/Q are
+    # increments, and Fagor's pole goes back to the zero at a plane change (FAGOR_PLANE: line 7 is
+    # (5, 0) on Fagor, (15, 10) about a kept pole; SIN_PLANE: (15, 10) and (10, 15) on Sinumerik):
+    # written where both controls read the same point, lowered (NC401) elsewhere
     conv = nctrans.transpile(text, read=source, write=target)
     assert conv.ok, conv.diagnostics
     assert nctrans.equiv(text, conv.text, read_a=source, read_b=target), conv.text

@@ -380,6 +380,11 @@ class Emitter(Spelling):
         write = getattr(self, prefix + type(node).__name__, None)
         if write is None:
             raise NotExpressible(self.describe(node))
+        t = type(node)
+        if t is n.PolarPole:                # polar_words_check: a plane change since the pole
+            self.pole_plane = "same"
+        elif t is n.ModeChange and node.group == "plane" and getattr(self, "pole_plane", None):
+            self.pole_plane = "changed"
         return write(node, *args)
 
     def describe(self, node: Any) -> str:
@@ -391,12 +396,15 @@ class Emitter(Spelling):
         a left-out angle or radius is the value last programmed or the current point's (option
         `polar_memory`), and under incremental distance the words are increments or not (option
         `polar_incremental`). Where the source's and this target's differ the words are written
-        only where they say the same point: both given, under absolute distance."""
+        only where they say the same point: both given, under absolute distance, and not after a
+        plane change since the pole where one control keeps the pole and the other does not
+        (option `pole_on_plane_change`)."""
         from nctrans.rules import option
 
         def semantics(dialect):
             return (option(dialect, "polar_memory") or "position",
-                    option(dialect, "polar_incremental") or "never")
+                    option(dialect, "polar_incremental") or "never",
+                    option(dialect, "pole_on_plane_change") or "kept")
         if not s.polar:
             return
         source, target = semantics(self.program.dialect), semantics(self.table_name)
@@ -406,6 +414,9 @@ class Emitter(Spelling):
         if source[1] != target[1] and self.distance != "absolute":
             raise NotExpressible("polar words under incremental distance (the two controls read "
                                  "them differently)")
+        if source[2] != target[2] and getattr(self, "pole_plane", None) == "changed":
+            raise NotExpressible("polar words after a plane change since the pole was set (one "
+                                 "control keeps the pole, the other goes back to the work zero)")
 
     # -------------------------------------------------------------- position and frame
     def forget(self) -> None:
@@ -414,6 +425,8 @@ class Emitter(Spelling):
         self.pos = {}
         self.frame_trans = None
         self.frame_other = True
+        if getattr(self, "pole_plane", None):
+            self.pole_plane = "changed"
 
     def incremental(self, av: n.AxisValue) -> bool:
         return av.mode == "inc" or (av.mode is None and self.distance == "incremental")
