@@ -187,10 +187,31 @@ def test_blocks_without_motion_between():
 
 
 def test_too_large_and_negative_values():
+    # RND=20 at the 90 degree corner of a 10 mm and a 5 mm line: a rounding r touches each line r
+    # from the corner, so it fits up to r = min(10, 5) = 5: the control reduces it [GK], nctrans
+    # to the largest that fits (NC229): from (5, 0) about (5, 5) to (10, 5), ccw
     recs, diags = run(HEAD + "G1 X10 RND=20\nY5\nM30\n")
-    assert [pt(r.end) for r in moves(recs)[1:]] == [(10, 0), (10, 5)]
-    (d,) = [d for d in diags if d.rule == "NC219"]
-    assert d.line == 2 and "shrinks" in d.message and "inserts none" not in d.message
+    ms = moves(recs)[1:]
+    assert [pt(r.end) for r in ms if r.kind != "linear" or pt(r.start) != pt(r.end)] == [(5, 0), (10, 5)]
+    arc = next(r for r in ms if r.kind == "arc")
+    assert pt(arc.center) == (5, 5) and arc.direction == "ccw"
+    (d,) = [d for d in diags if d.rule == "NC229"]
+    assert d.line == 2 and d.severity == "warning" and "RND=20" in d.message and "at 5 " in d.message
+    assert not [d for d in diags if d.rule in ("NC217", "NC219")]
+    # CHF=20 (the chamfer's own length): equal legs L make a chamfer L * sqrt 2 long; L fits up to
+    # 5, so the chamfer is 5 * sqrt 2 = 7.0710678, taken at the control's 0.001 mm: 7.071
+    # (legs 7.071 / sqrt 2 = 4.99995 from the corner)
+    recs, diags = run(HEAD + "G1 X10 CHF=20\nY5\nM30\n")
+    (d,) = [d for d in diags if d.rule == "NC229"]
+    assert "CHF=20" in d.message and "at 7.071 " in d.message
+    ends = [pt(r.end, 6) for r in moves(recs)[1:]]
+    assert ends[:2] == [(round(10 - 7.071 / math.sqrt(2), 6), 0), (10, round(7.071 / math.sqrt(2), 6))]
+    # lines meeting at 45 degrees (turning by 135): (0, 0) -> (10, 0) -> (0, 10); a rounding r
+    # touches them r / tan(22.5) = 2.414214 r from the corner, so r fits up to 10 tan(22.5) =
+    # 4.1421356 (the first line is the shorter, 10 against 14.14): 4.142
+    _, diags = run(HEAD + "G1 X10 RND=20\nX0 Y10\nM30\n")
+    (d,) = [d for d in diags if d.rule == "NC229"]
+    assert "at 4.142 " in d.message
     recs, diags = run(HEAD + "G1 X10 RND=-2\nY5\nM30\n")
     assert [pt(r.end) for r in moves(recs)[1:]] == [(10, 0), (10, 5)]
     assert ("NC120", 2) in bad(diags)

@@ -19,10 +19,12 @@ nctrans.lower.corner_fit, fed by `_mark`.
 Not inserted, said at the line of the word (NC217 warning, NC218 error where the control alarms):
 the next move is not G1/G2/G3 in the same plane, or moves outside the plane, the plane, the frame
 or the cutter compensation changes between the two blocks, an element is a full circle or helix,
-or the element does not fit (the Sinumerik control then shrinks it [GK]; that is not modelled).
+or the element does not fit where the control alarms (ISO). A Sinumerik element too large for its
+blocks is shrunk to fit, as the control does [GK] (`_shrunk`, NC229 at the word's line).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import Optional
@@ -283,6 +285,43 @@ def _mark(it, m: Move) -> None:
         sink.add((m.span.file, m.span.line))
 
 
+# The control computes positions at 0.001 mm (MD 10200 INT_INCR_PER_MM = 1000 by default [GK]); a
+# shrunk element is taken at that resolution, in program units, so a writer can state it exactly.
+_RESOLUTION = {True: 0.001, False: 0.0001}      # mm program / inch program
+
+
+def _shrunk(it, m: Move, first: corners.Element, second: corners.Element) -> Optional[corners.Corner]:
+    """The element a Sinumerik control puts where the programmed one is too large for its blocks
+    (rules `too_large = "reduced"`): [GK, Siemens Fundamentals "Chamfer, rounding": a chamfer or
+    rounding too large for the contour elements is reduced automatically to a value that fits]. The
+    manual does not say to which value: nctrans takes the largest that fits on both blocks as they
+    stand (the element then takes the whole of the shorter one) [NC], at the control's resolution.
+    Said at the word's line (NC229), since the program asks for another size; None where not even
+    the smallest element fits."""
+    kind, value, _, dialect = m.corner
+    scale = it.st.scale or 1.0
+    step = _RESOLUTION[scale == 1.0]
+    lo, hi = 0.0, value
+    for _ in range(60):                     # the largest that fits: it fits below, not above
+        mid = (lo + hi) / 2
+        if _shape(kind, first, second, mid)[0] is not None:
+            lo = mid
+        else:
+            hi = mid
+    size = math.floor(lo / scale / step + 1e-9) * step      # program units, at the resolution
+    corner = _shape(kind, first, second, size * scale)[0] if size > 0 else None
+    if corner is None:
+        return None
+    word = {v: k for k, v in settings(dialect).get("words", {}).items()}.get(kind, kind)
+    it.diag("NC229", "warning", f"the {_NOUN[kind]} ({word}={value / scale:g}) is too large for its "
+            f"blocks: the control reduces it to fit; the analysed toolpath inserts it at {size:g} (the "
+            "largest that fits, nctrans' reading of 'reduced to a suitable value')", m.span)
+    sink = it.__dict__.get("corner_shrunk")
+    if sink is not None and m.span is not None:
+        sink[(m.span.file, m.span.line)] = size
+    return corner
+
+
 def _in_plane(m: Move, a1: str, a2: str) -> bool:
     keys = set(m.start) | set(m.end)
     return all(abs(m.end.get(a, 0.0) - m.start.get(a, 0.0)) < 1e-9 for a in keys if a not in (a1, a2))
@@ -337,11 +376,13 @@ def _join(it, p: Move, new: Move) -> Move:
     corner = None
     if not corners.is_tangent(first, second):
         corner, why = _shape(kind, first, second, value)
-        if corner is None:
-            reduced = settings(dialect).get("too_large") == "reduced"
-            _not_inserted(it, p, why, "the control shrinks it to fit" if reduced else "")
-            if reduced:
+        if corner is None and settings(dialect).get("too_large") == "reduced":
+            corner = _shrunk(it, p, first, second)
+            if corner is None:
+                _not_inserted(it, p, why, "the control shrinks it to fit")
                 _mark(it, p)
+        elif corner is None:
+            _not_inserted(it, p, why)
     if corner is None:
         _emit(it, p)
         _replay(it, it.corner)

@@ -6,8 +6,9 @@ A Sinumerik control shrinks a rounding or chamfer too large for the blocks aroun
 geometry at the corner, which only the interpreter knows, so a writer of such a target asks here
 before it writes the word: the source runs once (records dropped, memory flat) and the blocks whose
 element did not fit or spans such blocks come back as (file, line). The writer then lowers that
-construct (the interpreter writes the arc it inserts) or, where nctrans does not model what the
-control does (the shrink), the lowering refuses it at its line (NC402 after NC219).
+construct (the interpreter writes the arc it inserts), or, for an element the control shrinks,
+writes the shrunk size (`shrunk_corners`); where not even the smallest element fits, the lowering
+refuses it at its line (NC402 after NC219).
 """
 from __future__ import annotations
 
@@ -16,20 +17,33 @@ from typing import Any
 
 from nctrans.ir import nodes as n
 
-_LAST: list[Any] = [None, frozenset()]          # (program, its answer): one conversion at a time
+_LAST: list[Any] = [None, frozenset(), {}]      # (program, its answers): one conversion at a time
 
 
 def unfit_corners(program: n.Program, machine=None) -> frozenset:
     """(file, line) of every block whose corner element the source control inserts so."""
+    _run(program, machine)
+    return _LAST[1]
+
+
+def shrunk_corners(program: n.Program, machine=None) -> dict:
+    """(file, line) -> the size (program units) the source control shrinks the block's element to
+    where it is too large for its blocks (nctrans.interp.corner_elements._shrunk): a writer whose
+    word the target's control alarms on when too large writes that size instead."""
+    _run(program, machine)
+    return _LAST[2]
+
+
+def _run(program: n.Program, machine) -> None:
     if _LAST[0] is program:
-        return _LAST[1]
+        return
     from nctrans import pipeline
     from nctrans.interp.interpreter import Interpreter
     source_dir = os.path.dirname(program.file) if program.file and program.file != "<stdin>" else None
     it = Interpreter(program, machine, diagnostics=[],
                      resolver=pipeline.make_resolver(source_dir or None, program.dialect))
     it.corner_unfit = set()
+    it.corner_shrunk = {}
     for _ in it.run():
         pass
-    _LAST[:] = [program, frozenset(it.corner_unfit)]
-    return _LAST[1]
+    _LAST[:] = [program, frozenset(it.corner_unfit), dict(it.corner_shrunk)]

@@ -1913,7 +1913,28 @@ class IsoEmitter(IsoSpelling, Emitter):
                                  "it to fit or inserts it after blocks that move nothing, where the ISO "
                                  f"control alarms at {own.get(kind, kind)}: the corner is written as the "
                                  "arc or line it inserts)", s.text.strip())
+        shrunk = self._corner_shrunk_here(s)
+        if shrunk is not None:
+            # too large for its blocks: the source control shrinks it (NC229), the ISO control
+            # would alarm; the size it shrinks to fits, so the ISO word carries that size
+            self.lowered(f"{s.dialect} {s.text.strip()!r} is too large for its blocks: written as "
+                         f"{word}{shrunk:g}, the size the source control reduces it to")
+            return "," + self.addr(word.lstrip(","), n.Num(shrunk))
         return "," + self.addr(word.lstrip(","), s.value)
+
+    def _corner_shrunk_here(self, s: n.Passthrough):
+        """The size the source control shrinks this block's element to, where it shrinks one too
+        large for its blocks and this control does not (nctrans.lower.corner_fit); else None."""
+        src = corner_elements.settings(s.dialect)
+        if src.get("too_large") in (None, corner_elements.settings(self.dialect).get("too_large")):
+            return None
+        from nctrans.dialects.emit import CONVERSION_MACHINE
+        from nctrans.lower.corner_fit import shrunk_corners
+        get = CONVERSION_MACHINE.get()
+        span = self.span
+        if span is None:
+            return None
+        return shrunk_corners(self.program, get() if get else None).get((span.file, span.line))
 
     def _corner_unlike_here(self, s: n.Passthrough) -> bool:
         """Whether the source control inserts this block's element in a way the ISO word cannot say
