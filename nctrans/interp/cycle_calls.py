@@ -83,7 +83,7 @@ class CycleCallsMixin:
         return mode
 
     def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None,
-                steps=None) -> None:
+                steps=None, own: Optional[dict] = None) -> None:
         st = self.st
         feed = p.get("feed")
         feed = feed * st.feed_scale if feed is not None else (st.feed or 0.0)
@@ -95,8 +95,10 @@ class CycleCallsMixin:
             steps = expand_cycle(kind, plane=st.plane, position=dict(self.pos), hole=hole,
                                  approach=approach, bottom=bottom, retract=retract,
                                  peck=p.get("peck"), dwell_s=p.get("dwell"), shift=p.get("shift"),
-                                 feed=feed, spindle_dir=st.spindle_dir, units_mm=st.scale == 1.0,
-                                 repeat=repeat, step=step, position_at=self._position_at())
+                                 feed=feed, spindle_dir=(own or {}).get("spindle_dir", st.spindle_dir),
+                                 units_mm=st.scale == 1.0, repeat=repeat, step=step,
+                                 position_at=self._position_at(),
+                                 **{k: v for k, v in (own or {}).items() if k != "spindle_dir"})
         elif callable(steps):
             steps = steps(feed)
         pitch = None
@@ -231,7 +233,7 @@ class CycleCallsMixin:
             v = self._value(self.ev.compile(e), f"cycle {k}")
             if v is not None:
                 params[k] = v * st.scale if k in CYCLE_LENGTH_KEYS else v
-        if "bottom" not in params and "depth_rel" not in params:
+        if "bottom" not in params and not params.get("depth_rel"):
             self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
             return
         approach, bottom, retract = plane_cycle_levels(params, current=self.pos.get(ax, 0.0))
@@ -248,7 +250,27 @@ class CycleCallsMixin:
             kind, steps = self._tap(s, params, approach, bottom, retract)
             if steps is None:
                 return
-        self._expand(kind, hole, approach, bottom, retract, params, steps=steps)
+        self._expand(kind, hole, approach, bottom, retract, params, steps=steps,
+                     own=self._boring_params(kind, params))
+
+    def _boring_params(self, kind: str, p: dict) -> dict:
+        """What Sinumerik's boring cycles do beyond the ISO cycle of their kind [GK, Siemens
+        cycles manual]: CYCLE85 feeds out at RFF; CYCLE86 lifts off by RPA/RPO/RPAP (increments in
+        the abscissa, ordinate and applicate) after the oriented stop and turns the spindle back
+        on in SDIR (3: M3, 4: M4); CYCLE87/CYCLE88 retract with G0 after NC start."""
+        st = self.st
+        own: dict = {}
+        if kind == "bore_feed_out" and p.get("rff"):
+            own["feed_out"] = p["rff"] * st.feed_scale
+        elif kind == "fine_bore":
+            a1, a2, ax = PLANE_AXES[st.plane]
+            own["lift"] = {a: (p.get(k) or 0.0) * st.scale for a, k in ((a1, "rpa"), (a2, "rpo"), (ax, "rpap"))}
+            direction = {3: "cw", 4: "ccw"}.get(int(p.get("sdir") or 0))
+            if direction:
+                own["spindle_dir"] = direction
+        elif kind == "bore_manual":
+            own["manual_retract"] = True
+        return own
 
     def _tap(self, s: n.CycleCall, p: dict, approach: float, bottom: float, retract: float):
         """CYCLE84/CYCLE840: lead from PIT, else from the M size MPIT; its sign gives the hand;
@@ -285,20 +307,32 @@ class CycleCallsMixin:
         rfp = p.get("r_plane", 0.0)
         up = 1.0 if approach >= bottom else -1.0
         first = p.get("first_peck")
-        if "fdpr" in p:
+        if p.get("fdpr"):               # FDPR as DPR: 0 is "not programmed" (plane_cycle_levels)
             first = rfp - up * abs(p["fdpr"] * self.st.scale)
         vari = int(p.get("vari", 0) or 0)
         vari = 1 if vari % 10 == 1 else 0
         anticipation = p.get("_dis1")     # _DIS1: re-approach distance (VARI=1), a length
         if anticipation is not None:
             anticipation *= self.st.scale
+        # _DTD: dwell at the final depth [GK, Siemens cycles manual]: > 0 seconds, < 0 spindle
+        # revolutions, 0 as DTB
+        final = p.get("_dtd") or None
+        if final is not None and final < 0:
+            speed = self.st.spindle_speed
+            if not speed:
+                self.diag("NC206", "error", "CYCLE83 with a dwell _DTD in spindle revolutions and no "
+                          "spindle speed: the dwell at the final depth is taken as DTB")
+                final = None
+            else:
+                final = -final * 60.0 / speed
 
         def make(feed: float):
             return deep_hole_steps(plane=self.st.plane, vari=vari, approach=approach, rfp=rfp,
                                    bottom=bottom, retract=retract, first=first,
                                    decrement=p.get("decrement", 0.0), dwell_bottom=p.get("dwell"),
                                    dwell_top=p.get("dts"), relief=p.get("relief"), feed=feed,
-                                   first_factor=p.get("frf"), anticipation=anticipation)
+                                   first_factor=p.get("frf"), anticipation=anticipation,
+                                   dwell_final=final)
         return make
 
     def _swivel_plane(self, s: n.CycleCall) -> None:

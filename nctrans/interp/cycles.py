@@ -66,7 +66,9 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
                  dwell_s: float | None, shift: float | None, feed: float,
                  spindle_dir: str | None, units_mm: bool,
                  repeat: int = 1, step: Optional[dict[str, float]] = None,
-                 liftoff: Optional[str] = None, position_at: str = "clear_level") -> list[Step]:
+                 liftoff: Optional[str] = None, position_at: str = "clear_level",
+                 feed_out: Optional[float] = None, lift: Optional[dict[str, float]] = None,
+                 manual_retract: bool = False) -> list[Step]:
     """The steps of one cycle block: ("rapid"|"linear", point) | ("dwell", s) | ("spindle", dir) | ("stop", "stop").
 
     `retract` is the level the hole ends at: the initial level Zi under G98 (may be below R; the
@@ -81,6 +83,11 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
     clearance is 0.254 mm in both unit systems). One approximation: under G98 with Zi exactly at R,
     the plane move happens at the current height (LinuxCNC: at Zi), which differs only if a G99
     hole with another R came earlier in the same series.
+    Sinumerik's own boring cycles [GK, Siemens cycles manual] differ in three ways the caller
+    asks for: `feed_out` (CYCLE85 RFF) is the feed of the move out of the hole; `lift` (CYCLE86
+    RPA/RPO/RPAP) is the lift-off after the oriented stop, an increment in up to three axes, and
+    the tool comes back over the hole at the clear level; `manual_retract` (CYCLE87/CYCLE88): after
+    the stop the control retracts with G0 to the clear level when NC start is pressed.
     """
     ax = DRILL_AXIS[plane]
     a1, a2 = PLANE_AXES[plane]
@@ -156,9 +163,14 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
             if dwell_s is not None:
                 steps.append(("dwell", dwell_s))
             steps.append(("spindle", "orient"))
-            move("rapid", **{lift_axis: target[lift_axis] + lift_sign * q_shift})
-            to_level("rapid", clear)
-            move("rapid", **{lift_axis: target[lift_axis]})
+            if lift is not None:
+                move("rapid", **{a: cur.get(a, 0.0) + d for a, d in lift.items()})
+                to_level("rapid", clear)
+                move("rapid", **target)
+            else:
+                move("rapid", **{lift_axis: target[lift_axis] + lift_sign * q_shift})
+                to_level("rapid", clear)
+                move("rapid", **{lift_axis: target[lift_axis]})
             steps.append(("spindle", spindle_dir if spindle_dir in ("cw", "ccw") else "cw"))
         else:
             to_level("linear", bottom)
@@ -166,13 +178,18 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
                         "bore_manual") and dwell_s is not None:
                 steps.append(("dwell", dwell_s))
             if kind == "bore_feed_out":
+                if feed_out:
+                    steps.append(("feed", feed_out))
                 to_level("linear", approach)
                 to_level("rapid", clear)
             elif kind == "bore_dwell_feed_out":
                 to_level("linear", clear)
             elif kind in ("bore_stop_rapid_out", "bore_manual"):
                 steps.append(("spindle", "off"))
-                if kind == "bore_manual":
+                if kind == "bore_manual" and manual_retract:
+                    steps.append(("stop", "stop"))
+                    to_level("rapid", clear)
+                elif kind == "bore_manual":
                     steps.append(("stop", "stop"))
                     cur = dict(cur)
                     cur[ax] = clear          # the operator retracts; LinuxCNC assumes the clear level
@@ -212,14 +229,15 @@ def deep_hole_steps(*, plane: str, vari: int, approach: float, rfp: float, botto
                     retract: float, first: Optional[float], decrement: float,
                     dwell_bottom: Optional[float], dwell_top: Optional[float],
                     relief: Optional[float], feed: float, first_factor: Optional[float],
-                    anticipation: Optional[float] = None) -> list[Step]:
+                    anticipation: Optional[float] = None, dwell_final: Optional[float] = None) -> list[Step]:
     """Sinumerik CYCLE83 at the current position [GK, Siemens cycles manual]: G0 to RFP+SDIS, then
     each infeed with G1 (the first at F*FRF), DTB dwell at each depth; VARI=1 (swarf removal):
     G0 back to RFP+SDIS, DTS dwell, G0 to the last depth less the anticipation distance (0.6 mm,
     or depth/50 up to 7 mm beyond 30 mm) before the next infeed; VARI=0 (chip breaking): G1 back
     by _VRT (1 mm when not given) before the next infeed. `anticipation`: _DIS1, the programmed
-    re-approach distance of VARI=1 (when given and positive; else the automatic one). Last: G0 to
-    RTP. Steps as expand_cycle's,
+    re-approach distance of VARI=1 (when given and positive; else the automatic one).
+    `dwell_final`: _DTD, the dwell at the final depth in seconds (0 or None: DTB there too). Last:
+    G0 to RTP. Steps as expand_cycle's,
     plus ("feed", f) setting the feed of the linear steps after it. Points hold the drilling axis
     only: the caller completes them from the current point."""
     ax = DRILL_AXIS[plane]
@@ -245,8 +263,9 @@ def deep_hole_steps(*, plane: str, vari: int, approach: float, rfp: float, botto
         steps.append(("linear", {ax: depth}))
         if i == 0 and factor != 1.0:
             steps.append(("feed", feed))
-        if dwell_bottom:
-            steps.append(("dwell", dwell_bottom))
+        dwell = dwell_final if dwell_final and i == len(depths) - 1 else dwell_bottom
+        if dwell:
+            steps.append(("dwell", dwell))
         last = depth
     steps.append(("rapid", {ax: retract if (retract - approach) * up > 0 else approach}))
     return steps
@@ -558,14 +577,17 @@ def plane_cycle_levels(params: dict[str, float], *, current: float) -> tuple[flo
 
     approach = RFP + SDIS (towards RTP), retract = RTP (`current` when RTP is not given), bottom = DP,
     or RFP - DPR when DPR is given: the Siemens cycles manual [GK] says DPR wins when both are
-    programmed. The drilling direction is from RTP towards RFP (RTP below RFP drills upwards).
+    programmed. A cycle is a subprogram, and a subprogram sees an omitted argument as 0 (seed
+    L4722), so it cannot tell DPR 0 from DPR not programmed: DPR 0 leaves the depth to DP (a
+    relative depth of 0 would be no hole), as the milling cycles and the ISO writer read it.
+    The drilling direction is from RTP towards RFP (RTP below RFP drills upwards).
     A missing RFP is taken as 0; a missing depth gives bottom = RFP (the caller reports NC206).
     """
     rfp = params.get("r_plane", 0.0)
     rtp = params.get("retract_plane", current)
     up = 1.0 if rtp >= rfp else -1.0
     approach = rfp + up * abs(params.get("safety", 0.0))
-    if "depth_rel" in params:
+    if params.get("depth_rel"):
         bottom = rfp - up * abs(params["depth_rel"])
     else:
         bottom = params.get("bottom", rfp)
