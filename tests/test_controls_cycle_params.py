@@ -108,3 +108,13 @@ def test_converted_to_iso_the_same_toolpath(call):
     conv = nctrans.transpile(text, read="sinumerik", write="iso-m")
     assert conv.ok, conv.diagnostics
     assert nctrans.equiv(text, conv.text, read_a="sinumerik", read_b="iso-m")
+
+
+def test_cycle97_thread_size_up_to_m60():
+    # MPIT 56 (no PIT): the ISO 261 coarse pitch of M56 is 5.5 mm [GK]; CYCLE97 takes MPIT 3..60.
+    # External (VARI 1), DM1 = DM2 = 56, TDEP 3, FAL 0, one cut (NRC 1), no idle pass
+    text = ("G18 G90 G54 T1 D1\nS200 M3\nG0 X70 Z10\n"
+            "CYCLE97(, 56, 0, -20, 56, 56, 4, 2, 3, 0, 0, 0, 1, 0, 1, 1)\nG0 X80\nM30\n")
+    ld = pipeline.load_source(from_text(text, "t.mpf"), "t.mpf", "sinumerik")
+    cuts = [r for r in pipeline.toolpath_of(ld) if r.line == 4 and r.kind == "linear"]
+    assert cuts and {r.pitch for r in cuts} == {5.5}
