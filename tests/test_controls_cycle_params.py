@@ -118,3 +118,14 @@ def test_cycle97_thread_size_up_to_m60():
     ld = pipeline.load_source(from_text(text, "t.mpf"), "t.mpf", "sinumerik")
     cuts = [r for r in pipeline.toolpath_of(ld) if r.line == 4 and r.kind == "linear"]
     assert cuts and {r.pitch for r in cuts} == {5.5}
+
+
+def test_cycle84_tapping_speeds_are_said_not_modelled():
+    # SST 400 / SST1 200 under S1000: the cycle taps at 400 and retracts at 200 [GK]; nctrans taps
+    # at the speed in force, so it says so (NC113) once per call; SST equal to S (and SST1 0) is
+    # what it models
+    recs, diags = run("CYCLE84(10, 0, 2, -18, , 0.3, 3, , 1.5, 0, 400, 200)")
+    said = [d for d in diags if d.rule == "NC113"]
+    assert len(said) == 1 and "400, 200" in said[0].message and said[0].line == 2
+    _, diags = run("CYCLE84(10, 0, 2, -18, , 0.3, 3, , 1.5, 0, 600, 0)")
+    assert not [d for d in diags if d.rule == "NC113"]

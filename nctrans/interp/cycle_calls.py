@@ -297,6 +297,16 @@ class CycleCallsMixin:
         if (s.name or "").upper() == "CYCLE84":     # taps with G331/G332 on the control
             from nctrans.interp.rigid_tap import spindle_state
             before = spindle_state(self)
+            speeds = [v for v in (p.get("sst"), p.get("sst1")) if v and v != st.spindle_speed]
+            said = self.__dict__.setdefault("_tap_speeds_said", set())
+            if speeds and id(s) not in said:           # once per call (an MCALL's holes too)
+                said.add(id(s))
+                # [GK] SST is the spindle speed the cycle taps at, SST1 the one it retracts at
+                # (0: SST); which speed is in force after the cycle is not documented
+                self.diag("NC113", "warning", f"CYCLE84 tapping speed SST / retraction speed SST1 "
+                          f"({', '.join(f'{v:g}' for v in speeds)}) is not modelled: the analysed tap runs "
+                          f"at the speed in force (S{st.spindle_speed:g}), so its feed (lead x speed), "
+                          "time and spindle events differ from the machine's; the path is the same")
         steps = tap_steps(plane=st.plane, approach=approach, bottom=bottom, retract=retract,
                           dwell_s=p.get("dwell"), forward="ccw" if kind == "tap_left" else "cw",
                           after=after, before=before)
