@@ -121,6 +121,9 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.travel_limits: Optional[ProgrammedLimits] = None     # set by the first TravelLimit
         self.settable = None            # settable_frames.SettableFrames where the dialect has them
         self.edges = None               # tool_edges.ToolEdges where D numbers are cutting edges
+        # tools selected by a name the machine file does not number: analysis number -> name (a
+        # target that selects tools by number cannot be given one: flatten refuses their change)
+        self.unnumbered_tools: dict[int, str] = {}
         if self.st.work_offset:
             self.off.set_work(self._work_offset(self.st.work_offset))
         # machine position (last emitted end) and the same point in program coordinates

@@ -164,6 +164,7 @@ class StatementsMixin:
             match = next((t.number for t in tools if str(getattr(t, "name", "")).upper() == key), None)
             if match is None:
                 match = max([t.number for t in tools] + [0] + list(numbers.values())) + 1
+                self.unnumbered_tools[match] = name
                 self.diag("NC107", "info", f"tool {name!r} is not named in the machine's tool table; "
                           f"analysed as tool {match} with no geometry")
             numbers[key] = match

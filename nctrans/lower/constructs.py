@@ -31,7 +31,8 @@ from nctrans import limits
 from nctrans.diagnostics import Diagnostic
 from nctrans.interp import corner_elements
 from nctrans.interp.interpreter import Interpreter
-from nctrans.lower.flatten import ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Walker, takes_unknown_path
+from nctrans.lower.flatten import (ISO_OFFSETS, UNMODELLED_RULES, _Flattener, _Walker, length_in_effect,
+                                  takes_unknown_path)
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks, walk
 
@@ -464,12 +465,26 @@ def _variables_reason(written: set, read_elsewhere: set, local: Callable[[str, o
 
 def _mode_state(interp: Interpreter) -> dict:
     st = interp.st
+    length_mode, length_index = length_in_effect(interp, st)
     return {"units": st.groups.get("units"), "distance": st.groups.get("distance"),
             "plane": st.plane, "motion": st.motion, "feed_mode": st.feed_mode, "feed": st.feed,
-            "scale": st.scale, "feed_scale": st.feed_scale, "work_offset": st.work_offset, "length_mode": st.length_mode,
-            "length_index": st.length_index, "arc_absolute": st.arc_absolute,
+            "scale": st.scale, "feed_scale": st.feed_scale, "work_offset": st.work_offset, "length_mode": length_mode,
+            "length_index": length_index, "arc_absolute": st.arc_absolute, "tool_selected": st.tool_selected,
             "comp": st.comp_side != "off" or interp.comp is not None,
             "frame": not interp.frame.identity or any(v for v in interp.off.g92.values())}
+
+
+def _selection_to_restore(seg: Segment) -> Optional[int]:
+    """The tool a segment leaves selected (T without a change: a preselection) where the target
+    has another one selected after its plain motion, which writes T only with a change: the
+    selection would be lost, and the next change take the wrong tool. None: nothing to write."""
+    st = seg.end_state
+    if st is None or seg.flattener is None:
+        return None
+    written = seg.flattener.tool_written
+    target = written if written is not None else (seg.start_state or st).get("tool_selected")
+    sel = st.get("tool_selected")
+    return sel if sel is not None and sel != target else None
 
 
 def _restore(seg: Segment, span: n.Span, units_follow: bool) -> n.Block:
@@ -516,6 +531,9 @@ def _restore(seg: Segment, span: n.Span, units_follow: bool) -> n.Block:
     if st["feed"] is not None and feed_differs:
         scale = st["feed_scale"] if st["feed_mode"] != "inverse_time" else 1.0
         body.append(n.Feed(n.Num(round(st["feed"] / scale, 9))))
+    selected = _selection_to_restore(seg)
+    if selected is not None:
+        body.append(n.ToolSelect(n.Num(float(selected))))
     return n.Block(span, body, comment="nctrans: modes of the source restored" if body else None)
 
 
@@ -730,6 +748,11 @@ class SegmentHook:
             for d in self.diags[seg.diag_mark:]:
                 if _blocks_lowering(d):
                     seg.why_not = seg.why_not or d.message
+            selected = _selection_to_restore(seg)
+            name = it.unnumbered_tools.get(selected) if selected is not None else None
+            if name is not None and seg.why_not is None:
+                seg.why_not = (f"it selects tool {name!r}, which the target selects by number, and "
+                               "the machine file names no tool so")
             self.current = None
             return
         seg.starts += 1

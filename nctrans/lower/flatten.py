@@ -231,6 +231,28 @@ class _Walker:
                                           f"{sp.line})", sp))
 
 
+def length_in_effect(interp, st) -> tuple[str, Optional[int]]:
+    """The tool length the source has on, as the target writes it: ("plus", register) or ("off",
+    None). ISO-style sources switch it with G43/G44/G49 (`length_mode`); where a D selects a
+    cutting edge (tool_edges: no G43 in the source) the edge brings its length, and the target
+    needs the length on as well, or a program that ran with it would run on the gauge line
+    (on a real machine the tool tip then lies its length lower). Edge D1 is the tool's own
+    register, D<d> the register d, D0 none: the reading of the ISO writer's edge_length. A lathe
+    applies no edge length (tool_edges: not modelled), so none is written there either. G44
+    comes back as ("minus", register): the flattener folds it, a segment's end restores it."""
+    edges = getattr(interp, "edges", None) if interp is not None else None
+    if edges is not None and getattr(interp.machine, "kind", "mill") != "lathe":
+        d = int(getattr(st, "radius_index", 0) or 0)
+        if not d:
+            return ("off", None)
+        return ("plus", int(st.tool or 1) if d == 1 else d)
+    if st.length_mode in ("plus", "minus"):
+        idx = st.length_index if st.length_index is not None else st.tool
+        if idx:
+            return (st.length_mode, int(idx))
+    return ("off", None)
+
+
 class _Flattener:
     """Turns the interpreter's records into blocks, tracking what the target's modal state is."""
 
@@ -254,6 +276,7 @@ class _Flattener:
         self.mpos: dict[str, float] = {"X": 0.0, "Y": 0.0, "Z": 0.0}   # target's machine point
         self.off: dict[str, float] = {}            # target's offsets (work + tool length), mm
         self.noted: set[str] = set()
+        self.tool_written: Optional[int] = None    # the tool of the last change written
         self._raw: Optional[tuple] = None          # interpreter state the offsets were synced for
         # taps written in the target control's tapping form (flat_tapping.py); records held for
         # a tap are written later with the offsets state they came with (st_override)
@@ -284,19 +307,16 @@ class _Flattener:
                            f"{st.work_offset or 'none'}): coordinates written under G54, relative "
                            "to the machine model's G54 values", span)
             sel = "G54"
-        length: tuple[str, Optional[int]] = ("off", None)
-        if st.length_mode == "plus":
-            idx = st.length_index if st.length_index is not None else st.tool
-            if idx:
-                length = ("plus", int(idx))
-        elif st.length_mode == "minus":
+        length = length_in_effect(self.interp, st)
+        if length[0] == "minus":
+            length = ("off", None)
             self.info_once("g44", "--flatten: negative tool length compensation folded into "
                            "coordinates (written with length compensation off)", span)
         return sel, length
 
     def _sync_offsets(self, body: list, span: n.Span) -> None:
         st = self.st_override or self.interp.st
-        raw = (st.work_offset, st.length_mode, st.length_index, st.tool)
+        raw = (st.work_offset, st.length_mode, st.length_index, st.tool, getattr(st, "radius_index", None))
         if raw == self._raw:
             return
         self._raw = raw
@@ -320,7 +340,8 @@ class _Flattener:
     def _offsets_state(self):
         st = self.interp.st
         return types.SimpleNamespace(work_offset=st.work_offset, length_mode=st.length_mode,
-                                     length_index=st.length_index, tool=st.tool)
+                                     length_index=st.length_index, tool=st.tool,
+                                     radius_index=st.radius_index)
 
     def _replay(self, rec: ToolpathRecord, work_end, work_center, state) -> None:
         self.st_override = state
@@ -344,8 +365,18 @@ class _Flattener:
         if kind in ("rapid", "linear", "arc"):
             self.move(rec, span)
         elif kind == "tool_change":
+            name = self.interp.unnumbered_tools.get(rec.tool) if self.interp is not None else None
+            if name is not None:
+                # the analysis' own number for a named tool is no pocket or tool number of any
+                # machine: writing it would load another tool
+                self.diags.append(at_span("NC402", "error", f"plain motion cannot write the change to "
+                                          f"tool {name!r}: the target selects tools by number, and "
+                                          "the machine file names no tool so (give it a [[tools]] "
+                                          f"entry with name = {name!r} and its number, --machine)",
+                                          span))
             # no tool known (the source's T word failed): the change alone, as the source did
             body = [] if rec.tool is None else [n.ToolSelect(n.Num(float(rec.tool)))]
+            self.tool_written = rec.tool
             self.blocks.append(n.Block(span, body + [n.ToolChange()]))
             # the target's M6 may stop the spindle (LinuxCNC's does: a G33 after it then stops
             # with "spindle not turning"): the direction the source programs next is written again
