@@ -101,3 +101,15 @@ def test_preselection_inside_a_lowered_segment_reaches_the_next_change():
         assert conv.text, conv.diagnostics
         assert machine_z(conv.text, target)[-1] == 55
         assert api.equiv(text, conv.text, read_a="sinumerik", read_b=target, machine=M)
+
+
+def test_fagor_offset_d_is_written_with_its_h_register():
+    # Fagor `T1 D1` then M06 (which brings D1): ISO got a bare `G43`, which a Fanuc reads with the
+    # last H programmed (none: no length) and only LinuxCNC with the loaded tool's. Tool 1 (100):
+    # G0 Z5 -> machine Z 105 on both
+    text = "G0 G17 G71 G90 G54\nT1 D1\nM6\nG0 X0 Y0 Z5\nM30\n"
+    conv = api.transpile(text, "fagor", "iso-m", machine=M)
+    blocks = words(conv.text)
+    assert ["M6", "G43", "H1"] in blocks
+    assert not any("G43" in ws and not any(w.startswith("H") for w in ws) for ws in blocks)
+    assert machine_z(conv.text, "iso-m") == machine_z(text, "fagor") == [105]

@@ -229,10 +229,16 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.edge_lengths = (EdgeLengths(self) if self.writes_edge_lengths
                              and program.dialect != self.dialect and edge_offsets(program.dialect)
                              and not (program.meta or {}).get("flattened_from") else None)
+        # the tool in the spindle as the text has it (0: none changed yet; None: not known here)
+        # and the last T word, for a source that switches the length on without naming a
+        # register (Fagor D: the active tool's offset), see _length_register
+        self.spindle_tool: Optional[int] = 0
+        self.selected_tool = None
 
     def forget(self) -> None:
         super().forget()
         self.distance_known = False
+        self.spindle_tool = None
         if getattr(self, "edge_lengths", None) is not None:
             self.edge_lengths.reached_from_elsewhere()
 
@@ -870,9 +876,12 @@ class IsoEmitter(IsoSpelling, Emitter):
     # -------------------------------------------------------------- statements
     def statements(self, body) -> list[list[str]]:
         lines: list[_Line] = [_Line()]
+        names_register = any(type(s) is n.OffsetSelect and s.kind == "length" for s in body)
         for s in body:
             try:
                 words = self.dispatch("w_", s)
+                if type(s) is n.ModeChange and s.group == "tool_length" and not names_register:
+                    words = words + self._length_register(s)
             except NotConvertible as err:
                 if not self.in_place:
                     self.refuse(f"{type(s).__name__}: {err}")
@@ -1177,11 +1186,29 @@ class IsoEmitter(IsoSpelling, Emitter):
         return [("S", self.addr("S", s.value))]
 
     def w_ToolSelect(self, s):
+        self.selected_tool = s.tool
         return [("T", self.addr("T", s.tool))]
 
     def w_ToolChange(self, s):
         self.pos = {}
+        sel = self.selected_tool
+        self.spindle_tool = int(sel.value) if type(sel) is n.Num and float(sel.value).is_integer() else None
         return [self.code_word("tool_change", "change")]
+
+    def _length_register(self, s: n.ModeChange) -> list:
+        """The H word of a length switched on by another control's word that names no register
+        (Fagor `D1`, M06's implied D1: the active tool's offset). A bare G43 is read differently by
+        the ISO controls: LinuxCNC takes the loaded tool's length, a Fanuc the last H programmed
+        (none after power-on), so the register is always written: H<tool in the spindle>."""
+        if s.value not in ("plus", "minus") or not self.writes_edge_lengths:
+            return []
+        rule = self.table.lookup(s.code.upper()) if s.code else None
+        if rule is not None and rule.group == "tool_length":
+            return []                   # this control's own G43/G44: as the source wrote it
+        if self.spindle_tool is None:
+            raise NotConvertible(f"the tool length {s.code or ''} of the tool in the spindle, which "
+                                 "is not known here (ISO needs its H register)", "G43 H..")
+        return [("H", f"H{self.spindle_tool}")]
 
     def w_OffsetSelect(self, s):
         self.pos = {}
