@@ -292,7 +292,7 @@ def func(name: str, args: list) -> ir.Expr:
 
 # --------------------------------------------------------------------------- block lowering
 
-_ORDER = {"Assign": 0, "VarDecl": 0, "ModeChange": 1, "Feed": 2, "SpindleSpeed": 2,
+_ORDER = {"Assign": 0, "VarDecl": 0, "ModeChange": 1, "Feed": 2, "SpindleSpeed": 2, "SpindleLimit": 1,
           "ModeSelect": 1, "ToolSelect": 2, "OffsetSelect": 2, "ToolChange": 3, "Message": 5, "Alarm": 5,
           "Passthrough": 5, "FrameOp": 5, "HomeReturn": 5, "Dwell": 6, "Motion": 6, "CycleCall": 6,
           "CycleParams": 6, "PolarPole": 5, "SubCall": 7, "ModalCallOff": 7, "Stop": 8, "ProgramEnd": 8,
