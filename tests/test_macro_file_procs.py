@@ -136,3 +136,24 @@ def test_modal_g66_call_of_a_macro_file_is_mcall_with_the_same_parameters(tmp_pa
     # after each move the macro feeds to Z = -2 - 1 and back up (hand-computed)
     downs = [r.end for r in api.toolpath(sin / "O1000.mpf") if r.kind == "linear"]
     assert downs == [{"X": 10.0, "Y": 0.0, "Z": -3.0}, {"X": 20.0, "Y": 5.0, "Z": -3.0}]
+
+
+def test_every_m99_of_a_macro_file_is_its_return(tmp_path):
+    # an early M99 (a Renishaw-style macro returns from several places) was refused in place as
+    # "a program restart in the middle of a main program": the PROC stopped there with alarm 65002.
+    # Call A5: X5 then return; call A20: jump to N5, X10, return; then Y3 (hand-computed)
+    macro = "%\nO9003\nIF[#1GT10]GOTO5\nG0 X#1\nM99\nN5 G0 X10\nM99\n%\n"
+    caller = "%\nO1000\nG21 G90 G17\nG65 P9003 A5.\nG65 P9003 A20.\nG0 Y3\nM30\n%\n"
+    conv = _sinumerik(macro)
+    body = [x for x in conv.text.splitlines() if not x.startswith(";")]
+    assert body.count("RET") + body.count("M17") == 2 and "65002" not in conv.text
+    iso, sin = tmp_path / "iso", tmp_path / "sin"
+    iso.mkdir()
+    sin.mkdir()
+    (iso / "O1000.nc").write_text(caller)
+    (iso / "O9003.nc").write_text(macro)
+    (sin / "L9003.spf").write_text(conv.text)
+    (sin / "O1000.mpf").write_text(_sinumerik(caller).text)
+    ends = [r.end["X"] for r in api.toolpath(sin / "O1000.mpf") if r.kind == "rapid"]
+    assert ends == [5.0, 10.0, 10.0]
+    assert api.equiv(iso / "O1000.nc", sin / "O1000.mpf").equivalent

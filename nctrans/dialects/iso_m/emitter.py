@@ -1648,7 +1648,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         kind = "g66" if s.modal != "none" else "g65"
         self.diags.append(at_span(
             "NC404", "warning", f"the call of {s.name} is kept as {self.code_for(*_CALL[kind])} P{number}: {s.name} is not in "
-            f"this program nor found beside it, so the target control must provide O{number} "
+            f"this program (a file beside the source is not converted with it), so the target control "
+            f"must provide O{number} "
             f"(convert {s.name}'s own file to get it)", self._where()))
         lines = self._call_lines(s, kind, number, unit, params)
         if type(lines) is _Lines and unit.frame and pl.SPILL_BASE + unit.frame <= pl.SPILL_END:

@@ -494,6 +494,10 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
 
     def w_ProgramEnd(self, s: ir.ProgramEnd, out: "_Line") -> None:
         if s.kind == "restart":
+            if self.macro_file is not None:
+                # every M99 of a macro file returns to its G65 caller, not only its last one
+                self.w_Return(ir.Return(), out)
+                return
             raise NotExpressible("a program restart (M99) in the middle of a main program")
         out.words.append(self.code_for("end", "end_rewind" if s.kind == "end_rewind" else "end"))
 
@@ -899,7 +903,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         if self.p.dialect != DIALECT and c.name and not self._defined(c.name):
             self.diags.append(at_span(
                 "NC404", "warning", f"the call of {c.name} is kept as a call of {name}: it is not in "
-                f"this program nor found beside it, so the target control must provide {name} "
+                f"this program (a file beside the source is not converted with it), so the target control "
+                f"must provide {name} "
                 f"(convert {c.name}'s own file to get it)", self.span))
         pre = []
         proc = self.procs.get(macro_procs.key(c.name)) if c.kind == "g65" else None
