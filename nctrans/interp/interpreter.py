@@ -130,6 +130,10 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.mpos: dict[str, float] = ({"X": 0.0, "Z": 0.0} if getattr(machine, "kind", "") == "lathe"
                                        else {"X": 0.0, "Y": 0.0, "Z": 0.0})
         self.pos: dict[str, float] = {}
+        # axes the program has positioned with a word so far: the start point is the analysis'
+        # assumption, so plain motion writes an axis at its first programmed position even where
+        # the analysis has it there already (lower/flatten.py)
+        self.positioned: set[str] = set()
         self._resync()
         self.out: list = []
         self._hookq: deque = deque()

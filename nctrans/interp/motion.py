@@ -138,6 +138,7 @@ class MotionMixin:
         self.out.append(rec)
         if self.hook is not None:
             self._hookq.append(({a: v - tot.get(a, 0.0) for a, v in mend.items()}, None))
+            self.positioned.update(w[0] for w in words)     # what plain motion must write (flatten)
         return None
 
     def _h_motion(self, d):

@@ -88,6 +88,7 @@ class WordsMixin:
         tgt = dict(self.pos)
         inc_default = self.st.incremental
         for axis, v, mode in vals:
+            self.positioned.add(axis)
             cur = tgt.get(axis)
             if cur is None:
                 cur = self._new_axis(axis)

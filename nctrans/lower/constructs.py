@@ -773,6 +773,7 @@ class SegmentHook:
         fl.sel, fl.length, fl.motion, fl.plane = None, ("unknown", None), None, None
         fl.feed, fl.feed_mode, fl.speed, fl.spindle_dir = None, None, it.st.spindle_speed, it.st.spindle_dir
         fl.mpos = dict(it.mpos)
+        fl.written_axes = set(it.positioned)    # the structural text before wrote those
         begin = [n.ModeChange("units", "mm"), n.ModeChange("distance", "absolute")]
         if state["arc_absolute"]:
             begin.append(n.ModeChange("arc_distance", "incremental"))

@@ -274,6 +274,10 @@ class _Flattener:
         self.speed: Optional[float] = None
         self.spindle_dir: Optional[str] = None
         self.mpos: dict[str, float] = {"X": 0.0, "Y": 0.0, "Z": 0.0}   # target's machine point
+        # axes the target text has positioned; one the source positioned is written at its first
+        # move even where the analysis' start point has it already: on the machine the tool starts
+        # anywhere (`G0 X0 Y0 Z10` then `G1 Z-1` must not become `G0 Z10`, `G1 Z-1`)
+        self.written_axes: set[str] = set()
         self.off: dict[str, float] = {}            # target's offsets (work + tool length), mm
         self.noted: set[str] = set()
         self.tool_written: Optional[int] = None    # the tool of the last change written
@@ -458,8 +462,9 @@ class _Flattener:
             if rec.feed is not None and (rec.feed != self.feed or fm == "inverse_time"):
                 body.append(n.Feed(_num(rec.feed)))
                 self.feed = rec.feed
+        first = self.interp.positioned - self.written_axes if self.interp is not None else ()
         axes = [a for a, v in target_vals.items()
-                if a in (a1, a2) or a not in prog_now or abs(v - prog_now[a]) > _EPS]
+                if a in (a1, a2) or a not in prog_now or abs(v - prog_now[a]) > _EPS or a in first]
         if not axes:
             axes = list(target_vals)
         motion_stmt = n.Motion({a: n.AxisValue(n.Num(target_vals[a])) for a in axes})
@@ -484,6 +489,7 @@ class _Flattener:
         for a, v in target_vals.items():
             mpos[a] = v + off.get(a, 0.0)
         self.mpos = mpos
+        self.written_axes.update(axes)
 
 
 def _centre_at(centre: dict, point: dict, a1: str, a2: str) -> dict:
