@@ -105,6 +105,9 @@ class _State:
     feed_mode: str = "per_min"
     units: str = "mm"
     diameter: bool = False                  # X words are diameters (ISO-T, DIAMON): frames are radii
+    # frame components of another dialect's source in force, in text order (local, g92, rot,
+    # scale, mirror): Sinumerik writes them into one programmable frame, which TRANS clears whole
+    frame_parts: set = field(default_factory=set)
 
 
 class SinumerikEmitter(SinumerikSpelling, Emitter):
@@ -461,11 +464,17 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         """ISO G92 / ISO-T G50: ATRANS by the position minus the new value. A frame offset and
         $P_EP are radii; an X set under diameter programming (ISO-T, DIAMON) is a diameter, halved."""
         self.info("G92", "G92 written as ATRANS by the programmed position minus the new value")
+        self.st.frame_parts.add("g92")
         ws = [f"{a}=$P_EP[{a}]-({self.expr(v.value)})" + ("/2" if a == "X" and self.st.diameter else "")
               for a, v in s.target.items()]
         out.alone(f"{self.code_for('frame', 'trans_add')} " + " ".join(ws))
 
     def w_ResetSetPosition(self, s: ir.ResetSetPosition, out: "_Line") -> None:
+        others = sorted(self.st.frame_parts - {"g92"})
+        self.st.frame_parts.discard("g92")
+        if others and self.p.dialect != DIALECT:
+            raise NotExpressible(f"cancelling G92 while {', '.join(others)} stays in force: the "
+                                 "Sinumerik TRANS it needs clears the whole programmable frame")
         self.info("G92.1", "G92.1 written as TRANS (clears the whole programmable frame)")
         out.alone(self.code_for("frame", "trans"))
 
@@ -695,7 +704,39 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         value = feed[1:].lstrip("=") if feed else "$P_F"
         return f"{'IJK'['XYZ'.index(axes[0])]}={value}"
 
+    def _frame_parts(self, f: ir.FrameOp) -> None:
+        """Another dialect's frame components are independent (ISO G52, G92, G68, G51, G51.1:
+        each cancelled on its own); in Sinumerik they are one programmable frame, and the TRANS
+        written for a cancel or a G52 clears (replaces) all of it. Where another component is in
+        force there (in text order), that TRANS would drop it: refused, so the stretch is lowered
+        or refused at its line instead of moving silently elsewhere (ISO `G52 X50 / G68 R30 /
+        G69 / X10` went to X10, not X60)."""
+        if self.p.dialect == DIALECT:
+            return
+        parts = self.st.frame_parts
+        part = "local" if f.local else f.op
+        zero = all(isinstance(v, ir.Num) and v.value == 0 for v in f.values.values())
+        if f.op == "all" and f.clear:
+            parts.clear()
+            return
+        replaces = (f.clear and not f.values) or f.local or (not f.additive and f.center is None)
+        others = sorted(parts - {part}) if replaces else []
+        # the source's own meaning first (a refused op still runs on the source's control)
+        if f.clear or (f.local and zero):
+            parts.discard(part)
+        elif f.local or f.additive or f.center is not None:
+            parts.add(part)
+        else:
+            parts.clear()
+            parts.add(part)
+        if others:
+            raise NotExpressible(
+                f"{'a G52 local offset' if f.local else 'cancelling one frame component'} while "
+                f"{', '.join(others)} stays in force: the Sinumerik TRANS it needs replaces the "
+                "whole programmable frame")
+
     def frame(self, f: ir.FrameOp, out: "_Line") -> None:
+        self._frame_parts(f)
         trans, trans_add = self.code_for("frame", "trans"), self.code_for("frame", "trans_add")
         add = "_add" if f.additive else ""
         if f.op in ("mirror", "scale") and f.additive and not f.clear:
