@@ -160,9 +160,13 @@ def test_iso_frames_and_g92_are_lowered():
             block(ir.SetPosition({"X": ir.AxisValue(ir.Num(0.0))})),
             block(ir.FrameOp("rot", clear=True))]
     out = emit(ir.Program("iso.nc", "iso-m", body))
-    assert out.text.splitlines() == ["ATRANS X=10 Y=5", "AROT RPL=30", "ATRANS X=-(10) Y=-(5)",
-                                     "ATRANS X=$P_EP[X]-(0)", "TRANS"]
+    assert out.text.splitlines()[:4] == ["ATRANS X=10 Y=5", "AROT RPL=30", "ATRANS X=-(10) Y=-(5)",
+                                         "ATRANS X=$P_EP[X]-(0)"]
     assert not [d for d in parse(out.text, "o.mpf").diagnostics if d.rule.startswith("NC0")]
+    # G69 ends the rotation only; the G92 shift stays (ISO), while the TRANS it would need clears
+    # the whole programmable frame: refused (the conversion lowers or refuses that stretch)
+    assert "TRANS" not in out.text.splitlines()
+    assert [d.rule for d in out.diagnostics if "stays in force" in d.message] == ["NC402"]
 
 
 def test_for_loop_with_step_becomes_while():
