@@ -320,6 +320,26 @@ class Emitter(Spelling):
                                   "same, but what it does on its own control is not done", self._where()))
         return f"NC413 {s.dialect}: {s.text}"
 
+    def settings_cycle(self, s: n.SubCall) -> Optional[n.Passthrough]:
+        """A call of another control's standard cycle that only sets modes and has no path of its
+        own (rules/cycles.toml [[unmodelled]] with moves = false: CYCLE832's tolerance and
+        continuous-path settings), as the no-motion function it is: the toolpath passes it over,
+        so the target gets the NC413 comment (what it does on its own control is not done) instead
+        of a call of a program no target control has (G65 P9134, L CYCLE832). None otherwise."""
+        if not s.name or s.target is not None or self.program.dialect == self.dialect:
+            return None
+        from nctrans.interp.cycles import unmodelled_cycle
+        from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
+        what = unmodelled_cycle(str(s.name))
+        if what is None or what.moves:
+            return None
+        try:
+            args = ",".join("" if a is None else self.expr(a) for a in s.args)
+        except Exception:           # an argument the target cannot spell: the comment names the call
+            args = ".."
+        return n.Passthrough(f"{s.name}({args})", f"{NO_EFFECT_PREFIX}: {what.meaning}",
+                             self.program.dialect)
+
     def refuse(self, what: str) -> None:
         """NC402: the target cannot express `what`; the text leaves it out."""
         line = self.span.line if self.span is not None else 1

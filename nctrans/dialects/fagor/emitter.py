@@ -576,6 +576,9 @@ class FagorEmitter(FagorSpelling, Emitter):
             word("", f"$GOTO {target}", alone=True)
 
     def w_SubCall(self, s: n.SubCall, word, new_line, rest: list):
+        settings = self.settings_cycle(s)
+        if settings is not None:
+            return self.w_Passthrough(settings, word, new_line, rest)
         if s.target is not None:
             raise NotExpressible("an indirect call (the called program's name is a string computed as the program runs)")
         self._subcall(s, word)

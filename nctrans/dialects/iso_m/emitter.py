@@ -1564,6 +1564,9 @@ class IsoEmitter(IsoSpelling, Emitter):
         return lines
 
     def w_SubCall(self, s: n.SubCall):
+        settings = self.settings_cycle(s)
+        if settings is not None:
+            return self.w_Passthrough(settings)
         if s.target is not None:
             raise NotExpressible("an indirect call (the called program's name is a string computed as the program runs)")
         self.forget()

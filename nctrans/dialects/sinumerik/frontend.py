@@ -323,9 +323,12 @@ def _g_group_choices(family: int) -> list:
 def _priority(st) -> int:
     kind = type(st).__name__
     if kind == "ModeChange":
-        # spindle and coolant switch before the block's motion, on and off alike (as RS274/NGC
-        # orders them; the Siemens output timing "with the motion" is a PLC matter)
-        return 4 if st.group in ("spindle", "coolant") else 1
+        # spindle and coolant switch before the block's motion, on and off alike, the spindle
+        # first (as RS274/NGC orders them and the ISO and Fagor readings do: `M9 M5` and `M5 M9`
+        # are one block's output to the PLC, whose timing "with the motion" is a PLC matter)
+        if st.group == "spindle":
+            return 4
+        return 4.5 if st.group == "coolant" else 1
     if kind == "SubCall" and st.modal != "none":
         return 7
     return _ORDER.get(kind, 5)
