@@ -231,6 +231,16 @@ class _Walker:
                                           f"{sp.line})", sp))
 
 
+def _target_kind() -> Optional[str]:
+    """The machine kind of the dialect a conversion writes (None outside one)."""
+    from nctrans.dialects.emit import TARGET_PROFILE
+    current = TARGET_PROFILE.get()
+    if current is None:
+        return None
+    from nctrans.dialects.base import get
+    return get(current[0]).machine_kind
+
+
 def length_in_effect(interp, st) -> tuple[str, Optional[int]]:
     """The tool length the source has on, as the target writes it: ("plus", register) or ("off",
     None). ISO-style sources switch it with G43/G44/G49 (`length_mode`); where a D selects a
@@ -238,10 +248,12 @@ def length_in_effect(interp, st) -> tuple[str, Optional[int]]:
     needs the length on as well, or a program that ran with it would run on the gauge line
     (on a real machine the tool tip then lies its length lower). Edge D1 is the tool's own
     register, D<d> the register d, D0 none: the reading of the ISO writer's edge_length. A lathe
-    applies no edge length (tool_edges: not modelled), so none is written there either. G44
+    (the machine analysed, or the target's: its T word names the offset) applies no edge length
+    (tool_edges: not modelled), so none is written there either. G44
     comes back as ("minus", register): the flattener folds it, a segment's end restores it."""
     edges = getattr(interp, "edges", None) if interp is not None else None
-    if edges is not None and getattr(interp.machine, "kind", "mill") != "lathe":
+    if edges is not None and getattr(interp.machine, "kind", "mill") != "lathe" \
+            and _target_kind() != "lathe":
         d = int(getattr(st, "radius_index", 0) or 0)
         if not d:
             return ("off", None)
