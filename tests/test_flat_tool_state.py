@@ -113,3 +113,21 @@ def test_fagor_offset_d_is_written_with_its_h_register():
     assert ["M6", "G43", "H1"] in blocks
     assert not any("G43" in ws and not any(w.startswith("H") for w in ws) for ws in blocks)
     assert machine_z(conv.text, "iso-m") == machine_z(text, "fagor") == [105]
+
+
+def test_plain_motion_under_a_register_the_program_writes_says_so():
+    # G10 L2 P2 writes G55 = (100, 50, 0) and the motion runs under G55; G10 L10 P1 writes
+    # register H1 = 50 and the motion runs under G43 H1. The flattened program selects G55 and H1
+    # but does not carry the writes: NC417 names each register once
+    text = "G21 G17 G90\nG10 L2 P2 X100. Y50. Z0\nT1 M6\nG55 G0 X0 Y0 Z10.\nX5.\nM30\n"
+    conv = api.transpile(text, "iso-m", "iso-m", flatten=True, machine=M)
+    found = [d for d in conv.diagnostics if d.rule == "NC417"]
+    assert [(d.severity, d.line) for d in found] == [("warning", 4)]
+    assert "G55" in found[0].message and "X100 Y50 Z0" in found[0].message
+    text = "G21 G17 G90\nG10 L10 P1 R50.\nT1 M6\nG43 H1 G0 X0 Y0 Z10.\nX5.\nM30\n"
+    conv = api.transpile(text, "iso-m", "iso-m", flatten=True, machine=M)
+    found = [d for d in conv.diagnostics if d.rule == "NC417"]
+    assert len(found) == 1 and "H1" in found[0].message and "here 50" in found[0].message
+    plain = api.transpile("G21 G17 G90\nT1 M6\nG55 G43 H1 G0 X0 Y0 Z10.\nM30\n", "iso-m", "iso-m",
+                          flatten=True, machine=M)
+    assert not [d for d in plain.diagnostics if d.rule == "NC417"]

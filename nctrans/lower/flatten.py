@@ -231,6 +231,12 @@ class _Walker:
                                           f"{sp.line})", sp))
 
 
+def _register_text(v) -> str:
+    if isinstance(v, dict):
+        return " ".join(f"{a}{float(x):g}" for a, x in sorted(v.items())) or "0"
+    return f"{float(v):g}"
+
+
 def _target_kind() -> Optional[str]:
     """The machine kind of the dialect a conversion writes (None outside one)."""
     from nctrans.dialects.emit import TARGET_PROFILE
@@ -351,6 +357,29 @@ class _Flattener:
         if length[0] == "plus":
             off["Z"] = off.get("Z", 0.0) + self.machine.length_offset(length[1])
         self.off = off
+        self._written_register(sel, length, span)
+
+    def _written_register(self, sel: str, length, span: n.Span) -> None:
+        """NC417 where plain motion runs under a register the program itself writes (G10, #5221=,
+        $P_UIFR): the output keeps the selection (G55, H1) but not the write, and its coordinates
+        are relative to the machine model's value, so on the target the register's own content
+        applies instead of what the source put there."""
+        ran = getattr(self.interp, "machine", None) if self.interp is not None else None
+        if ran is None or ran is self.machine:
+            return
+        checks = [(sel, ran.work_offset(sel), self.machine.work_offset(sel))]
+        if length[0] == "plus":
+            h = length[1]
+            checks.append((f"H{h}", ran.length_offset(h), self.machine.length_offset(h)))
+        for name, now, model in checks:
+            if now != model and name not in self.noted:
+                self.noted.add(name)
+                self.diags.append(at_span(
+                    "NC417", "warning", f"plain motion runs under {name}, which the program writes "
+                    f"(here {_register_text(now)}; the machine model: {_register_text(model)}): the "
+                    "output selects it but does not carry the write, and its coordinates are "
+                    "relative to the model's value, so on the target the register's own content "
+                    "applies", span))
 
     # ------------------------------------------------------------------ records
     def _offsets_state(self):
