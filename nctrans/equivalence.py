@@ -498,7 +498,9 @@ def _compare_runs(A: _Run, B: _Run, sa: _Stream, sb: _Stream, tol: float) -> Opt
     if fb is None:
         q, beyond = _beyond(A, ba.j, B.last_point(), tol)
         A.drain()
-        if math.dist(A.last_point(), B.last_point()) > tol:
+        # B stopped on A's path and A goes on, though it comes back to where B stopped (a full
+        # circle from there): still B's end, not a path that leaves A's
+        if math.dist(A.last_point(), B.last_point()) > tol or (b_stops_on_a and fa is not None):
             follows = sb.what_next()
             return Difference(f"B's {cls} motion ends at {fmt(B.last_point())}"
                               f"{' and ' + follows + ' follows' if follows else ''}; "
