@@ -116,3 +116,31 @@ def test_the_whole_program_fallback_streams_past_the_held_limit(monkeypatch):
     streamed = api.transpile(text, "sinumerik", "iso-m", out=sink)
     assert streamed.text == "" and "".join(sink.parts) == held.text
     assert [d.format_text() for d in streamed.diagnostics] == [d.format_text() for d in held.diagnostics]
+
+
+# three X=AC words in one IF: the segment (lines 7-9) is lowered once, so one NC401 names it
+SEVERAL_IN_ONE = """G71 G90 G17 G40 F500
+T1 D1 M6
+S6000 M3
+G0 X0 Y0 Z5
+R1=0
+IF R1<2
+G1 X=AC(20) Y1
+G1 X=AC(3) Y2
+G1 X=AC(4) Y2
+ENDIF
+G0 X0
+M30
+"""
+
+
+def test_a_segment_lowered_alone_is_named_once():
+    program, res = _convert(SEVERAL_IN_ONE, "sinumerik", "iso-m")
+    assert res.text is not None and not res.flattened
+    infos = [d for d in res.diagnostics if d.rule == "NC401" and CONSTRUCT_NOTE in d.message]
+    # was one note per refused line (7, 8, 9), each saying "lines 7-9 were lowered" (the blocks
+    # inside the IF: the IF line itself is not a block)
+    assert [d.line for d in infos] == [7]
+    assert "nor what lines 8, 9 hold" in infos[0].message and "lines 7-9 were" in infos[0].message
+    out = get("iso-m").parse(res.text, "p.nc").program
+    assert equiv.compare(_records(program), _records(out)) is None

@@ -448,13 +448,21 @@ def _static_checks(program: n.Program, segments: list[Segment]) -> None:
                                             lambda sp, k: _local(sp, k, local_names))
 
 
+# How a variable of a numbered space is named in a note (a bare number said nothing: "it sets 1").
+_SPACE_SPELLING = {"R": "R{}", "num": "#{}", "arg": "argument {}"}
+
+
+def _var_name(space: str, key) -> str:
+    return _SPACE_SPELLING.get(space, "{}").format(key)
+
+
 def _variables_reason(written: set, read_elsewhere: set, local: Callable[[str, object], bool]
                       ) -> Optional[str]:
     """Why a segment that writes `written` cannot be lowered on its own (its assignments vanish
     into plain motion), or None: the rest of the program reads one, or one outlives the program
     (`local(space, key)` is False)."""
-    shared = sorted(str(k) for _, k in written & read_elsewhere)
-    lasting = sorted(str(k) for sp, k in written if not local(sp, k))
+    shared = sorted(_var_name(sp, k) for sp, k in written & read_elsewhere)
+    lasting = sorted(_var_name(sp, k) for sp, k in written if not local(sp, k))
     if shared:
         return f"it sets {', '.join(shared[:3])}, which the rest of the program reads"
     if lasting:
@@ -641,14 +649,27 @@ def refused(seg: Segment) -> list[Diagnostic]:
 
 
 def lowered_notes(seg: Segment, target_name: str, first_line: int, last_line: int) -> list[Diagnostic]:
-    """The NC401 of each refusal of a segment lowered to plain motion (lines first-last), then
-    what its plain motion leaves out."""
+    """One NC401 for a segment lowered to plain motion (lines first-last), at its first refusal,
+    counting the others (one note per refused line repeated the same span), then what its plain
+    motion leaves out."""
+    if not seg.refusals:
+        return list(seg.notes)
     what = "line " + str(first_line) if first_line == last_line else f"lines {first_line}-{last_line}"
-    notes = [Diagnostic("NC401", "info", f"{d.message} — {target_name} cannot express it, so "
-                        f"{what} {'was' if first_line == last_line else 'were'} {NOTE} "
-                        "(the rest keeps its structure)", d.file, d.line, d.column,
-                        d.end_line, d.end_column) for d in seg.refusals]
-    return notes + seg.notes
+    first = seg.refusals[0]
+    others = sorted({d.line for d in seg.refusals[1:]} - {first.line})
+    also = ""
+    if others:
+        shown = ", ".join(map(str, others[:MORE_LINES_SHOWN])) + (", ..." if len(others) > MORE_LINES_SHOWN else "")
+        also = f" (nor what line{'s' if len(others) > 1 else ''} {shown} hold{'' if len(others) > 1 else 's'})"
+    note = Diagnostic("NC401", "info", f"{first.message} — {target_name} cannot express it{also}, so "
+                      f"{what} {'was' if first_line == last_line else 'were'} {NOTE} "
+                      "(the rest keeps its structure)", first.file, first.line, first.column,
+                      first.end_line, first.end_column)
+    return [note] + seg.notes
+
+
+# Lines named in a segment's one lowering note besides its first refusal (the count is in the span).
+MORE_LINES_SHOWN = 5
 
 
 def _marker(k: int) -> n.Block:
