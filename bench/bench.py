@@ -13,8 +13,10 @@ Last, the peak resident memory of the CLI's `convert` (to every target, with and
 and `equiv` at 1x and 10x the program, and of the program written as Fagor read back (toolpath,
 lint, convert); the same for the program made structured (loops, calls, a drilling cycle between
 its CAM stretches), as ISO and as Sinumerik (toolpath, lint, convert, equiv), and the Sinumerik one
-with its whole body under G70 converted to ISO (a construct lowered over the CAM runs): memory must
-stay flat (10x/1x near 1) (`--peaks` runs only that table). Plain-text table; no assertions.
+with its whole body under G70 converted to ISO (a construct lowered over the CAM runs), and programs
+that jump back into their body (the ISO program ending with M99, written as one Sinumerik LOOP or Fagor
+$WHILE; the Sinumerik one run twice by a label loop, to ISO): memory must stay flat (10x/1x near 1;
+what still grows is the source text each process holds) (`--peaks` runs only that table). Plain-text table; no assertions.
 """
 from __future__ import annotations
 
@@ -480,6 +482,34 @@ print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, os.waitstatus_to_e
 """
 
 
+# Programs that jump back into their main body (`--peaks`, last two tables): converted on the compact
+# parse, each written as one structure the target writer may still take back, so its output lines
+# go to a temporary file (nctrans.spilled.OutputLines) instead of growing with the program.
+def restarting(text: str, times: int) -> str:
+    """repeated() ending with M99 instead of M30: a main program that starts again for ever
+    (Sinumerik writes its whole body in one LOOP)."""
+    return repeated(text, times).replace("\nM30\n%\n", "\nM99\n%\n")
+
+
+def sinumerik_label_loop(text: str) -> str:
+    """The CAM program converted to Sinumerik, its body run twice by a label loop (a jump back
+    to TOP: at its start)."""
+    lines = text.rstrip("\n").split("\n")
+    end = max(i for i, line in enumerate(lines) if re.search(r"\bM(30|2)\b", line))
+    body = [line for line in lines[:end] if not line.startswith(";")]
+    return ("%_N_PART_MPF\nDEF INT CNT\nCNT=0\nTOP:\n" + "\n".join(body)
+            + "\nCNT=CNT+1\nIF CNT<2 GOTOB TOP\nM30\n")
+
+
+RESTART_PEAK_RUNS = (
+    ("convert --to sinumerik (LOOP)", ["convert", "SRC", "--from", "iso-m", "--to", "sinumerik", "-o", "OUT"]),
+    ("convert --to fagor ($WHILE)", ["convert", "SRC", "--from", "iso-m", "--to", "fagor", "-o", "OUT"]),
+)
+LABEL_LOOP_PEAK_RUNS = (
+    ("convert --to iso-m (GOTO)", ["convert", "SRC", "--from", "sinumerik", "--to", "iso-m", "-o", "OUT"]),
+)
+
+
 def peak_rss(cmd: list[str]) -> tuple[float, float, int]:
     """(peak resident MiB, wall seconds, exit code) of one CLI run (see _RSS_PROBE)."""
     t0 = time.perf_counter()
@@ -544,7 +574,8 @@ def cli_peaks(base: Path, tmp: Path, notes: list) -> None:
     holds, 0.6 MB -> 5.7 MB here)."""
     print("CLI peak memory (max RSS of the process, MiB) and wall time at 1x and 10x the program")
     text = read_text(base)
-    for kind in ("straight", "structured", "structured sinumerik", "sinumerik inch stretch"):
+    for kind in ("straight", "structured", "structured sinumerik", "sinumerik inch stretch", "restart",
+                 "sinumerik label loop"):
         _peak_table(kind, base, text, tmp, notes)
 
 
@@ -555,15 +586,19 @@ def _peak_table(kind: str, base: Path, text: str, tmp: Path, notes: list) -> Non
     stem, ending = kind.replace(" ", "-"), ".mpf" if "sinumerik" in kind else ".nc"
     for times in (1, 10):
         src = tmp / f"peak-{stem}-x{times}{ending}"
-        if kind in ("structured sinumerik", "sinumerik inch stretch"):
+        if kind in ("structured sinumerik", "sinumerik inch stretch", "sinumerik label loop"):
             # the straight table's conversion to Sinumerik (its first row), made structured
             straight = tmp / f"peak-straight-x{times}.mpf"
             if not straight.exists():
                 notes.append(f"{kind}: no Sinumerik conversion of the straight program x{times}")
                 return
-            make = structured_sinumerik if kind == "structured sinumerik" else sinumerik_inch_stretch
+            make, runs = {"structured sinumerik": (structured_sinumerik, SINUMERIK_PEAK_RUNS),
+                          "sinumerik inch stretch": (sinumerik_inch_stretch, INCH_STRETCH_PEAK_RUNS),
+                          "sinumerik label loop": (sinumerik_label_loop, LABEL_LOOP_PEAK_RUNS)}[kind]
             src.write_text(make(straight.read_text()))
-            runs = SINUMERIK_PEAK_RUNS if kind == "structured sinumerik" else INCH_STRETCH_PEAK_RUNS
+        elif kind == "restart":
+            src.write_text(restarting(text, times))
+            runs = RESTART_PEAK_RUNS
         elif kind == "structured":
             src.write_text(structured(text, times))
         else:

@@ -291,10 +291,15 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
             if flatten and out is not None:         # written as the run goes: flat memory
                 result = _transpile_flat_stream(ld, target, strict, out, flat_machine)
             if result is None:
-                result = convert(program, target, flatten=flatten, strict_mode=strict,
-                                 flatten_with=flatten_with, machine=flat_machine,
-                                 resolver=pipeline.make_resolver(ld.source_dir, ld.dialect),
-                                 stream_whole=stream_whole, whole=lambda: _parsed_whole(ld, profile, write))
+                # written out piece by piece (`out`): the emitters' lines may go to a temporary
+                # file (a structure spanning the whole body is held until its end)
+                from nctrans import spilled
+                with spilled.spooled_output() if out is not None else contextlib.nullcontext():
+                    result = convert(program, target, flatten=flatten, strict_mode=strict,
+                                     flatten_with=flatten_with, machine=flat_machine,
+                                     resolver=pipeline.make_resolver(ld.source_dir, ld.dialect),
+                                     stream_whole=stream_whole,
+                                     whole=lambda: _parsed_whole(ld, profile, write))
             diags.extend(result.diagnostics)
             out_text = result.text
         elif strict:
@@ -304,7 +309,9 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
             out_text = None
     _raise_on_errors(diags, error_level)
     if out is not None and out_text is not None:
-        out.write(out_text)
+        from nctrans import spilled
+        for piece in spilled.pieces(out_text):
+            out.write(piece)
         out_text = ""
     return Conversion(out_text, diags, ld.dialect or "", write)
 

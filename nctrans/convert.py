@@ -19,6 +19,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Optional
 
+from nctrans import spilled
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import Dialect
 from nctrans.ir.nodes import Block, Program
@@ -156,7 +157,7 @@ def _refused_in_place(program: Program, target: Dialect, refusals: list[Diagnost
         return None
     # what the refusals kept from being written before (another control's words the emitter
     # passes through) must read back in the target, or the conversion stays refused
-    back = target.parse(again.text, program.file)
+    back = target.parse(spilled.as_str(again.text), program.file)
     if any(d.severity == "error" for d in back.diagnostics):
         return None
     return again

@@ -29,7 +29,7 @@ import sys
 import re
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import ClassVar, Iterator, NamedTuple, Optional
+from typing import Any, ClassVar, Iterator, NamedTuple, Optional
 
 from nctrans.diagnostics import Diagnostic
 from nctrans.ir.nodes import Program
@@ -43,7 +43,7 @@ class ParseResult:
 
 @dataclass
 class EmitResult:
-    text: str
+    text: Any       # str, or a spilled.SpilledText where output spools (spilled.spooled_output)
     diagnostics: list[Diagnostic] = field(default_factory=list)
 
 
@@ -168,7 +168,10 @@ class Dialect:
 
     def with_header(self, text: str, comment: str) -> str:
         """`text` with the comment line `comment` after its opening lines (only those are looked
-        at: the text of a long program is not split into lines again)."""
+        at: the text of a long program is not split into lines again). A text whose lines went to
+        a file (spilled.SpilledText) gets it in its held head."""
+        if type(text) is not str:
+            return text.with_head(lambda head: self.with_header(head, comment))
         opening = re.compile(self.opening_lines)
         line = self.line_comment.format(comment)
         pos = 0

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
+from nctrans import spilled
 from nctrans.dialects.base import EmitResult
 from nctrans.dialects.base import get as get_dialect
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
@@ -201,7 +202,7 @@ class FagorEmitter(FagorSpelling, Emitter):
 
     def __init__(self, program: n.Program):
         super().__init__(program)
-        self.out: list[str] = []
+        self.out = spilled.output_lines()      # to a temporary file once many (spilled.OutputLines)
         self.targets: set = set()
         self.motion = "rapid"
         self.plane = "XY"
@@ -258,7 +259,7 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.out.append(f"%{_program_header(p)}")
         self.prologue()
         self.nodes(self._restart_as_loop(p.body if type(p.body) is list else list(p.body)))
-        return "\n".join(self.out) + "\n"
+        return spilled.joined(self.out)
 
     def _restart_as_loop(self, body: list) -> list:
         """M99 ending a main program of another dialect starts it again for ever: the body runs

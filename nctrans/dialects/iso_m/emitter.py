@@ -30,6 +30,7 @@ import itertools
 import math
 from typing import Any, Optional
 
+from nctrans import spilled
 from nctrans.diagnostics import at_span
 from nctrans.interp import corner_elements
 from nctrans.interp.frames import PLANE_AXES
@@ -160,7 +161,7 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def __init__(self, program: n.Program):
         super().__init__(program)
-        self.out: list[str] = []
+        self.out = spilled.output_lines()      # to a temporary file once many (spilled.OutputLines)
         self.var_map: dict = {}
         self.next_common = 100
         self.next_label = 90000
@@ -476,7 +477,7 @@ class IsoEmitter(IsoSpelling, Emitter):
             self.out[names_at:names_at] = self._name_table()
             if percent:
                 self.out.append("%")
-            return "\n".join(self.out) + "\n"
+            return spilled.joined(self.out)
         if self.sub_numbers and (head is None or p.dialect != self.dialect):
             # an O block after a headless main program would be read as the main program's number
             head = f"O{pl.stable_number('MAIN ' + (p.name or ''), set(self.sub_numbers.values()))}"
@@ -502,7 +503,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.out[names_at:names_at] = self._name_table()
         if percent:
             self.out.append("%")
-        return "\n".join(self.out) + "\n"
+        return spilled.joined(self.out)
 
     def _power_on(self) -> None:
         """The source's power-on feed mode and plane where this control's differ (a lathe's G99

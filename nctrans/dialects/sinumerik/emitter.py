@@ -34,6 +34,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
+from nctrans import spilled
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.calls import call_arguments
 from nctrans.dialects.base import EmitResult
@@ -123,7 +124,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         super().__init__(program)
         self.p = program
         self.t = self.table
-        self.lines: list[str] = []
+        self.lines = spilled.output_lines()    # to a temporary file once many (spilled.OutputLines)
         self.st = _State()
         self.pending = None
         self.targets = walk.program_jump_targets(program)
@@ -1247,7 +1248,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             return None
         res = iso.emit(ir.Program(self.p.file, "iso-m", ns, {}, {}))
         self.diags.extend(res.diagnostics)
-        lines = [l for l in res.text.splitlines() if l.strip() and not l.strip().startswith("%")]
+        lines = [l for l in spilled.as_str(res.text).splitlines() if l.strip() and not l.strip().startswith("%")]
         return "\n".join(lines)
 
     def nodes(self, ns: list, ind: str = "") -> None:
@@ -1425,7 +1426,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         # a compact body (base.CompactBody) is written item by item, its runs a few blocks at a time
         self.unit(self.restart_as_loop(body if type(body) is list else list(body)))
         self.subprograms()
-        return "\n".join(self.lines) + "\n"
+        return spilled.joined(self.lines)
 
     def restart_as_loop(self, body: list) -> list:
         """ISO M99 at the end of a main program from another dialect. In a program that reads G65
