@@ -64,8 +64,44 @@ def test_haas_m97_calls_the_numbered_blocks_up_to_m99():
     assert diags == []
 
 
-def test_m97_without_the_haas_profile_is_not_a_call():
-    # on a Fanuc M97 disarms macro interrupts: nothing is called, and the P word is reported
-    recs, diags, _ = run("G0 X0 Y0 Z5\nM97 P100\nM30\nN100 G1 Z-1 F100\nM99\n")
+def test_m97_with_an_address_makes_the_program_a_haas_program():
+    # a Fanuc M97 (interrupt disarm) stands alone in its block, else the control alarms (seed
+    # sinumerik-iso-milling L4113): "M97 P100" is the Haas local call whatever the header says.
+    # It was read as the Fanuc M97 with P kept verbatim (NC403), and the local M99 as a restart
+    recs, diags, prog = run("G0 X0 Y0 Z5\nM97 P100\nM30\nN100 G1 Z-1 F100\nM99\n")
+    assert ends(recs) == [(0, 0, 5), (0, 0, -1)]
+    assert [(d.line, d.rule, d.severity) for d in diags] == [(2, "NC407", "info")]
+    assert prog.meta["profile"] == "haas" and "N100" in prog.subprograms
+
+
+def test_a_bare_m97_stays_the_interrupt_disarm():
+    recs, diags, prog = run("G0 X0 Y0 Z5\nM97\n(M97 P100 IN A COMMENT)\nM30\n")
     assert ends(recs) == [(0, 0, 5)]
-    assert any(d.line == 2 and d.severity == "warning" for d in diags)
+    assert not prog.meta.get("profile") and not [d for d in diags if d.rule == "NC407"]
+
+
+# M97 P100 L2 (no header naming the control): N100..M99 runs twice from (0,0,5), incremental:
+# X+10 -> (10,0), Y+5 -> (10,5), X+10 -> (20,5), Y+5 -> (20,10); then G0 X50 Y0 absolute
+M97_REPEATED = ("%\nO1234 (PART 7)\nG21 G90 G17 G40 G80\nT1 M6\nS1000 M3\nG0 X0 Y0 Z5.\nM97 P100 L2\n"
+                "G0 X50. Y0\nM30\nN100 G91 G1 X10. F100.\nY5.\nG90\nM99\n%\n")
+
+
+def test_m97_repeat_count_runs_the_local_blocks_again():
+    recs, diags, _ = run(M97_REPEATED)
+    assert ends(recs) == [(0, 0, 5), (10, 0, 5), (10, 5, 5), (20, 5, 5), (20, 10, 5), (50, 0, 5)]
+    assert [d.rule for d in diags] == ["NC407"]
+
+
+def test_m97_converts_to_every_target_with_the_same_toolpath():
+    from nctrans import api, equivalence
+    source = run(M97_REPEATED)[0]
+    for target in ("sinumerik", "fagor", "iso-m", "iso-t"):
+        conv = api.transpile(M97_REPEATED, "iso-m", target, file="p.nc")
+        assert conv.text is not None, (target, conv.diagnostics)
+        back = pipeline.load_source(from_text(conv.text, "q"), "q", target)
+        assert equivalence.compare(source, list(pipeline.toolpath_of(back))) is None, target
+        if target == "sinumerik":
+            # the local subprogram N100 as a valid Sinumerik name (two letters first, seed L839:
+            # "N100" read back as a block number), called twice with P2; it was "N100() P2"
+            assert "N_100 P2" in conv.text.splitlines() and "PROC N_100" in conv.text
+            assert "LOOP" not in conv.text

@@ -1101,8 +1101,16 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
     meta.update({"program_number": None, "percent": False, "defaults": low.program_defaults(low.table),
                  "options": dict(opts)})
     if "profiles" in opts and not meta.get("profile"):
-        from nctrans.dialects.iso_m.profiles import detect
+        from nctrans.dialects.iso_m.profiles import detect, detect_by_block
         meta["profile"] = detect(text, opts)
+        found = detect_by_block(text, opts) if not meta["profile"] else None
+        if found is not None:
+            profile, line, block = found
+            meta["profile"] = profile
+            meaning = opts["profiles"][profile].get("meaning") or profile
+            diags.append(Diagnostic(
+                "NC407", "info", f"{block[:40]}: read as a program for the {meaning} (control "
+                f"profile {profile}): only that control accepts this block", file, line))
     if meta.get("profile"):
         low.local_call_code = str((opts.get("profiles") or {}).get(meta["profile"], {})
                                   .get("local_call", "")).upper()

@@ -24,6 +24,22 @@ def detect(text: str, options: dict) -> Optional[str]:
     return None
 
 
+def detect_by_block(text: str, options: dict) -> Optional[tuple[str, int, str]]:
+    """(profile, line, block text) of the first block only one profile's control reads (its
+    `detect_blocks` patterns, outside comments), or None: a regular-expression scan per pattern."""
+    for name, p in (options.get("profiles") or {}).items():
+        for pattern in p.get("detect_blocks", ()):
+            for m in re.finditer(pattern, text, re.IGNORECASE):
+                start = text.rfind("\n", 0, m.start()) + 1
+                before = text[start:m.start()]
+                if "(" in before or ";" in before:
+                    continue            # in a comment
+                end = text.find("\n", m.end())
+                block = text[start:end if end >= 0 else len(text)].strip()
+                return name, text.count("\n", 0, start) + 1, block
+    return None
+
+
 def common_ranges(meta: Optional[dict]) -> list[tuple[int, int]]:
     """The number ranges the program's profile makes plain common variables (none without one)."""
     meta = meta or {}

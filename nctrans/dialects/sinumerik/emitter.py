@@ -921,6 +921,11 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         m = _SUB_NUM.match(name)
         if m and self.p.dialect != DIALECT:
             return "L" + m.group(1)
+        m = _LETTER_NUMBER.match(name)
+        if m and self.p.dialect != DIALECT:
+            # a letter and digits (a Haas M97 local subprogram "N100") breaks the two-letter
+            # rule of names (seed L839) and reads back as an address word: N_100
+            return f"{m.group(1)}_{m.group(2)}"
         if self.p.dialect != DIALECT and not _NAME_OK.match(name):
             self.refuse_because(f"program name {name!r} is not a Sinumerik name")
             fixed = re.sub(r"\W", "_", name)[:31]
@@ -1587,6 +1592,7 @@ def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
 # what the Sinumerik front end makes of text that is no Sinumerik vocabulary
 _NOT_SINUMERIK = frozenset(("syntax error", "unknown function", "invalid number", "address without value"))
 
+_LETTER_NUMBER = re.compile(r"^([A-KM-Za-km-z])(\d+)$")     # not L<n>: a Sinumerik name itself
 _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z_0-9]{0,30}$")
 
 
