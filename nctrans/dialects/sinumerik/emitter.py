@@ -203,6 +203,30 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         cmp = self.expr(left, atom) + self.syntax.binary[e.op].text + self.expr(right, atom)
         return f"{given} AND ({cmp})" if e.op == "==" else f"NOT {given} OR ({cmp})"
 
+    def var(self, v: ir.Var, target: bool = False) -> str:
+        """A variable; another control's system variable (space "system" of a non-Sinumerik
+        source) by its neutral meaning, else refused: it was written verbatim (Fagor
+        V.E.LAYERS=3 in Sinumerik output, a name the control does not know)."""
+        if v.space == "system" and self.p.dialect != DIALECT:
+            return self.foreign_system_var(v, target)
+        return super().var(v, target)
+
+    def foreign_system_var(self, v: ir.Var, target: bool) -> str:
+        """Another control's named system variable (Fagor V.A.POS.X) as the Sinumerik variable of
+        the same neutral meaning (rules/<dialect>.toml [system_variables]); one no table gives a
+        meaning (a Fagor V.E interface variable: machine-wide, set by the HMI or the OEM) or that
+        is written is refused at its line (NC402: lowered where the run knows its value)."""
+        found = system_spelling(DIALECT, str(v.key)) if not v.indices else None
+        if found is None:
+            raise NotExpressible(f"the {self.p.dialect} system variable {v.key} (no Sinumerik variable "
+                                 "of the same meaning)")
+        if target:
+            raise NotExpressible(f"writing the {self.p.dialect} system variable {v.key}")
+        name, axis = found
+        self.info("foreign-sysvar", f"{self.p.dialect} system variables written as the Sinumerik "
+                                    "variables of the same meaning")
+        return f"{name}[{axis}]" if axis else name
+
     def foreign_var(self, v: ir.Var, target: bool, idx: str) -> str:
         """ISO macro variables: a G65 macro's locals by name, system variables (#1000 and up) by
         meaning, the rest as R parameters."""
