@@ -57,6 +57,15 @@ class TurningEmitter(iso.IsoEmitter):
             return []
         return super().w_ModeChange(s)
 
+    def w_SubCall(self, s: n.SubCall):
+        """A call made under G91: the called blocks' axis words are incremental at run time, but
+        system A writes an incremental word as U/W where it is written, and a subprogram is written
+        once, from its own text (its plain X0 Y0 came out absolute: the motion changed, exit 0)."""
+        if self.distance == "incremental":
+            raise NotExpressible(f"a call of {s.name or 'a subprogram'} under G91 (ISO turning has no "
+                                 "G91: the called program's incremental words would be written absolute)")
+        return super().w_SubCall(s)
+
     def _axes(self, target: dict) -> list:
         words = []
         for k, av in target.items():

@@ -880,6 +880,12 @@ class _Unit:
         return self.stack[-1].body if self.stack else self.root
 
 
+def _comment_only(node) -> bool:
+    """A block holding only a comment (no statement, number or label)."""
+    return (type(node) is ir.Block and not node.body and node.number is None and not node.label
+            and node.skip is None)
+
+
 def _span(file: str, line: Line) -> ir.Span:
     return ir.Span(file, line.lineno, 1, line.lineno, len(line.raw) + 1)
 
@@ -1168,7 +1174,9 @@ class _FileParse:
             if m and not raw.lstrip().startswith("%%"):
                 name = m.group(1)
                 um = _UNIT_NAME.match(name)
-                if seen_code or units[-1].pre or units[-1].proc:
+                # comment lines before the file's first header are the program's own: the header
+                # opened an uncalled second unit, and the program ran nothing (exit 0, no diagnostic)
+                if seen_code or units[-1].proc or any(not _comment_only(x) for x in units[-1].pre):
                     units.append(_Unit(um.group(1).upper() if um else name.upper()))
                     meta.setdefault("unit_headers", {})[units[-1].name] = name
                 else:
