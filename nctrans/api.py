@@ -501,24 +501,37 @@ def toolpath(source: Source, dialect: Optional[str] = None, machine: MachineLike
     writes them. The program runs while the result is iterated. `profile`: the control of the
     source's family that runs it (rules `[options.profiles]`, e.g. iso-m "linuxcnc")."""
     dirs = list(search_path)
+    opened = _open_run(source, dialect, dirs, file, profile)
+    return _run_opened(opened, _machine(machine, opened[1]), dirs)
 
+
+def _open_run(source: Source, dialect: Optional[str], dirs: list[PathLike], file: str,
+              profile: Optional[str], write: Optional[str] = None) -> tuple[Any, Optional[str]]:
+    """(a parsed Program or the loaded source, its dialect): a program ready to run, before the
+    machine it runs on is chosen. `write`: the other dialect of an equiv, whose profile the name
+    may be instead."""
+    if isinstance(source, Program):
+        _check_dialect(dialect)
+        return source, dialect or source.dialect
+    with _search_path(dirs):
+        ld = _load(source, dialect, stream=True, file=file, compact=True)
+    _set_profile(ld, profile, write)
+    return ld, ld.dialect
+
+
+def _run_opened(opened: tuple[Any, Optional[str]], m: Machine, dirs: list[PathLike]) -> Toolpath:
     def run(records: Iterator[ToolpathRecord]) -> Iterator[ToolpathRecord]:
         with _search_path(dirs):
             yield from records
 
-    if isinstance(source, Program):
-        _check_dialect(dialect)
-        m = _machine(machine, dialect or source.dialect)
+    what, dialect = opened
+    if isinstance(what, Program):
         diags: list[Diagnostic] = []
         with _search_path(dirs):
-            records = pipeline.run_toolpath(source, m, diags, dialect=dialect or source.dialect)
-        return Toolpath(run(records), diags, source.file, dialect or source.dialect)
-    with _search_path(dirs):
-        ld = _load(source, dialect, stream=True, file=file, compact=True)
-    _set_profile(ld, profile)
-    m = _machine(machine, ld.dialect)
-    return Toolpath(run(pipeline.toolpath_of(ld, m)), ld.diagnostics, ld.label, ld.dialect,
-                    parsed=ld.program is not None)
+            records = pipeline.run_toolpath(what, m, diags, dialect=dialect)
+        return Toolpath(run(records), diags, what.file, dialect)
+    return Toolpath(run(pipeline.toolpath_of(what, m)), what.diagnostics, what.label, dialect,
+                    parsed=what.program is not None)
 
 
 # --------------------------------------------------------------------------- lint
@@ -677,6 +690,33 @@ class Equivalence:
         return f"<Equivalence {'yes' if self.equivalent else 'no'}: {self.message}>"
 
 
+def _equiv_profiles(oa: tuple[Any, Optional[str]], ob: tuple[Any, Optional[str]],
+                    profile: Optional[str], profile_b: Optional[str]) -> None:
+    """`profile` runs A, and B too where B's table names it (both ISO milling programs as
+    LinuxCNC runs them); `profile_b` runs B. NCError when a name is neither's."""
+    if profile is not None:
+        in_a, in_b = profile in _profiles(oa[1]), profile in _profiles(ob[1])
+        if not in_a and not in_b:
+            raise NCError(f"profile {profile!r} is not one of {oa[1] or 'A'}'s: "
+                          f"{', '.join(_profiles(oa[1])) or 'it has none'}, nor of {ob[1] or 'B'}'s: "
+                          f"{', '.join(_profiles(ob[1])) or 'it has none'}")
+        if in_a and isinstance(oa[0], pipeline.Loaded):
+            _set_profile(oa[0], profile)
+        if in_b and profile_b is None and isinstance(ob[0], pipeline.Loaded):
+            _set_profile(ob[0], profile)
+    if profile_b is not None and isinstance(ob[0], pipeline.Loaded):
+        _set_profile(ob[0], profile_b)
+
+
+def _equiv_machine(machine: MachineLike, da: Optional[str], db: Optional[str]) -> Machine:
+    """The one machine both programs of an equiv run on: the given one, else the built-in machine
+    of their dialects, the lathe where either is a turning dialect."""
+    if machine is not None:
+        return _machine(machine, da)
+    kinds = {da: pipeline.load_machine(None, da), db: pipeline.load_machine(None, db)}
+    return next((m for m in kinds.values() if m.kind == "lathe"), kinds[da])
+
+
 def _budget_spent(diags: list[Diagnostic]) -> bool:
     """The run was cut by the step budget (NC205 as an error: an endless loop)."""
     return any(d.rule == "NC205" and d.severity == "error" and "step budget" in d.message for d in diags)
@@ -684,20 +724,29 @@ def _budget_spent(diags: list[Diagnostic]) -> bool:
 
 def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[str] = None,
           read_b: Optional[str] = None, machine: MachineLike = None,
-          search_path: Iterable[PathLike] = ()) -> Equivalence:
+          search_path: Iterable[PathLike] = (), profile: Optional[str] = None,
+          profile_b: Optional[str] = None) -> Equivalence:
     """Compare the toolpaths of two programs (text, paths or parsed Programs) within `tol` mm,
-    as `nctrans equiv` does."""
+    as `nctrans equiv` does. Both run on one machine: `machine`, else the built-in one of their
+    dialects, and the lathe where one of them is a turning dialect (a lathe program converted to
+    a milling dialect's language still runs on the lathe). `profile`: the control that runs A
+    (rules `[options.profiles]`), and B where B's table names it too; `profile_b`: B's own."""
     from nctrans import equivalence as _equivalence
     if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not math.isfinite(tol) or tol <= 0:
         raise NCInputError(f"tol must be a positive finite number of mm, not {tol!r}")
     # Both programs run at once, in step (the comparison reads each toolpath as a stream, so
     # memory stays flat); the search path is set once around both runs.
     from nctrans.interp.flow import RESTART_MAIN
+    dirs = list(search_path)
+    oa = _open_run(a, read_a, dirs, "<a>", None)
+    ob = _open_run(b, read_b, dirs, "<b>", None)
+    _equiv_profiles(oa, ob, profile, profile_b)
+    ma = mb = _equiv_machine(machine, oa[1], ob[1])
     restarts = RESTART_MAIN.set(True)       # M99 in a main program loops, as a LOOP does
     try:
-        with _search_path(search_path):
-            ta = toolpath(a, read_a, machine, file="<a>")
-            tb = toolpath(b, read_b, machine, file="<b>")
+        with _search_path(dirs):
+            ta = _run_opened(oa, ma, dirs)
+            tb = _run_opened(ob, mb, dirs)
             try:
                 diff = _equivalence.compare(ta, tb, tol) if ta.parsed and tb.parsed else None
                 for _ in ta:                # the rest of each run: its diagnostics complete

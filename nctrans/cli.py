@@ -381,7 +381,8 @@ def cmd_equiv(args) -> int:
     tol = api.DEFAULT_TOL if args.tol is None else args.tol
     try:
         result = api.equiv(_cli_source(args.a), _cli_source(args.b), tol=tol, read_a=args.from_a,
-                           read_b=args.from_b, machine=machine)
+                           read_b=args.from_b, machine=machine, profile=args.profile,
+                           profile_b=args.profile_b)
     except api.NCInputError as e:
         raise UsageError(str(e).replace("tol must", "--tol must")) from None
     _print_text_diags(result.diagnostics, sys.stderr)
@@ -620,6 +621,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--machine", metavar="MACHINE.toml")
     p.add_argument("--tol", type=float, default=None, metavar="MM",
                    help="tolerance in mm (default 0.001)")
+    p.add_argument("--profile", metavar="NAME", help="control of A's family that runs it (profiles of its "
+                   "rules table, e.g. linuxcnc), and B's too where B's table names it; detected from the "
+                   "header comments when omitted")
+    p.add_argument("--profile-b", metavar="NAME", help="control of B's family that runs it (default: "
+                   "--profile where B's table names it, else detected)")
     _add_search_path(p)
     p.set_defaults(func=cmd_equiv)
 
