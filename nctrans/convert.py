@@ -168,23 +168,30 @@ def _lower_whole(program: Program, target: Dialect, flatten_with, refusals: list
     a construct cannot be lowered on its own; (None, [the held-limit or step-budget error]) when
     that is refused too (its other reasons are the refusals themselves; a limit is news to the
     user, so the caller adds it to them)."""
+    from nctrans.lower.flatten import UNKNOWN_VALUE_NOTE
     flat_diags: list[Diagnostic] = []
     flat = lower_for(flatten_with(flat_diags), target, flat_diags)
     again = target.emit(flat)
     found = [*(_whole_note(d, target) for d in refusals), *flat_diags, *again.diagnostics]
     if any(d.severity == "error" for d in found):
         return None, [d for d in found if d.severity == "error" and (
-            HELD_LIMIT_NOTE in d.message or d.rule == "NC205")]
+            HELD_LIMIT_NOTE in d.message or d.rule == "NC205" or UNKNOWN_VALUE_NOTE in d.message)]
     return again, found
 
 
 def whole_failure(refusals: list[Diagnostic], whole: list[Diagnostic]) -> list[Diagnostic]:
     """The refusals, saying why lowering the whole program failed too when a budget stopped it
-    (`whole`: that lowering's diagnostics): an endless loop is named at its line."""
+    or it would fix a value only the machine knows (`whole`: that lowering's diagnostics): an
+    endless loop is named at its line."""
+    from nctrans.lower.flatten import UNKNOWN_VALUE_NOTE
     stop = next((d for d in whole if d.rule == "NC205" and d.severity == "error"), None)
-    if stop is None:
+    unknown = next((d for d in whole if d.rule == "NC402" and UNKNOWN_VALUE_NOTE in d.message), None)
+    if stop is not None:
+        why = f"{BUDGET_NOTE} {stop.line}: {stop.message}"
+    elif unknown is not None:       # (a compensation radius of a tool the program never chose)
+        why = f"lowering the whole program instead fails at line {unknown.line}: {unknown.message}"
+    else:
         return refusals
-    why = f"{BUDGET_NOTE} {stop.line}: {stop.message}"
     return [dataclasses.replace(d, message=f"{d.message}; {why}") for d in refusals]
 
 

@@ -165,10 +165,14 @@ class Mesh:
 class ToolChange:
     """What the machine's tool change (its M6 macro) expects and does: lint NC213 reports a change
     while something in `requires_stopped` runs; `stops_spindle` (None: the dialect's default) makes
-    a feed move before the spindle is started again NC209."""
+    a feed move before the spindle is started again NC209; `by_t_word`: whether T changes the tool
+    without M6."""
     __pydantic_config__ = {"extra": "forbid"}
     requires_stopped: list[Literal["spindle", "coolant"]] = field(default_factory=list)
     stops_spindle: Optional[bool] = None
+    # a T word changes the tool at once (True) or only M6 does (False); None: the dialect's
+    # default for the machine's kind (nctrans.interp.tool_change)
+    by_t_word: Optional[bool] = None
 
 
 @dataclass

@@ -13,7 +13,7 @@ MACHINE = Machine(name="m", kind="mill", axes={"X": _AX, "Y": _AX, "Z": _AX},
 # the seed's square (L12474-12480) without TRANSMIT: 20 x 20 about the origin, run counter-
 # clockwise with G41, so the tool is left of the path: inside the square, where the corners are
 # plain intersections of the offset sides
-SQUARE = ("G17 G90 G0 X30 Y-10 Z0 T1 D1 F1000\nG1 X10 Y-10 G41 OFFN={offn}\nX10 Y10\nX-10\n"
+SQUARE = ("G17 G90 G0 X30 Y-10 Z0 T1 M6 D1 F1000\nG1 X10 Y-10 G41 OFFN={offn}\nX10 Y10\nX-10\n"
           "Y-10\nX10\nG0 X30 G40 OFFN=0\nM30\n")
 
 

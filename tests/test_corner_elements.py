@@ -230,7 +230,7 @@ def test_rounding_under_cutter_compensation_rounds_the_programmed_contour():
     ax = Axis(min=-500.0, max=500.0)
     machine = Machine(name="m", kind="mill", axes={"X": ax, "Y": ax, "Z": ax},
                       tools=[Tool(number=1, length=0.0, radius=1.0)])
-    text = "G17 G90 G0 X-10 Y0 Z0 F1000 T1 D1\nG41 G1 X0 Y0\nX10 RND=3\nY10\nG40 X20 Y20\nM30\n"
+    text = "G17 G90 G0 X-10 Y0 Z0 F1000 T1 M6 D1\nG41 G1 X0 Y0\nX10 RND=3\nY10\nG40 X20 Y20\nM30\n"
     recs = list(nctrans.toolpath(text, "sinumerik", machine))
     arcs = [r for r in recs if r.kind == "arc" and r.line == 3]
     assert arcs, [r.kind for r in recs]

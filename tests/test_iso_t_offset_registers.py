@@ -41,7 +41,12 @@ def test_a_fagor_d_with_no_tool_is_not_written_without_its_offset():
     conv = nctrans.transpile(src, read="fagor", write="iso-t")
     said = [d for d in conv.diagnostics if d.line == 3 and "no tool known" in d.message]
     assert said, conv.diagnostics
-    assert "G41" not in conv.text or t_words(conv.text)
+    assert conv.text is None or "G41" not in conv.text or t_words(conv.text)
+    # nor lowered whole with some tool's radius: the radius of D1 of a tool the program never
+    # chose is not known (NC123), so the whole-program lowering is refused too and says why
+    assert conv.text is None
+    assert [d for d in conv.diagnostics if d.line == 3 and "NC123" not in d.rule
+            and "tool the machine holds" in d.message], conv.diagnostics
 
 
 def test_an_iso_mill_length_and_radius_register_that_differ_are_refused_at_the_line():

@@ -44,7 +44,7 @@ from typing import Any, Iterator, Optional
 
 from nctrans import plainrun
 from nctrans.diagnostics import at_span
-from nctrans.interp import edge_data, ggroups, settable_frames, sysvars, tool_edges
+from nctrans.interp import comp_radius, edge_data, ggroups, settable_frames, sysvars, tool_change, tool_edges
 from nctrans.interp.evaluate import AxisName, EvalError, Evaluator, FrameValue
 from nctrans.interp.frames import Offsets, PLANE_AXES, ProgrammableFrame
 from nctrans.interp.lathe import LatheMixin
@@ -154,6 +154,10 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.master_spindle = 1           # SETMS(n) (spindle_position.py); None: not known
         self.thread_start = 0.0           # SD 42000 THREAD_START_ANGLE (thread_starts.py)
         self.comp_d_reported = False      # NC208 once per G41/G42 without a D word
+        self.comp_on_span = None          # the G41/G42 block of the episode (comp_radius.py)
+        self.comp_checked = True          # its radius's source checked at the first move (NC123)
+        self.offsets_of_tool = comp_radius.offsets_of_active_tool(program.dialect)
+        self.t_changes_tool = tool_change.changes_on_t_word(machine, program.dialect)
         self.last_from: Optional[dict] = None     # previous move (tangent of Sinumerik CT)
         self.last_arc = None
         self.comp = None

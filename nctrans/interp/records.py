@@ -8,7 +8,7 @@ A mixin of Interpreter.
 """
 from __future__ import annotations
 
-from nctrans.interp import corner_elements, episode_frame
+from nctrans.interp import comp_radius, corner_elements, episode_frame
 from nctrans.interp.cutter_comp import PlannedMove
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.toolpath import ToolpathRecord
@@ -55,6 +55,9 @@ class RecordsMixin:
 
     def _emit_move(self, kind, start, end, center, cw, turns, payload) -> None:
         """A move of the programmed contour on to cutter compensation and the records."""
+        if not self.comp_checked and self.comp is None and not self.comp_exit:
+            self.comp_checked = True
+            comp_radius.check_entry(self)       # NC123: the radius of a tool the program never chose
         if self.comp_exit or self.comp is not None or (
                 self.st.comp_side != "off" and (self.comp_radius or self.contour_offset)):
             if self._comp_move(kind, start, end, center, cw, turns, payload):

@@ -14,6 +14,8 @@ from nctrans.interp.words import LENGTH_WORDS
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_LIMITS, UNMODELLED_MODES
 
+_BY_T_WORD = n.ToolChange(turret=True)      # the change a T word makes where it changes the tool
+
 class StatementsMixin:
     """Modal and setting statements."""
 
@@ -70,6 +72,7 @@ class StatementsMixin:
             st.set(g, v)
             if v != prev:
                 self.comp_d_reported = False
+                self.comp_on_span, self.comp_checked = self.span, v == "off"
             if v == "off" and prev != "off" and self.comp is not None:
                 self.comp_exit = True
             elif v != "off" and self.comp is not None and prev != v:
@@ -149,10 +152,14 @@ class StatementsMixin:
         raw = f()
         if isinstance(raw, str):          # Sinumerik tool management: T="DRILL"
             self.st.tool_selected = self._named_tool(raw)
+            if self.t_changes_tool:
+                self._h_toolchange(_BY_T_WORD)
             return
         v = self._value(lambda: raw, "tool number")
         if v is not None:
             self.st.tool_selected = int(round(v))
+            if self.t_changes_tool:             # a turret, or T set to change (tool_change.py)
+                self._h_toolchange(_BY_T_WORD)
 
     def _named_tool(self, name: str) -> int:
         """The number of a tool selected by name: the machine's tool with that `name`, else a
@@ -172,7 +179,7 @@ class StatementsMixin:
 
     def _h_toolchange(self, s):
         st = self.st
-        if s.turret and st.tool is not None and st.tool == st.tool_selected:
+        if (s.turret or self.t_changes_tool) and st.tool is not None and st.tool == st.tool_selected:
             return                              # the turret stays: only the offset changes
         self._rc_tool_change()
         if st.tool_selected is None:
@@ -231,7 +238,7 @@ class StatementsMixin:
             return contour_offset.compile_word(self, s)
         if s.reason == rigid_tap.COMPENSATING_CHUCK:
             return (rigid_tap.compensating_chuck, self)
-        if spindle_position.is_modelled(s):
+        if spindle_position.is_positioning(s):
             return (spindle_position.position, spindle_position.compile_position(self, s))
         if spindle_position.is_setms(s):
             return (spindle_position.set_master, (self, s))

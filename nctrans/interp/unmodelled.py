@@ -31,9 +31,12 @@ _CODE = re.compile(r"\s*([A-Za-z_$][A-Za-z_0-9.]*)")
 # must not look clean (issue 8: toolpath, lint and check all say it at its line). By name, so a
 # rule added later for another unmodelled construct (NC113 turning-cycle-not-modelled) is one too.
 NOT_ANALYSED_SUFFIXES = ("not-modelled", "not-run", "not-in-model")
-# NC217/NC218: a programmed rounding or chamfer the analysed corner runs without
+# NC217/NC218: a programmed rounding or chamfer the analysed corner runs without (where the
+# control shrinks it, the machine's corner is not the analysed one); NC123: a compensation radius
+# of a tool the program never chose, analysed as 0
 NOT_ANALYSED_NAMES = frozenset(("unresolved-call", "unknown-at-analysis-time", "analysis-truncated",
-                                "corner-element-not-inserted", "corner-element-alarm"))
+                                "corner-element-not-inserted", "corner-element-alarm",
+                                "compensation-radius-of-unknown-tool"))
 
 
 @lru_cache(maxsize=None)

@@ -199,8 +199,9 @@ class _Walker:
             return
         self.dropped.add(key)
         what = f"{s.text!r}" + (f" ({s.reason})" if s.reason else "")
-        if spindle_position.is_modelled(s):
-            return                     # modelled: its spindle record is written (interp/spindle_position.py)
+        if spindle_position.is_positioning(s):
+            return                     # run: its spindle record is written, or NC220 says it addressed
+            #                            a spindle that is not the master (interp/spindle_position.py)
         if s.reason == COMPENSATING_CHUCK:                       # nctrans.interp.rigid_tap
             self.diags.append(at_span("NC401", "info", f"--flatten writes {s.text} (tapping with a "
                                       "compensating chuck) as the block's G1 feed move it is; the "
@@ -692,18 +693,21 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
                                           f"{d.message}", d.file, d.line, d.column, d.end_line,
                                           d.end_column))
         elif stop_when_incomplete and takes_unknown_path(d):
-            diagnostics.append(Diagnostic("NC402", "error", f"plain motion would take one path for "
-                                          f"a value only the machine knows: {d.message}", d.file,
+            diagnostics.append(Diagnostic("NC402", "error", f"{UNKNOWN_VALUE_NOTE}: {d.message}", d.file,
                                           d.line, d.column, d.end_line, d.end_column))
     walker.report()
+
+
+UNKNOWN_VALUE_NOTE = "plain motion would take one path for a value only the machine knows"
 
 
 def takes_unknown_path(d: Diagnostic) -> bool:
     """A run diagnostic saying the path taken depends on a value unknown to the analysis (NC107 as
     a warning: a condition taken as false, a word ignored; a probe result, a PLC input): plain
     motion written from that run would fix one path the machine may not take. `--flatten` asks for
-    it and says so (the warning stays); a lowering nctrans chooses on its own refuses it."""
-    return d.rule == "NC107" and d.severity == "warning"
+    it and says so (the warning stays); a lowering nctrans chooses on its own refuses it. NC123
+    likewise: a cutter compensation radius of a tool the program never chose (interp/comp_radius)."""
+    return d.rule in ("NC107", "NC123") and d.severity == "warning"
 
 
 def _incomplete(d: Diagnostic) -> bool:

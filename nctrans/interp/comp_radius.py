@@ -1,0 +1,51 @@
+"""Where the radius of G41/G42 comes from, and saying so where the program does not know it (NC123).
+
+Two kinds of offset number (rules table option `offsets_of_active_tool`):
+- ISO D (Fanuc, LinuxCNC) names a register of the control's offset table, whatever tool is in the
+  spindle: the machine file's `radius_offsets`, else tool n's radius. D0 is offset 0; G41 with no D
+  at all is NC208 (records.py).
+- Sinumerik D ("compensation data for a certain tool T", seed L24265; edges of the active tool,
+  L13484-13490) and Fagor D (a corrector of
+  the active tool, seed L5711-5803: `T2` then `D2` selects D2 of the still active T1) belong to the
+  tool in the spindle. When no tool change precedes the compensation in the run, that tool is the
+  one the machine holds from before (in a subprogram file: its caller's), which the program does
+  not say. Unless the machine file gives that number as a flat offset (`radius_offsets`, Sinumerik
+  flat D numbers, seed L13488), the radius is not known: NC123 at the G41/G42 line, and the
+  analysis runs the programmed contour (radius 0, as a control with no tool or D0 compensates)
+  instead of taking some tool's radius from the machine file. A conversion that would
+  lower the compensation into coordinates refuses it (lower/flatten.takes_unknown_path).
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+
+def offsets_of_active_tool(dialect: Optional[str]) -> bool:
+    from nctrans.rules import option
+    return bool(option(dialect, "offsets_of_active_tool", False))
+
+
+def check_entry(it) -> None:
+    """Before the first move of a G41/G42 episode: NC123 and radius 0 where the radius is the
+    unknown tool's. `it`: the Interpreter (st, machine, comp_radius, default_edge, diag)."""
+    if not it.offsets_of_tool or it.st.tool is not None:
+        return
+    d = it.st.radius_index
+    defaulted = d is None and bool(it.default_edge)
+    if defaulted:                               # the edge a tool brings (Sinumerik D1)
+        d = it.default_edge
+    if not d:
+        return                                  # D0 / no D: no offset (NC208 where no D)
+    if d in getattr(it.machine, "radius_offsets", {}):
+        return                                  # a flat offset number the machine file gives
+    side = it.st.comp_side
+    code = "G41" if side == "left" else "G42"
+    which = f"D{d}" if it.st.radius_index is not None and not defaulted else f"D{d} (the default edge)"
+    it.diag("NC123", "warning",
+            f"{code} with {which} of the active tool, but no tool change precedes it in the program: the "
+            "radius is that of the tool the machine holds (a subprogram's: its caller's), which the "
+            "program does not say; analysed on the programmed contour (radius 0). Change the tool "
+            "before (T.. M6), or give the offset number in the machine file's radius_offsets",
+            it.comp_on_span)
+    it.st.radius_index = d
+    it.comp_radius = 0.0
