@@ -47,6 +47,29 @@ def test_setms_moves_the_master_role():
     assert said == [("NC220", 3), ("NC220", 4), ("NC220", 7)]
 
 
+def test_a_numbered_spos_of_the_master_positions_it():
+    text = ("G0 X0 Y0 Z10\nM3 S1000\nSPOS[1]=90\nSETMS(2)\nSPOS[2]=45\nSPOS[2]=IC(10)\nSPOS[3]=5\n"
+            "SPOSA[2]=DC(0)\nM30\n")
+    events, said = _run(text)
+    # SPOS[1] (line 3) under the configured master is SPOS=90; SETMS(2) (line 4) said; SPOS[2]=45
+    # (line 5) is the master's now, as SPOS=45 (it was NC220 before); IC(10) from 45 is 55 (line 6);
+    # SPOS[3] (line 7) is not the master: said, nothing recorded; SPOSA[2]=DC(0) (line 8): 0
+    assert events == [(2, 1000.0, "cw", None), (3, 1000.0, "orient", 90.0), (5, 1000.0, "orient", 45.0),
+                      (6, 1000.0, "orient", 55.0), (8, 1000.0, "orient", 0.0)]
+    assert said == [("NC220", 4), ("NC220", 7)]
+
+
+def test_a_numbered_spos_of_the_master_converts_from_the_run():
+    # SPOS[2]=0 after SETMS(2): the text alone does not say spindle 2 is the master, so no writer
+    # spells it as its own master positioning; the run does, and the ISO program (one spindle) gets
+    # the M19 of the lowered block
+    from nctrans import api
+    text = "G0 X0 Y0 Z10\nM3 S1000\nSETMS(2)\nSPOS[2]=0\nG1 X10 F100\nM30\n"
+    conv = api.transpile(text, "sinumerik", "iso-m")
+    assert conv.text is not None and "M19" in conv.text.splitlines()
+    assert [d for d in conv.diagnostics if d.line == 4 and d.rule == "NC401"]
+
+
 def test_a_computed_master_number_leaves_numbered_words_unmodelled():
     text = "R1=2\nM3 S1000\nSETMS(R1)\nS1=300\nS=400\nM30\n"
     events, said = _run(text)

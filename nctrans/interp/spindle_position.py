@@ -21,11 +21,13 @@ spindle n the master, SETMS alone gives the role back to the configured one, spi
 machine data 20090 SPIND_DEF_MASTER_SPIND, 1 by default; the seeds do not describe SETMS]. A
 spindle word written with its number reaches the master only where that number is the master's:
 `S2=500` under master 1, `SPOS[1]=90` or `S1=300` after SETMS(2) are NC220 at their line, not
-the master's speed or angle (`S2=500` used to set the master's speed). `SPOS[n]` with n other
-than 1 stays NC220 even where n is the master (the writers would otherwise take it for the
-master's without the SETMS); plain `S`, `SPOS=` address whichever spindle is the master. The
-seed's SPOS[2] examples (L21470-21482) position a following spindle under synchronised spindle
-coupling (COUPON), an overlay on the coupled motion nctrans does not model either.
+the master's speed or angle (`S2=500` used to set the master's speed). `SPOS[n]=` positions the
+master where n is the master: `SPOS[1]=` under the configured master, `SPOS[2]=` after SETMS(2),
+as `SPOS=` does; plain `S`, `SPOS=` address whichever spindle is the master. A writer spells only
+the plain and spindle-1 forms as its own master positioning (`is_modelled`): whether n is the master
+is known to the run, not to the text. The seed's SPOS[2] examples (L21470-21482) position a
+following spindle under synchronised spindle coupling (COUPON), an overlay on the coupled motion
+nctrans does not model either.
 """
 from __future__ import annotations
 
@@ -39,10 +41,27 @@ from nctrans.ir import nodes as n
 REASON = "spindle positioning"
 
 
-def is_modelled(s: n.Passthrough) -> bool:
-    """A SPOS/SPOSA word of the master spindle, which this module runs (the front end gives it its
-    address and value; other spindles' SPOS[n]= come without and stay NC220)."""
+def is_positioning(s: n.Passthrough) -> bool:
+    """A SPOS/SPOSA word this module runs: plain, or with a constant spindle number (the front end
+    gives it its address and value); the run positions the master, any other spindle is NC220."""
     return s.reason == REASON and bool(s.address) and s.value is not None
+
+
+def is_modelled(s: n.Passthrough) -> bool:
+    """A positioning word that names the master whatever SETMS says: plain (`SPOS=`), or spindle
+    1's (`SPOS[1]=`, the configured master). What a writer may spell as its own dialect's
+    master-spindle positioning; `SPOS[2]=` is the master's only after SETMS(2), which only the
+    run knows."""
+    return is_positioning(s) and spindle_number(s) in (None, 1)
+
+
+_NUMBERED_WORD = re.compile(r"\s*[A-Za-z_]\w*\s*\[\s*(\d+)\s*\]\s*=")
+
+
+def spindle_number(s: n.Passthrough) -> Optional[int]:
+    """The spindle number a positioning word is written with (SPOS[2]=.. -> 2), else None."""
+    m = _NUMBERED_WORD.match(s.text)
+    return int(m.group(1)) if m else None
 
 
 # Siemens position modes: absolute (direction by the shortest way or as written) and incremental
@@ -62,8 +81,9 @@ def compile_position(it, s: n.Passthrough):
 def position(d) -> None:
     """Run one SPOS/SPOSA: stop the spindle at the angle and record the event."""
     it, s, incremental, value = d
-    if "[" in s.text.split("=", 1)[0] and it.master_spindle != 1:
-        _not_the_master(it, s, 1)               # SPOS[1]= after SETMS(n)
+    number = spindle_number(s)
+    if number is not None and number != it.master_spindle:
+        _not_the_master(it, s, number)          # SPOS[2]= under master 1, SPOS[1]= after SETMS(2)
         return
     angle = it._value(value, s.address)
     if angle is None:

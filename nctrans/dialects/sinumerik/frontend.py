@@ -181,9 +181,10 @@ _RPARAM = re.compile(r"R(\d+)$")
 SPINDLE_POSITIONING = ("SPOS", "SPOSA")
 
 
-def _master_spindle(index: list) -> bool:
-    """SPOS[1]: the index names spindle 1 (a constant)."""
-    return len(index) == 1 and isinstance(index[0], ir.Num) and index[0].value == 1
+def _spindle_number(index: list) -> bool:
+    """SPOS[n]: the index is a constant spindle number (the run positions the master, SETMS)."""
+    return (len(index) == 1 and isinstance(index[0], ir.Num) and index[0].value >= 1
+            and index[0].value == int(index[0].value))
 _INTEGER_ADDRESSES = frozenset("NGMLTDP")     # spec 2.2 / table: integer values only
 
 
@@ -642,8 +643,8 @@ class Lowerer:
                         w.indirect.append((_index(idx)[0], _axis_value(value)))
                     elif name == "G" and (select := self.indirect_g(_index(idx), value)) is not None:
                         w.out.append(select)
-                    elif name in SPINDLE_POSITIONING and _master_spindle(_index(idx)):
-                        # SPOS[1]=..: the master spindle (other spindles stay unmodelled, NC220)
+                    elif name in SPINDLE_POSITIONING and _spindle_number(_index(idx)):
+                        # SPOS[n]=..: the master's where n is the master (SETMS), else NC220 at run
                         w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT, name, value))
                     elif name in self.pass_words:
                         w.out.append(ir.Passthrough(_t(text), self.pass_words[name], DIALECT))
