@@ -28,11 +28,13 @@ def run(text):
 
 def test_a_rounding_goes_past_a_g1_that_moves_nothing():
     # X line to (10, 0), Y line up: RND=2 at the 90 degree corner runs from (8, 0) to (10, 2)
-    # about (8, 2), counter-clockwise; the G1 X10 between moves nothing
+    # about (8, 2), counter-clockwise; the G1 X10 between moves nothing: its block keeps its record
+    # (a move of no length, line 3) where the tool stands then, after the arc, at (10, 2)
     recs, said = run(HEAD + "G1 X10 RND=2\nG1 X10\nY10\nM30\n")
     assert said == []
-    assert [(r.kind, r.end["X"], r.end["Y"]) for r in recs] == [
-        ("linear", 8.0, 0.0), ("arc", 10.0, 2.0), ("linear", 10.0, 10.0)]
+    assert [(r.line, r.kind, r.end["X"], r.end["Y"]) for r in recs] == [
+        (2, "linear", 8.0, 0.0), (2, "arc", 10.0, 2.0), (3, "linear", 10.0, 2.0), (4, "linear", 10.0, 10.0)]
+    assert recs[2].start == recs[2].end
     arc = recs[1]
     assert (arc.center["X"], arc.center["Y"], arc.direction) == (8.0, 2.0, "ccw")
 

@@ -68,6 +68,16 @@ class Move:
 
 
 @dataclass
+class StillMove:
+    """A G1 that moves nothing, held with the records behind a corner element (its block counts as
+    one without motion): replayed as a move of no length where the tool then stands, so the
+    toolpath keeps its block (line, feed, modes) as it does without a corner."""
+    file: str
+    line: int
+    payload: tuple
+
+
+@dataclass
 class CornerStage:
     """The interpreter's corner state; exists only while something is programmed or held."""
     block: Optional[tuple] = None           # (kind, value, span, dialect) of this block's word
@@ -168,6 +178,7 @@ def move(it, kind, start, end, center, cw, turns, payload) -> None:
         # goes to the next block that moves, as long as few enough stand between
         cs.still.add((payload[0], payload[1]))
         if not _too_many_between(it, cs):
+            cs.queued.append(StillMove(payload[0], payload[1], payload))
             return
         it.corner = cs                  # the flush may have let the stage go; this move uses it
     new = Move(kind, start, end, center, cw, turns, payload, it.span)
@@ -237,7 +248,7 @@ def flush(it, why: str = "no contour move follows it") -> None:
         cs.pending = None
         _not_inserted(it, p, why)
         _emit(it, p)
-    _replay(it, cs)
+    _replay(it, cs, p.end if p is not None else None)
     _idle(it)
 
 
@@ -251,11 +262,17 @@ def finish(it) -> None:
     flush(it)
 
 
-def _replay(it, cs: CornerStage) -> None:
+def _replay(it, cs: CornerStage, at: Optional[dict] = None) -> None:
+    """The records that waited behind the held move, in order; a StillMove as a move of no length
+    at `at` (program coordinates: where the held move, or the element after it, left the tool)."""
     cs.still = set()
     queued, cs.queued = cs.queued, []
     for rec in queued:
-        it._push_record(rec)
+        if type(rec) is StillMove:
+            if at is not None:
+                it._emit_move("linear", at, at, None, None, None, rec.payload)
+        else:
+            it._push_record(rec)
 
 
 def _emit(it, m: Move) -> None:
@@ -369,7 +386,7 @@ def _join(it, p: Move, new: Move) -> Move:
     if why:
         _not_inserted(it, p, why, control_does)
         _emit(it, p)
-        _replay(it, it.corner)
+        _replay(it, it.corner, p.end)
         return new
     first, second = _element(p, a1, a2), _element(new, a1, a2)
     kind, value, feed, dialect = p.corner
@@ -385,7 +402,7 @@ def _join(it, p: Move, new: Move) -> Move:
             _not_inserted(it, p, why)
     if corner is None:
         _emit(it, p)
-        _replay(it, it.corner)
+        _replay(it, it.corner, p.end)
         return new
 
     def at(point, like):
@@ -402,7 +419,7 @@ def _join(it, p: Move, new: Move) -> Move:
     file, line = p.payload[0], p.payload[1]
     element_payload = (file, line, feed if feed is not None else pay[2], pay[3], pay[4], pay[5], plane, pay[7])
     it._emit_move(corner.kind, t1, t2, corner.center, corner.cw, None, element_payload)
-    _replay(it, cs)
+    _replay(it, cs, t2)
     return replace(new, start=t2)
 
 
