@@ -233,7 +233,7 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
     _check_dialect(write)
     from nctrans.dialects.emit import conversion_machine, target_profile
     written_for = _target_profile(write, profile)
-    with _search_path(search_path), conversion_machine(lambda: _machine(machine, read)), \
+    with _search_path(search_path), conversion_machine(lambda: _equiv_machine(machine, read, write)), \
             target_profile(write, written_for):
         # written as it goes (`out`): a program that holds structure is parsed compact (its plain
         # stretches held as spans of the text: --flatten runs them, the emitters write them a few
@@ -246,7 +246,8 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
         if ld.streamed is not None:
             streamed: Optional[Conversion]
             if flatten:
-                streamed = _transpile_flat_stream(ld, target, strict, out, _machine(machine, ld.dialect))
+                streamed = _transpile_flat_stream(ld, target, strict, out,
+                                                  _equiv_machine(machine, ld.dialect, write))
             else:
                 streamed = _transpile_stream(ld, target, strict, out, machine)
             if streamed is not None:
@@ -260,7 +261,8 @@ def transpile(text: Union[str, "os.PathLike[str]"], read: Optional[str] = None, 
         if ld.program is not None and not any(d.severity == "error" for d in diags):
             from nctrans.convert import convert
             program = ld.program
-            flat_machine = _machine(machine, ld.dialect)
+            # a lathe program written for another control runs on the lathe (as equiv runs both)
+            flat_machine = _equiv_machine(machine, ld.dialect, write)
 
             # the plain motion held whole is bounded, except where the caller asked for the
             # whole flattened text (flatten=True and no `out` to stream to)
@@ -423,7 +425,7 @@ def _lower_constructs_stream(ld: pipeline.Loaded, target: Any, found: list[Diagn
         return parsed.program if parsed is not None else None
 
     return convert_constructs_stream(reparse, target, found, out.write, out.reset,
-                                     machine=_machine(machine, ld.dialect),
+                                     machine=_equiv_machine(machine, ld.dialect, target.name),
                                      resolver=pipeline.make_resolver(ld.source_dir, ld.dialect))
 
 

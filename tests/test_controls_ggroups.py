@@ -29,7 +29,7 @@ def values(program: str, count: int):
     ("G710\n", 13, 4.0),          # G710 and G71 both mean mm: the code spelt last decides
     ("G710\nG71\n", 13, 2.0),
     ("G91\n", 14, 2.0),
-    ("G42 D1\n", 7, 3.0),
+    ("T1 M6 D1\nG42\n", 7, 3.0),   # (a tool changed first: G42 D1 of no tool is NC123)
     ("G0 Y0\n", 1, 1.0),
     ("G1 Y0 F100\n", 1, 2.0),
 ])
