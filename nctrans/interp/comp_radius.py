@@ -25,6 +25,43 @@ def offsets_of_active_tool(dialect: Optional[str]) -> bool:
     return bool(option(dialect, "offsets_of_active_tool", False))
 
 
+def radius_of(it, d: int) -> float:
+    """The radius of offset number `d` where D numbers are not cutting edges of their own model
+    (interp/tool_edges): a register the machine file gives (radius_offsets); a tool-relative D1
+    (Fagor: the corrector of the active tool, which the machine file's tool holds) is the active
+    tool's radius, as its length is; else register d (tool d's radius). D0: none."""
+    if not d:
+        return 0.0
+    m = it.machine
+    if it.offsets_of_tool and it.st.tool and d == 1 and d not in m.radius_offsets:
+        tool = m.tool(int(it.st.tool))
+        if tool is not None:
+            return float(tool.radius)
+    return float(m.radius_offset(d))
+
+
+def loaded_tool_radius(it) -> Optional[float]:
+    """G41/G42 with no D where the control profile compensates with the loaded tool's radius
+    (rules `[options.profiles.<p>] comp_without_d = "loaded_tool"`, LinuxCNC: "if D is omitted,
+    the radius of the tool in the spindle" [GK, LinuxCNC G-code reference]; rs274 2.9 checked by
+    hand: T1 of diameter 10 M6, G41 G1 X10 Y0 then Y10 runs X5 Y5), else None (NC208)."""
+    from nctrans.rules import option
+    profile = (it.program.meta or {}).get("profile") if isinstance(it.program.meta, dict) else None
+    if not profile:
+        return None
+    own = ((option(it.program.dialect, "profiles") or {}).get(profile) or {}).get("comp_without_d")
+    if own != "loaded_tool":
+        return None
+    if it.st.tool is None:
+        it.diag("NC123", "warning", f"G41/G42 with no D takes the radius of the tool in the spindle "
+                f"({profile}), but no tool change precedes it in the program: that tool is the one the "
+                "machine holds, which the program does not say; analysed on the programmed contour "
+                "(radius 0)", it.comp_on_span)
+        return 0.0
+    tool = it.machine.tool(int(it.st.tool))
+    return float(tool.radius) if tool is not None else 0.0
+
+
 def check_entry(it) -> None:
     """Before the first move of a G41/G42 episode: NC123 and radius 0 where the radius is the
     unknown tool's. `it`: the Interpreter (st, machine, comp_radius, default_edge, diag)."""

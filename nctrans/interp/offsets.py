@@ -12,7 +12,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any, Optional
 
-from nctrans.interp import episode_frame, polar_input
+from nctrans.interp import comp_radius, episode_frame, polar_input
 from nctrans.interp.evaluate import EvalError, FrameValue, UNKNOWN
 from nctrans.interp.frames import IDENT, PLANE_AXES, ProgrammableFrame, rpy_ordered
 from nctrans.interp.state import LINEAR_AXES
@@ -166,7 +166,7 @@ class OffsetsMixin:
             self.edges.select(i)
         else:
             self.st.radius_index = i
-            self.comp_radius = self.machine.radius_offset(i) if i else 0.0
+            self.comp_radius = comp_radius.radius_of(self, i)      # D of the active tool or a register
 
     def _h_data(self, s):
         """G10 data setting: write work offsets or tool-offset registers into the machine copy."""

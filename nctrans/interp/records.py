@@ -70,18 +70,30 @@ class RecordsMixin:
     def _comp_without_offset(self, kind, start, end, center, cw, turns, payload) -> None:
         """G41/G42 on with no D word. Where the dialect's table names the cutting edge a tool
         brings by default (options.default_cutting_edge, Sinumerik D1), compensate with it as if
-        written; else the controller compensates by zero: NC208, and the move runs as programmed."""
-        edge = self.default_edge
-        if edge:
+        written; else the controller compensates by zero: NC208, and the move runs as programmed.
+        An explicit D0 brings no default edge: no offset (where D is an edge, as the control runs
+        it; an ISO D0 is NC208 as before). It used to compensate with the default edge."""
+        edge = self.default_edge if self.st.radius_index is None else 0
+        loaded = comp_radius.loaded_tool_radius(self) if self.st.radius_index is None else None
+        if loaded is not None:          # the control's profile takes the loaded tool's radius
+            self.comp_radius = loaded
+            if loaded and self._comp_move(kind, start, end, center, cw, turns, payload):
+                return
+        elif edge:
             self.st.radius_index = edge
-            self.comp_radius = self.machine.radius_offset(edge)
+            self.comp_radius = (self.edges.radius(int(self.st.tool or 0), edge) if self.edges is not None
+                                else comp_radius.radius_of(self, edge))
             if self.comp_radius and self._comp_move(
                     kind, start, end, center, cw, turns, payload):
                 return
+        elif self.default_edge:
+            pass                        # D0 where D is an edge: no offset, as the control runs it
         elif not self.comp_d_reported:
             self.comp_d_reported = True
-            self.diag("NC208", "error", f"cutter compensation ({self.st.comp_side}) is on but no D word "
-                      "selects a radius offset: the tool runs on the programmed contour uncompensated")
+            which = "no D word selects a radius offset" if self.st.radius_index is None else \
+                "D0 selects no radius offset"
+            self.diag("NC208", "error", f"cutter compensation ({self.st.comp_side}) is on but {which}: "
+                      "the tool runs on the programmed contour uncompensated")
         self._finish_move(kind, start, end, center, cw, turns, payload)
 
     def _payload(self) -> tuple:
