@@ -226,6 +226,9 @@ class FagorEmitter(FagorSpelling, Emitter):
         # (a mill's: a lathe applies no length along the tool axis, its T<tt><oo> selects the offset)
         self.registers = (program.dialect != DIALECT and not _table_option(program.dialect, "edge_offsets")
                           and _machine_kind(program.dialect) == "mill")
+        # any source whose D (or ISO-T T-word offset) names an offset register, mill or lathe
+        self.register_radius = (program.dialect != DIALECT
+                                and not _table_option(program.dialect, "offsets_of_active_tool"))
         self.iso_length: Any = "off"
         self.iso_h: Optional[float] = None
         self.length_behind: Any = None
@@ -531,6 +534,12 @@ class FagorEmitter(FagorSpelling, Emitter):
     def w_OffsetSelect(self, s: n.OffsetSelect, word, new_line, rest: list):
         val = self.value
         if s.kind == "radius":
+            k = _num(s.index)
+            if self.register_radius and k == 1 and self.tool_active not in (None, 1):
+                # ISO radius register 1 (tool 1's radius) while another tool is in the spindle:
+                # a Fagor D1 is that tool's own corrector (nctrans.interp.comp_radius)
+                raise NotExpressible(f"radius register D1 while T{self.tool_active:g} is in the spindle: "
+                                     f"a Fagor D1 is the corrector of T{self.tool_active:g}, not register 1")
             word("D", "D" + val(s.index))
             self.radius_index = s.index
             if not self.length_on and _num(s.index) != 0:

@@ -135,6 +135,13 @@ class _Lines(list):
     """Words a statement writes on lines of their own (one list of words per line)."""
 
 
+def _const_int(e) -> Optional[int]:
+    """A constant whole number (a tool or offset number), else None."""
+    if type(e) is n.Num and float(e.value).is_integer():
+        return int(e.value)
+    return None
+
+
 class NotConvertible(NotExpressible):
     """A facility of the source control ISO has no counterpart for (text the IR keeps verbatim:
     synchronized actions, interrupts, cam tables; a system variable with no ISO number). In a
@@ -156,6 +163,10 @@ class IsoEmitter(IsoSpelling, Emitter):
     lowered_for = "ISO"
     # a milling control applies a tool length along Z (G43 H); a lathe's is not (iso-t)
     writes_edge_lengths: bool = True
+    # a turret T word naming the tool already in place (ISO turning T0111 after T0101) changes only
+    # the offset: written without T.. M6, which would change the tool (and stop the spindle) here
+    drops_staying_turret: bool = True
+    turret_tool: Optional[int] = None
     # power-on modes a program from another control relies on, written out where ours differ
     power_on_groups: tuple[str, ...] = ("feed_mode", "plane")
 
@@ -235,11 +246,21 @@ class IsoEmitter(IsoSpelling, Emitter):
         # register (Fagor D: the active tool's offset), see _length_register
         self.spindle_tool: Optional[int] = 0
         self.selected_tool = None
+        # a source whose D is a corrector of the active tool with no edge model of its own (Fagor):
+        # its D1 is the tool's own radius, ISO register D<t> of tool t (the machine file's
+        # convention); the tool is followed through T and M6 (0: none changed yet, None: unknown)
+        from nctrans.interp.comp_radius import offsets_of_active_tool
+        self.tool_relative = (self.edge_lengths is None and program.dialect != self.dialect
+                              and offsets_of_active_tool(program.dialect)
+                              and not (program.meta or {}).get("flattened_from"))
+        self.rel_selected: Optional[int] = None
+        self.rel_tool: Optional[int] = 0
 
     def forget(self) -> None:
         super().forget()
         self.distance_known = False
         self.spindle_tool = None
+        self.turret_tool = None
         if getattr(self, "edge_lengths", None) is not None:
             self.edge_lengths.reached_from_elsewhere()
 
@@ -559,6 +580,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         """A subprogram's body after its O word: the spill frame pushed, the body, M99."""
         self.unit = key
         self.forget()
+        self.rel_tool = None                # the caller's tool
+        self.turret_tool = None
         if self.edge_lengths is not None:
             self.edge_lengths.unknown()
         self.span = sub.span
@@ -875,7 +898,24 @@ class IsoEmitter(IsoSpelling, Emitter):
         return "0"
 
     # -------------------------------------------------------------- statements
+    def _turret_stays(self, body: list) -> list:
+        """The block without its T word and turret change where the turret keeps its tool."""
+        tools = [i for i, s in enumerate(body) if type(s) is n.ToolSelect]
+        turns = [i for i, s in enumerate(body) if type(s) is n.ToolChange]
+        if not turns:
+            return body
+        tool = _const_int(body[tools[-1]].tool) if tools else None
+        if not all(body[i].turret for i in turns) or tool is None:
+            self.turret_tool = None
+            return body
+        if tool != self.turret_tool:
+            self.turret_tool = tool
+            return body
+        return [s for i, s in enumerate(body) if i not in turns and i not in tools]
+
     def statements(self, body) -> list[list[str]]:
+        if self.drops_staying_turret:
+            body = self._turret_stays(body)
         lines: list[_Line] = [_Line()]
         names_register = any(type(s) is n.OffsetSelect and s.kind == "length" for s in body)
         for s in body:
@@ -1188,12 +1228,16 @@ class IsoEmitter(IsoSpelling, Emitter):
 
     def w_ToolSelect(self, s):
         self.selected_tool = s.tool
+        if self.tool_relative:
+            self.rel_selected = _const_int(s.tool)
         return [("T", self.addr("T", s.tool))]
 
     def w_ToolChange(self, s):
         self.pos = {}
         sel = self.selected_tool
         self.spindle_tool = int(sel.value) if type(sel) is n.Num and float(sel.value).is_integer() else None
+        if self.tool_relative:
+            self.rel_tool = self.rel_selected
         return [self.code_word("tool_change", "change")]
 
     def _length_register(self, s: n.ModeChange) -> list:
@@ -1215,6 +1259,13 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.pos = {}
         if self.edge_lengths is not None and s.kind == "radius":
             return []       # a cutting edge: its G43 H and, with G41/G42, its D (edge_length)
+        if self.tool_relative and s.kind == "radius" and _const_int(s.index) == 1:
+            if not self.rel_tool:
+                why = ("no tool change before it: the tool the machine holds" if self.rel_tool == 0
+                       else "a tool not known here")
+                raise NotConvertible(f"the radius of D1, the corrector of the active tool ({why}), which "
+                                     "no ISO register names", "D1")
+            return [("D", f"D{self.rel_tool}")]
         letter = "H" if s.kind == "length" else "D"
         return [(letter, self.addr(letter, s.index))]
 

@@ -33,12 +33,18 @@ class TurningEmitter(iso.IsoEmitter):
     target_text = "ISO turning"
     lowered_for = "ISO"
     writes_edge_lengths = False     # a lathe's tool length is not applied along Z (tool_edges)
+    drops_staying_turret = False    # its T word is the turret's own (T0111 says the offset)
 
     def __init__(self, program: n.Program):
         super().__init__(program)
         defaults = (program.meta or {}).get("defaults") or {}
         self.diameter = defaults.get("diameter") == "diameter"
         self.plane = defaults.get("plane", "ZX")
+        # a source whose D belongs to the active tool (Sinumerik edge, Fagor corrector): its D1 is
+        # the tool's own offset, the register of the tool number in the T word (T4 D1 -> T0404;
+        # D2 of tool 4 -> T0402, register 2, as ISO T0402 reads back as T4 D2)
+        from nctrans.rules import option
+        self.tool_relative = bool(option(program.dialect, "offsets_of_active_tool", False))
 
     def w_ModeChange(self, s: n.ModeChange):
         if s.group == "diameter":
@@ -109,6 +115,10 @@ class TurningEmitter(iso.IsoEmitter):
         self.t_tool = self.t_offset = None
         self.t_chosen = {}
 
+    def _own(self, k: "int | None", tool: "int | None") -> "int | None":
+        """Register k as the T word writes it: a tool-relative D1 is tool `tool`'s own offset."""
+        return tool if self.tool_relative and k == 1 and tool is not None else k
+
     def statements(self, body) -> list[list[str]]:
         # a D in the block of its T goes into that T word (T1 D2 -> T0102; ISO T0102 stays T0102)
         self.block_offset = next((_register(s.index) for s in body if type(s) is n.OffsetSelect
@@ -125,7 +135,7 @@ class TurningEmitter(iso.IsoEmitter):
         t = s.tool
         if type(t) is n.Num and t.value == int(t.value) and 0 <= t.value < 100:
             self.t_tool = int(t.value)
-            self.t_offset = self.t_tool if self.block_offset is None else self.block_offset
+            self.t_offset = self.t_tool if self.block_offset is None else self._own(self.block_offset, self.t_tool)
             self.t_chosen = {}
             return [("T", f"T{self.t_tool:02d}{self.t_offset:02d}")]
         self.t_tool = self.t_offset = None
@@ -153,6 +163,7 @@ class TurningEmitter(iso.IsoEmitter):
             raise NotConvertible(f"offset register {k} with no tool known before it: ISO turning selects "
                                  "the register with its tool in one word (T<tool><offset>), and which "
                                  "tool is in the turret here is not in the program", f"D{k}")
+        k = self._own(k, self.t_tool)
         if kind is not None:
             other_kind = "radius" if kind == "length" else "length"
             other = self.t_chosen.get(other_kind)

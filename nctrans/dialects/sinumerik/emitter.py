@@ -140,6 +140,13 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         # ISO tool length (G43/G44/G49 H) and radius register D as the cutting edge D
         # (nctrans.dialects.sinumerik.edge_selection); a Sinumerik source writes its own D words
         self.edges = EdgeSelection() if program.dialect == "iso-m" else None
+        # an ISO turning T word's offset register (T0401: tool 4, register 1) as the D of the tool:
+        # D1 is the tool's own edge, so register 1 under another tool has no D (edge_selection's
+        # rule for ISO milling); the turret tool is followed through T and its change
+        from nctrans.rules import option
+        self.t_registers = (self.edges is None and program.dialect != "sinumerik"
+                            and not option(program.dialect, "offsets_of_active_tool", False))
+        self.t_selected = self.t_active = None
         self.call_comp: dict[str, set] = {}     # callee -> compensation states at its calls
         self.jump_regions: dict[int, dict] = {}  # per unit: label -> what jumps to it may change
         self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
@@ -460,14 +467,20 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         out.words.append(f"LIMS={self.expr(s.value)}")
 
     def w_ToolSelect(self, s: ir.ToolSelect, out: "_Line") -> None:
+        self.t_selected = s.tool.value if type(s.tool) is ir.Num else None
         out.words.append(self.word("T", s.tool))
 
     def w_ToolChange(self, s: ir.ToolChange, out: "_Line") -> None:
+        self.t_active = self.t_selected
         out.words.append(self.code_for("tool_change"))
 
     def w_OffsetSelect(self, s: ir.OffsetSelect, out: "_Line") -> None:
         if self.edges is not None:
             return          # the block's D word comes from edge_selection (block_edge)
+        if (self.t_registers and s.kind == "radius" and type(s.index) is ir.Num and s.index.value == 1
+                and self.t_active not in (None, 1)):
+            raise NotExpressible(f"offset register 1 while T{self.t_active:g} is active: a Sinumerik D1 is "
+                                 f"the own edge of T{self.t_active:g}, not register 1")
         if s.kind == "radius":
             out.words.append(self.word("D", s.index))
         else:
@@ -1559,6 +1572,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         headers = meta.get("unit_headers", {})
         for name, sub in p.subprograms.items():
             self.span = sub.span
+            self.t_selected = self.t_active = None      # the caller's tool
             sname = self.subname(name)
             if name in headers and not re.match(r"_N_\w+_(?:MPF|SPF)$", headers[name], re.I):
                 self.lines.append(f"%{headers[name]}")          # a member header kept as written

@@ -1,0 +1,19 @@
+; Fagor 8065 mill: next tool preselected while the first one cuts (seed L5780-5800)
+G90 G17 G71
+T7 D1 M6
+S1200 M3
+G0 X0 Y0 Z5
+G1 Z-2 F200
+T2
+D2
+G1 X50 F300
+G0 Z50
+M6
+S3000 M3
+G0 X10 Y10 Z5
+G42 G1 X20 Y10 F400
+G1 Y30
+G1 X40
+G40 G1 X50 Y40
+G0 Z50
+M30

@@ -1,0 +1,19 @@
+; Fagor 8065 lathe: diameter programming, turret tools, nose radius compensation
+G18 G151 G95 G71
+T1 D1
+G96 S180 M4
+G192 S2500
+G0 X62 Z2
+G42 G1 X40 Z0 F0.15
+G1 Z-20
+G1 X50 Z-30
+G1 Z-45
+G40 G1 X62
+G0 Z20
+T3 D3
+G97 S600 M4
+G0 X52 Z-44
+G1 X44 F0.05
+G0 X62
+G0 Z20
+M30
