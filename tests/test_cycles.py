@@ -271,13 +271,12 @@ def test_sinumerik_args_and_levels():
     assert params["decrement"] == 2 and params["vari"] == 1
     assert bind_cycle_args("CYCLE83", [50, 0, 2, -20])[0] == "chip_break"
     assert bind_cycle_args("CYCLE999", [1]) is None
-    assert plane_cycle_levels(params, current=100) == (2, -20, 50)
-    # DPR wins over DP; RTP missing -> the current height
-    assert plane_cycle_levels({"r_plane": 10, "safety": 1, "bottom": -3, "depth_rel": 5},
-                                  current=80) == (11, 5, 80)
+    assert plane_cycle_levels(params) == (2, -20, 50)
+    # DPR wins over DP; RTP missing -> 0, as the cycle's PROC sees it (seed L4722): RTP 0 is
+    # below RFP 10, so the cycle drills upwards: approach 10-1 = 9, bottom 10+5 = 15
+    assert plane_cycle_levels({"r_plane": 10, "safety": 1, "bottom": -3, "depth_rel": 5}) == (9, 15, 0)
     # RTP below RFP: drilling upwards (+Z)
-    assert plane_cycle_levels({"retract_plane": -50, "r_plane": 0, "safety": 2, "depth_rel": 10},
-                                  current=0) == (-2, 10, -50)
+    assert plane_cycle_levels({"retract_plane": -50, "r_plane": 0, "safety": 2, "depth_rel": 10}) == (-2, 10, -50)
 
 
 def test_hole_patterns():

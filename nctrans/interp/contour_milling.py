@@ -112,7 +112,7 @@ def plan72(start, moves, p: dict[str, float], radius: float, here: tuple[float, 
     _finite(p)
     if not moves:
         raise _impossible("with a contour of fewer than two points")
-    lv = levels_of(p, here[2])
+    lv = levels_of(p)
     vari = int(p.get("VARI", 1))
     ones, tens, hundreds = vari % 10, vari // 10 % 10, vari // 100 % 10
     if ones not in (1, 2) or tens not in (0, 1) or hundreds > 3 or vari >= 1000:

@@ -16,6 +16,7 @@ from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.lathe import TURNING_KINDS
 from nctrans.interp.milling_cycles import run_milling_cycle
 from nctrans.ir import nodes as n
+from nctrans.ir.walk import constant
 
 CYCLE_LENGTH_KEYS = frozenset(("bottom", "r_plane", "retract_plane", "safety", "peck", "shift",
                                "depth_rel", "first_peck", "decrement", "min_peck", "relief"))
@@ -144,6 +145,8 @@ class CycleCallsMixin:
             return self._turning_cycle(s)
         if s.name and s.kind != "swivel_plane" and self._find_unit(s.name) is not None:
             return self._cycle_code(s)
+        self._omitted_retract_plane(s)
+        self._omitted_from_state(s)
         if s.kind in ("holes_line", "holes_circle", "holes_grid"):
             return self._hole_pattern(s)
         if s.kind == "swivel_plane":
@@ -157,6 +160,43 @@ class CycleCallsMixin:
             self.modal_cycle = s
             return
         self._run_cycle_call(s)
+
+    def _omitted_retract_plane(self, s: n.CycleCall) -> None:
+        """A built-in cycle model called with RTP left out: the cycle is a subprogram and sees
+        the omitted argument as 0 (seed L4722), so it retracts to 0, as modelled. That is almost
+        always a slip (the tool crosses to the next hole at the workpiece zero), so say it at the
+        line (NC127), once per call statement (an MCALL's holes are one call)."""
+        if "retract_plane" in s.params or not s.name:
+            return
+        name = s.name.upper()
+        spec = ({c.name: c for c in cycle_table().cycle} | {m.name: m for m in cycle_table().milling}).get(name)
+        if spec is None or "RTP" not in spec.params:
+            return
+        axis = PLANE_AXES[self.st.plane][2]
+        self.diag("NC127", "warning", f"{name} with RTP (retract plane) omitted: the cycle sees an "
+                  f"omitted parameter as 0 (seed L4722), so it retracts to {axis}0 (or to RFP+SDIS "
+                  f"where that is higher) as the control does, not to the height it started from "
+                  f"({axis}{self.pos.get(axis, 0.0):g}); give RTP")
+
+    def _omitted_from_state(self, s: n.CycleCall) -> None:
+        """Parameters a built-in model takes from the program's state when the call leaves them
+        out or gives 0, where the control's cycle sees 0 (rules/cycles.toml [omitted_from_state]):
+        said at the line (NC128), once per call statement."""
+        table = cycle_table()
+        fills = table.omitted_from_state.get((s.name or "").upper())
+        if not fills:
+            return
+        taken = []
+        for name, instead in fills.items():
+            e = s.params.get(table.neutral(name))
+            c = None if e is None else constant(e)
+            if e is None or (c is not None and c == 0):
+                taken.append(f"{name} as {instead}")
+        if taken:
+            self.diag("NC128", "warning", f"{s.name.upper()} with {', '.join(n_.split(' as ')[0] for n_ in taken)} "
+                      f"omitted or 0: the control's cycle sees 0 (seed L4722) and stops or uses a default "
+                      f"of its own; the analysis takes {'; '.join(taken)}. The path is the same, its feed, "
+                      "time or spindle may not be the machine's; give the value")
 
     def _cycle_code(self, s: n.CycleCall):
         """A cycle whose own code is in the program or beside it (CYCLE81.SPF on the search
@@ -236,7 +276,7 @@ class CycleCallsMixin:
         if "bottom" not in params and not params.get("depth_rel"):
             self.diag("NC206", "error", f"cycle {s.name or s.kind} without a depth")
             return
-        approach, bottom, retract = plane_cycle_levels(params, current=self.pos.get(ax, 0.0))
+        approach, bottom, retract = plane_cycle_levels(params)
         self._rc_cycle()
         steps = None
         if hole is not None and any(abs(hole.get(a, 0.0) - self.pos.get(a, 0.0)) > 0

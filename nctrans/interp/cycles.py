@@ -490,6 +490,7 @@ class CycleTable:
     milling_model: dict[str, float] = field(default_factory=dict)
     undercut: UndercutTables = field(default_factory=UndercutTables)
     cycle93_vari: dict[str, GrooveVariant] = field(default_factory=dict)
+    omitted_from_state: dict[str, dict[str, str]] = field(default_factory=dict)
 
     @classmethod
     def from_data(cls, d: dict) -> "CycleTable":
@@ -509,7 +510,8 @@ class CycleTable:
                    milling_param={k: MillingParam(**v) for k, v in d.get("milling_param", {}).items()},
                    milling_model=dict(d.get("milling_model", {})),
                    undercut=_undercut_tables(d.get("undercut", {})),
-                   cycle93_vari={k: GrooveVariant(**v) for k, v in d.get("cycle93_vari", {}).items()})
+                   cycle93_vari={k: GrooveVariant(**v) for k, v in d.get("cycle93_vari", {}).items()},
+                   omitted_from_state={k: dict(v) for k, v in d.get("omitted_from_state", {}).items()})
 
     def position_at(self, dialect: str, profile: Optional[str] = None) -> str:
         """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle); a
@@ -572,19 +574,20 @@ def bind_cycle_args(name: str, args: Sequence[float | None]) -> Optional[tuple[s
     return kind, params
 
 
-def plane_cycle_levels(params: dict[str, float], *, current: float) -> tuple[float, float, float]:
+def plane_cycle_levels(params: dict[str, float]) -> tuple[float, float, float]:
     """(approach, bottom, retract) of a Sinumerik drilling cycle from RTP, RFP, SDIS, DP, DPR.
 
-    approach = RFP + SDIS (towards RTP), retract = RTP (`current` when RTP is not given), bottom = DP,
-    or RFP - DPR when DPR is given: the Siemens cycles manual [GK] says DPR wins when both are
-    programmed. A cycle is a subprogram, and a subprogram sees an omitted argument as 0 (seed
-    L4722), so it cannot tell DPR 0 from DPR not programmed: DPR 0 leaves the depth to DP (a
-    relative depth of 0 would be no hole), as the milling cycles and the ISO writer read it.
+    approach = RFP + SDIS (towards RTP), retract = RTP, bottom = DP, or RFP - DPR when DPR is
+    given: the Siemens cycles manual [GK] says DPR wins when both are programmed. A cycle is a
+    subprogram, and a subprogram sees an omitted argument as 0 (seed L4722): an omitted RTP is a
+    retract plane at 0 (the caller says so at the line, NC127), an omitted RFP or SDIS is 0, and
+    DPR 0 cannot be told from DPR not programmed, so DPR 0 leaves the depth to DP (a relative
+    depth of 0 would be no hole), as the milling cycles and the ISO writer read it.
     The drilling direction is from RTP towards RFP (RTP below RFP drills upwards).
-    A missing RFP is taken as 0; a missing depth gives bottom = RFP (the caller reports NC206).
+    A missing depth gives bottom = RFP (the caller reports NC206).
     """
     rfp = params.get("r_plane", 0.0)
-    rtp = params.get("retract_plane", current)
+    rtp = params.get("retract_plane", 0.0)
     up = 1.0 if rtp >= rfp else -1.0
     approach = rfp + up * abs(params.get("safety", 0.0))
     if params.get("depth_rel"):

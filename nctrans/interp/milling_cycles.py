@@ -95,10 +95,11 @@ class Levels:
         return self.rtp if (self.rtp - self.approach) * self.up > 0 else self.approach
 
 
-def levels_of(p: dict[str, float], current: float) -> Levels:
-    """RTP, RFP, SDIS and DP/DPR (DPR wins) as heights; a missing RTP is the current height."""
+def levels_of(p: dict[str, float]) -> Levels:
+    """RTP, RFP, SDIS and DP/DPR (DPR wins) as heights. An omitted RTP, RFP or SDIS is 0, as the
+    cycle's PROC sees an omitted argument (seed L4722); the caller warns of an omitted RTP (NC127)."""
     rfp = p.get("RFP", 0.0)
-    rtp = p.get("RTP", current)
+    rtp = p.get("RTP", 0.0)
     up = 1.0 if rtp >= rfp else -1.0
     if p.get("DPR"):
         bottom = rfp - up * abs(p["DPR"])
@@ -579,7 +580,7 @@ def milling_steps(shape: str, p: dict[str, float], radius: float, start: tuple[f
         raise _unmodelled(f"shape {shape!r} is not modelled")
     _finite(p)
     plan = _Plan(start)
-    planner(plan, p, levels_of(p, start[2]), radius, feed, spindle_cw, shape)
+    planner(plan, p, levels_of(p), radius, feed, spindle_cw, shape)
     return plan.steps
 
 
