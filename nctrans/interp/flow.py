@@ -224,7 +224,7 @@ class FlowMixin:
     def _h_alarm(self, s: n.Alarm):
         """Sinumerik SETAL(n), Fanuc #3000=n (message): the control stops with alarm n (NC221)."""
         try:
-            num = self.ev.compile(s.number)()
+            num = "(no number)" if s.number is None else self.ev.compile(s.number)()
             text = None if s.text is None else self.ev.compile(s.text)()
         except EvalError:
             num, text = "?", None
@@ -234,7 +234,7 @@ class FlowMixin:
             num = "(unknown number)"
         what = f": {text}" if isinstance(text, str) and text else ""
         self.alarm = (n.Num(float(num)) if isinstance(num, (int, float)) else s.number,
-                      n.Str(text) if isinstance(text, str) and text else None, self.span)
+                      n.Str(text) if isinstance(text, str) and text else None, self.span, s.own_base)
         self.diag("NC221", "error", f"the program raises alarm {num}{what}; the control stops "
                   "here, so the analysis ends at this line")
         raise _Stop

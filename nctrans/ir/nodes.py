@@ -378,8 +378,14 @@ class Message:
 
 @node
 class Alarm:
-    number: Expr
+    """The control stops with an alarm. `own_base` set: `number` is one of the program's own
+    (user) alarms, the author's alarm n = number - own_base (ISO #3000=n: base 0; Sinumerik
+    SETAL(66000+n): base 66000; rules `[options] alarms`), which a writer moves into its own user
+    band. None: a number of the source control's own alarm list (a Sinumerik cycle alarm 61000, a
+    Fagor error-list number), or no number at all (`number` None: a Fagor #ERROR ["text"])."""
+    number: Optional[Expr]
     text: Optional[Expr] = None
+    own_base: Optional[int] = None
 
 
 @node

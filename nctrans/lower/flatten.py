@@ -667,8 +667,8 @@ def flatten_blocks(program: n.Program, machine=None, *, diagnostics: list,
     if raised is not None:
         # the source stops with an alarm here: the flattened program raises the same alarm, so
         # the run's NC221 becomes a lowering note (the conversion keeps the behaviour)
-        number, text, span = raised
-        fl.blocks.append(n.Block(span, [n.Alarm(number, text)]))
+        number, text, span, own_base = raised
+        fl.blocks.append(n.Block(span, [n.Alarm(number, text, own_base)]))
         last = fl.blocks[-1]
         for i, d in enumerate(interp_diags):
             if d.rule == "NC221":

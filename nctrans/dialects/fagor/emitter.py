@@ -27,6 +27,7 @@ from nctrans.plainrun import RUNS, run_blocks
 from nctrans.ir import walk as ir_walk
 from nctrans.lower import restart_loop
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
+from nctrans import alarm_numbers
 from nctrans.rules import load_table, option as rules_option
 
 __all__ = ["FagorSpelling", "FagorEmitter", "NotExpressible", "format_number", "format_expr", "emit_program"]
@@ -613,7 +614,15 @@ class FagorEmitter(FagorSpelling, Emitter):
         word("", f"#MSG [{self.message(s.text)}]", alone=True)
 
     def w_Alarm(self, s: n.Alarm, word, new_line, rest: list):
-        text = self.message(s.text) if s.text is not None else f'"ALARM %D", {self.expr(s.number)}'
+        """#ERROR ["text"] (or #ERROR [n] of the CNC's list): Fagor has no band of numbered user
+        alarms, so another control's alarm is raised by its text (nctrans.alarm_numbers)."""
+        w = alarm_numbers.written(s, DIALECT, self.program.dialect)
+        if w.number is None:
+            text = self.message(w.text)
+        elif w.text is None:
+            text = self.expr(w.number)
+        else:
+            text = self.message(w.text)
         word("", f"#ERROR [{text}]", alone=True)
 
     def w_FrameOp(self, s: n.FrameOp, word, new_line, rest: list):

@@ -1007,7 +1007,10 @@ class Parser:
                 args = [low.expr(c) for c in t.children[1:]]
                 text = ir.Str(fmt) if not args else ir.Func("format", [ir.Str(fmt)] + args)
             if kind == "error":
-                return body + [ir.Alarm(ir.Num(0.0, "0"), text)]
+                # #ERROR [n]: error n of the CNC's list; #ERROR ["text"]: no number (seed L15818-15892)
+                if t.data == "msg_number":
+                    return body + [ir.Alarm(text)]
+                return body + [ir.Alarm(None, text)]
             if name == "#WARNINGSTOP":
                 return body + [ir.Message(text), ir.Stop()]
             return body + [ir.Message(text)]

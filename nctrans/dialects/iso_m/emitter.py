@@ -31,6 +31,7 @@ import math
 from typing import Any, Optional
 
 from nctrans import spilled
+from nctrans import alarm_numbers
 from nctrans.diagnostics import at_span
 from nctrans.interp import corner_elements
 from nctrans.interp.frames import PLANE_AXES
@@ -1882,11 +1883,16 @@ class IsoEmitter(IsoSpelling, Emitter):
             return f"<{e.key}[{','.join(self.expr(i) for i in e.indices)}]>"
 
     def w_Alarm(self, s):
+        """#3000=n with the number moved into the program's own alarms (nctrans.alarm_numbers;
+        NC408 where it moves)."""
         self.lowered("alarm written as #3000")
-        num = self.val(s.number)
+        w = alarm_numbers.written(s, self.table_name, self.program.dialect)
+        if w.note:
+            self.diags.append(at_span("NC408", "info", w.note, self.span))
+        num = self.val(w.number)
         text = ""
-        if s.text is not None:
-            text = " " + self._comment(s.text.value if type(s.text) is n.Str else self.expr(s.text))
+        if w.text is not None:
+            text = " " + self._comment(w.text.value if type(w.text) is n.Str else self.expr(w.text))
         return [("#3000", f"#3000={num}{text}")]
 
     def w_VarDecl(self, s: n.VarDecl):

@@ -66,6 +66,7 @@ _G_IN_TEXT = re.compile(r"G(\d+(?:\.\d+)?)")
 _LEAD_N = re.compile(r"^\s*(?:/\d?\s*)?(?:[Nn]\s*\d+)?\s*")
 LOCAL_CALL = "m97"              # call kind of a control profile's local subprogram call (Haas M97)
 ALARM_VARIABLE = 3000          # Fanuc macro B: #3000=n (message) raises alarm n
+ALARM_OWN_BASE = 0             # ... the program's own alarm n (rules iso-m alarms.user_base)
 STOP_MESSAGE_VARIABLE = 3006   # Fanuc macro B: #3006=n (message) stops as M00 and shows the message
 _EXTERNAL_OUTPUT = re.compile(r"^(?:N\d+\s*)?(?:POPEN|PCLOS|[DB]PRNT\s*\[.*\])\s*$")
 _O_WORDS = re.compile(r"O(\d+)(?=$|[A-Z][-+.\d#\[]|[,#\[/])")
@@ -664,7 +665,7 @@ class Lowering:
             tag = it[0]
             if tag == "=":
                 if type(it[1]) is Var and it[1].space == "num" and it[1].key == ALARM_VARIABLE:
-                    out.append((B_END, Alarm(it[2])))     # #3000=n (MESSAGE): the control stops
+                    out.append((B_END, Alarm(it[2], None, ALARM_OWN_BASE)))     # #3000=n (MESSAGE): the control stops
                 elif _is_stop_message(it[1]):
                     out.append((B_END, Stop()))           # #3006=n (MESSAGE): M00 with a message
                 else:
@@ -1354,7 +1355,7 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 if tag == "IFTHEN":
                     # #3000=n after THEN raises the alarm as it does alone on a line
                     message = next((Str(a[1]) for a in it[2] if a[0] == "comment"), None)
-                    then = [Alarm(a[2], message) if _is_alarm(a[1]) else
+                    then = [Alarm(a[2], message, ALARM_OWN_BASE) if _is_alarm(a[1]) else
                             Stop() if _is_stop_message(a[1]) else Assign(a[1], a[2])
                             for a in it[2] if a[0] != "comment"]
                     cur.append(If(span, it[1], [Block(span, then, skip=skip)]))

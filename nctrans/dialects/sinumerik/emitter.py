@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 from typing import Any, Optional
 
 from nctrans import spilled
+from nctrans import alarm_numbers
 from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.calls import call_arguments
 from nctrans.dialects.base import EmitResult
@@ -600,8 +601,12 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         out.words.append(f"MSG({self.expr(s.text)})")
 
     def w_Alarm(self, s: ir.Alarm, out: "_Line") -> None:
-        extra = f", {self.expr(s.text)}" if s.text is not None else ""
-        out.words.append(f"SETAL({self.expr(s.number)}{extra})")
+        """SETAL with the number moved into this control's bands (nctrans.alarm_numbers; NC408)."""
+        w = alarm_numbers.written(s, DIALECT, self.program.dialect)
+        if w.note:
+            self.diags.append(at_span("NC408", "info", w.note, self.span))
+        extra = f", {self.expr(w.text)}" if w.text is not None else ""
+        out.words.append(f"SETAL({self.expr(w.number)}{extra})")
 
     def w_PolarPole(self, s: ir.PolarPole, out: "_Line") -> None:
         ws = [self.axis(a, v) for a, v in s.target.items()]

@@ -181,6 +181,17 @@ _RPARAM = re.compile(r"R(\d+)$")
 SPINDLE_POSITIONING = ("SPOS", "SPOSA")
 
 
+def _own_alarm_base(number) -> Optional[int]:
+    """The user band's base when SETAL(number) raises one of the program's own alarms (66000+n;
+    rules sinumerik.toml alarms), else None: a cycle alarm of the control's list, or computed."""
+    from nctrans.alarm_numbers import band
+    b = band(DIALECT)
+    if type(number) is ir.Num and b.user_base is not None and \
+            b.user_base <= number.value < b.user_base + b.user_count and number.value == int(number.value):
+        return b.user_base
+    return None
+
+
 def _spindle_number(index: list) -> bool:
     """SPOS[n]: the index is a constant spindle number (the run positions the master, SETMS)."""
     return (len(index) == 1 and isinstance(index[0], ir.Num) and index[0].value >= 1
@@ -547,7 +558,7 @@ class Lowerer:
             w.out.append(ir.Message(args[0] if args and not is_omitted(args[0]) else ir.Str("")))
             return
         if name == "SETAL" and not modal and args:
-            w.out.append(ir.Alarm(args[0], args[1] if len(args) > 1 else None))
+            w.out.append(ir.Alarm(args[0], args[1] if len(args) > 1 else None, _own_alarm_base(args[0])))
             return
         cyc = _cycles().get(name)
         if cyc is not None and args is not None:
