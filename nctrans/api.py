@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any, Iterable, Iterator, Optional, Sequence, U
 from nctrans import limits
 from nctrans import pipeline
 from nctrans import linting
+from nctrans.diagnostics import once_each
 from nctrans import source as _source
 from nctrans.diagnostics import Diagnostic
 from nctrans.dialects.base import DEFAULT_DIALECT
@@ -588,6 +589,7 @@ def lint(source: Union[str, "os.PathLike[str]", Iterable["os.PathLike[str]"]], d
                     from nctrans.check import check_loaded
                     diags = linting.lint_loaded(ld, m, target, run=lambda l, mm: check_loaded(l, mm)[0])
                 out.extend(d for d in diags if keep(d))
+    out = list(once_each(out))      # a macro file linted with its caller: once
     _raise_on_errors(out, error_level)
     return out
 

@@ -18,7 +18,7 @@ from nctrans import __version__, api
 from nctrans import output as _output
 from nctrans import pipeline
 from nctrans import source as _source
-from nctrans.diagnostics import SEVERITY_RANK, Diagnostic
+from nctrans.diagnostics import SEVERITY_RANK, Diagnostic, once_each
 
 # catalogue, detect, equiv, toolpath_io, inspect and tempfile are imported by the commands that
 # use them: start-up time is a large share of a `toolpath` or `lint` run on one file.
@@ -279,6 +279,7 @@ def cmd_lint(args) -> int:
     finally:
         if bar is not None:
             bar.stop()
+    all_diags = list(once_each(all_diags))     # a macro file linted with its caller: once
     if args.format == "text":
         _print_text_diags(all_diags, sys.stdout)
     else:

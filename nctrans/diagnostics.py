@@ -6,7 +6,7 @@ Rule codes are stable and documented in `rules/lint-rules.toml` (the catalogue `
 from __future__ import annotations
 
 from dataclasses import dataclass, field, asdict
-from typing import Optional
+from typing import Iterable, Iterator, Optional
 
 SEVERITIES = ("info", "warning", "error")
 SEVERITY_RANK = {s: i for i, s in enumerate(SEVERITIES)}
@@ -55,6 +55,21 @@ def at_span(rule: str, severity: str, message: str, span) -> Diagnostic:
         return Diagnostic(rule, severity, message)
     return Diagnostic(rule, severity, message, span.file, span.line, span.col,
                       span.end_line or span.line, span.end_col or span.col + 1)
+
+
+def once_each(diags: Iterable[Diagnostic]) -> Iterator[Diagnostic]:
+    """Each diagnostic once at its file:line. Several files analysed together report one file's
+    diagnostic twice: a macro file's own line reached by its caller's run and again in its own."""
+    import os
+    seen: set = set()
+    for d in diags:
+        # a called file is named relative to the working directory, the same file given on the
+        # command line as the user wrote it: one file either way
+        place = os.path.abspath(d.file) if d.file and not d.file.startswith("<") and d.file != "-" else d.file
+        key = (d.rule, place, d.line, d.column, d.message)
+        if key not in seen:
+            seen.add(key)
+            yield d
 
 
 # Diagnostics kept per list (one file's parse or run; NCTRANS_MAX_DIAGNOSTICS overrides it).

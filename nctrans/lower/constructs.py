@@ -625,7 +625,7 @@ def _walk_check(seg: Segment, nodes: list, machine) -> None:
     _Walker(found, getattr(machine, "kind", "mill")).nodes(nodes)
     blocked = [d for d in found if d.severity == "error"]
     if blocked:
-        seg.why_not = blocked[0].message.replace("--flatten", "plain motion")
+        seg.why_not = reason_at(blocked[0])
     else:
         seg.notes = [dataclasses.replace(d, message=d.message.replace("--flatten", "plain motion"))
                      for d in found]
@@ -640,6 +640,13 @@ def _settle(seg: Segment) -> bool:
     if seg.why_not is None and seg.end_state is not None and seg.end_state["comp"]:
         seg.why_not = "cutter radius compensation is on at its end"
     return ended
+
+
+def reason_at(d: Diagnostic) -> str:
+    """A diagnostic as the reason a segment is not lowered, with its line: a segment of several
+    lines refuses each, and a reason with no line read as each refused line's own (line 3's call
+    refused as "SUBX.NC not found", line 2's, looked like line 2's NC103 printed twice)."""
+    return f"at line {d.line}, " + d.message.replace("--flatten", "plain motion")
 
 
 def refused(seg: Segment) -> list[Diagnostic]:
@@ -768,7 +775,7 @@ class SegmentHook:
                 seg.why_not = "a programmable frame, G92 or local offset is active where it ends"
             for d in self.diags[seg.diag_mark:]:
                 if _blocks_lowering(d):
-                    seg.why_not = seg.why_not or d.message
+                    seg.why_not = seg.why_not or reason_at(d)
             selected = _selection_to_restore(seg)
             name = it.unnumbered_tools.get(selected) if selected is not None else None
             if name is not None and seg.why_not is None:
@@ -813,7 +820,7 @@ class SegmentHook:
             if seg.flattener is not None and seg.flattener.ended and seg.ends == 0:
                 for d in self.diags[seg.diag_mark:]:
                     if _blocks_lowering(d):
-                        seg.why_not = seg.why_not or d.message
+                        seg.why_not = seg.why_not or reason_at(d)
 
 
 def _first_span(program: n.Program, seg: Segment) -> n.Span:

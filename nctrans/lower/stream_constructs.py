@@ -39,7 +39,7 @@ from nctrans.ir import nodes as n
 from nctrans.ir.walk import blocks
 from nctrans.lower.constructs import (
     OFFSET_DATA_WHY, STRETCH_MODES, Segment, SegmentHook, _AllRefused, _local, _local_names, _marker, _ModalRuns,
-    _restore, _sets, _StretchRuns, _CornerRuns, _variables_reason, _vars, _written, lowered_notes, refused)
+    _restore, _sets, _StretchRuns, _CornerRuns, _variables_reason, _vars, _written, lowered_notes, reason_at, refused)
 from nctrans.lower.flatten import _Walker
 
 
@@ -223,7 +223,7 @@ class _StreamedLowering:
         if scan.static_why is None:
             blocked = [d for d in scan.found if d.severity == "error"]
             if blocked:
-                scan.static_why = blocked[0].message.replace("--flatten", "plain motion")
+                scan.static_why = reason_at(blocked[0])
             else:
                 scan.walk_notes = [_replace_flatten(d) for d in scan.found]
 
