@@ -227,13 +227,14 @@ PROGRAMS = {
     "cycle801-rotated": (START + "MCALL CYCLE82(10, 0, 2, , 3, 0.5)\nCYCLE801(0, 0, 30, 10, 10, 2, 4)"
                          "\nMCALL\nM30\n", "CYCLE82", "CYCLE801"),
     # rigid tapping: PIT 1.25 at S1000 (1250 mm/min), dwell, SDAC 3; left hand under M4 with DPR,
-    # spindle off after (SDAC 5); MCALL at three positions
-    "84-pit": (START + "CYCLE84(10, 0, 2, -15, , 0.5, 3, , 1.25)\nM30\n", "CYCLE84", None),
-    "84-left-dpr": (START.replace("M3", "M4") + "CYCLE84(10, 1, 2, , 9, , 5, , -1)\nM30\n",
+    # spindle off after (SDAC 5); MCALL at three positions. SST is the S in force (1000): the
+    # PROC above taps at the speed in force (an omitted SST is NC128 in the built-in model)
+    "84-pit": (START + "CYCLE84(10, 0, 2, -15, , 0.5, 3, , 1.25, 0, 1000)\nM30\n", "CYCLE84", None),
+    "84-left-dpr": (START.replace("M3", "M4") + "CYCLE84(10, 1, 2, , 9, , 5, , -1, 0, 1000)\nM30\n",
                     "CYCLE84", None),
-    "84-positions": (START + "MCALL CYCLE84(5, 0, 1, -6, , , 3, , 0.8)\nX10\nY10\nX20 Y5\n"
+    "84-positions": (START + "MCALL CYCLE84(5, 0, 1, -6, , , 3, , 0.8, 0, 1000)\nX10\nY10\nX20 Y5\n"
                      "MCALL\nM30\n", "CYCLE84", None),
-    "84-holes1": (START + "MCALL CYCLE84(5, 0, 1, -6, , , 3, , 1)\nHOLES1(5, 5, 0, 10, 8, 3)\n"
+    "84-holes1": (START + "MCALL CYCLE84(5, 0, 1, -6, , , 3, , 1, 0, 1000)\nHOLES1(5, 5, 0, 10, 8, 3)\n"
                   "MCALL\nM30\n", "CYCLE84", "HOLES1"),
     "pattern-no-mcall": (START + "CYCLE801(0, 0, 0, 5, 5, 2, 2)\nHOLES1(0, 0, 90, 0, 4, 3)\nM30\n",
                          None, "CYCLE801"),

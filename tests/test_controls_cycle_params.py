@@ -120,12 +120,34 @@ def test_cycle97_thread_size_up_to_m60():
     assert cuts and {r.pitch for r in cuts} == {5.5}
 
 
-def test_cycle84_tapping_speeds_are_said_not_modelled():
-    # SST 400 / SST1 200 under S1000: the cycle taps at 400 and retracts at 200 [GK]; nctrans taps
-    # at the speed in force, so it says so (NC113) once per call; SST equal to S (and SST1 0) is
-    # what it models
+def test_cycle84_taps_at_sst_and_retracts_at_sst1():
+    # SST 400 / SST1 200 under S600 M3 [GK, Siemens cycles manual: tap (G331) at SST, retract
+    # (G332) at SST1, then the speed active before the call again with SDAC's direction]:
+    # G0 Z2 (RFP 0 + SDIS 2); S400 M3; tap to DP -18 at lead 1.5 x 400 = 600 mm/min; dwell 0.3;
+    # S200 reversed (M4); back to Z2 at 1.5 x 200 = 300 mm/min; S600 M3 (SDAC 3); G0 Z10 (RTP)
     recs, diags = run("CYCLE84(10, 0, 2, -18, , 0.3, 3, , 1.5, 0, 400, 200)")
-    said = [d for d in diags if d.rule == "NC113"]
-    assert len(said) == 1 and "400, 200" in said[0].message and said[0].line == 2
-    _, diags = run("CYCLE84(10, 0, 2, -18, , 0.3, 3, , 1.5, 0, 600, 0)")
-    assert not [d for d in diags if d.rule == "NC113"]
+    got = [(r.kind, r.end["Z"], r.feed, r.pitch, r.spindle) if r.kind in ("rapid", "linear") else
+           (r.kind, r.spindle_dir, r.spindle) if r.kind == "spindle" else (r.kind, r.dwell_s) for r in recs]
+    assert got == [("rapid", 2, None, None, 600), ("spindle", "cw", 400), ("linear", -18, 600, 1.5, 400),
+                   ("dwell", 0.3), ("spindle", "ccw", 200), ("linear", 2, 300, 1.5, 200),
+                   ("spindle", "cw", 600), ("rapid", 10, None, None, 600)]
+    assert not diags
+    # SST1 0: retract at SST; SST 600 = the speed in force: no change before the tap
+    # (600 x 1.5 = 900 mm/min both ways)
+    recs, diags = run("CYCLE84(10, 0, 2, -18, , 0, 3, , 1.5, 0, 600, 0)")
+    assert [(r.feed, r.spindle) for r in recs if r.kind == "linear"] == [(900, 600), (900, 600)]
+    # reversed for G332, back to the state before the call (G332), then SDAC 3
+    assert [(r.spindle_dir, r.spindle) for r in recs if r.kind == "spindle"] == [
+        ("ccw", 600), ("cw", 600), ("cw", 600)]
+    assert not diags
+    # SST omitted: the tap runs at the speed in force, said at the line (NC128)
+    recs, diags = run("CYCLE84(10, 0, 2, -18, , 0, 3, , 1.5)")
+    assert [r.feed for r in recs if r.kind == "linear"] == [900, 900]
+    assert [d.rule for d in diags] == ["NC128"]
+
+
+def test_cycle84_speeds_convert_with_equal_toolpaths():
+    text = SETUP + "CYCLE84(10, 0, 2, -18, , 0.3, 3, , 1.5, 0, 400, 200)\nG1 X20\nM30\n"
+    for target in ("iso-m", "fagor", "sinumerik"):
+        conv = nctrans.transpile(text, read="sinumerik", write=target)
+        assert nctrans.equiv(text, conv.text, read_a="sinumerik", read_b=target), target

@@ -50,11 +50,13 @@ def test_plate_runs_clean_on_its_machine_with_tool_lengths():
     # nothing at warning level: every construct (T="NAME" M6 D1, $P_UIFR, MCALL CYCLE81/83/84,
     # POCKET3/POCKET4/SLOT1, CYCLE832, label loop, G53 D0) is modelled or has no motion effect
     diags = nctrans.lint(SIN / "shop_plate_4711.mpf", machine=VMC)
-    # but MCALL CYCLE84(.., SST 400, SST1 200): the retraction at 200 rev/min (the tap at S400 is
-    # the speed in force) is not modelled, said once at the first hole
     said = [(d.rule, d.line) for d in diags if d.severity != "info"]
-    assert said == [("NC113", 51)]
+    assert said == []
     recs = records(SIN / "shop_plate_4711.mpf", VMC)
+    # MCALL CYCLE84(.., PIT 1.5, SST 400, SST1 200) under S400: each of the four holes taps at
+    # 1.5 x 400 = 600 mm/min and retracts at SST1 200 rev/min, 1.5 x 200 = 300 mm/min [GK]
+    taps = [(r.feed, r.spindle) for r in recs if r.tool == 4 and r.kind == "linear" and r.pitch]
+    assert taps == [(600, 400), (300, 200)] * 4
     # G54 = $P_UIFR[1] TR (-250.5, -180.25, -412); T1 length 90 (D1 after the change):
     # N120 G0 X-40 Y25 Z50 -> (-290.5, -155.25, -412 + 50 + 90)
     assert xyz(at(recs, 15)[0]) == (-290.5, -155.25, -272.0)

@@ -125,8 +125,10 @@ class CycleCallsMixin:
                     st.feed = s[1]
                 elif k == "dwell":
                     self._record("dwell", dwell_s=float(s[1] or 0.0))
-                elif k == "spindle":         # the cycle turns it (tapping reversal, CYCLE84 SDAC)
+                elif k == "spindle":         # the cycle turns it (tapping reversal, CYCLE84 SDAC, SST)
                     st.set("spindle", s[1])
+                    if len(s) > 2:
+                        st.spindle_speed = s[2]
                     self.spindle_stopped = s[1] in ("off", "orient")
                     self._record("spindle", spindle_dir=s[1], spindle=st.spindle_speed)
                 elif k == "stop":
@@ -334,23 +336,31 @@ class CycleCallsMixin:
         p["feed"] = lead * st.spindle_speed / st.scale
         after = {3: "cw", 4: "ccw", 5: "off"}.get(int(p.get("sdac", 0) or 0))
         before = None
+        speeds = None
         if (s.name or "").upper() == "CYCLE84":     # taps with G331/G332 on the control
             from nctrans.interp.rigid_tap import spindle_state
             before = spindle_state(self)
-            speeds = [v for v in (p.get("sst"), p.get("sst1")) if v and v != st.spindle_speed]
-            said = self.__dict__.setdefault("_tap_speeds_said", set())
-            if speeds and id(s) not in said:           # once per call (an MCALL's holes too)
-                said.add(id(s))
-                # [GK] SST is the spindle speed the cycle taps at, SST1 the one it retracts at
-                # (0: SST); which speed is in force after the cycle is not documented
-                self.diag("NC113", "warning", f"CYCLE84 tapping speed SST / retraction speed SST1 "
-                          f"({', '.join(f'{v:g}' for v in speeds)}) is not modelled: the analysed tap runs "
-                          f"at the speed in force (S{st.spindle_speed:g}), so its feed (lead x speed), "
-                          "time and spindle events differ from the machine's; the path is the same")
+            speeds = self._tap_speeds(p, lead)
         steps = tap_steps(plane=st.plane, approach=approach, bottom=bottom, retract=retract,
                           dwell_s=p.get("dwell"), forward="ccw" if kind == "tap_left" else "cw",
-                          after=after, before=before)
+                          after=after, before=before, speeds=speeds)
         return kind, steps
+
+    def _tap_speeds(self, p: dict, lead: float):
+        """CYCLE84 SST (tapping speed) and SST1 (retraction speed; 0: SST) [GK, Siemens cycles
+        manual]: (tap speed, feed), (retraction speed, feed), the speed before the call, which the
+        cycle programs again at its end; None when neither differs from the speed in force (SST 0
+        or omitted taps at the speed in force, NC128)."""
+        st = self.st
+        now = st.spindle_speed
+        tap = p.get("sst") or now
+        back = p.get("sst1") or tap
+        if tap == now and back == now:
+            return None
+
+        def feed(speed: float) -> float:      # as p["feed"] and _expand scale it
+            return lead * speed / st.scale * st.feed_scale
+        return ((None, None) if tap == now else (tap, feed(tap))), (back, feed(back)), now
 
     def _deep_hole(self, p: dict, approach: float, bottom: float, retract: float):
         """CYCLE83 infeeds from FDEP/FDPR and DAM (cycles.deep_hole_steps)."""

@@ -273,23 +273,36 @@ def deep_hole_steps(*, plane: str, vari: int, approach: float, rfp: float, botto
 
 def tap_steps(*, plane: str, approach: float, bottom: float, retract: float,
               dwell_s: Optional[float], forward: str, after: Optional[str],
-              before: Optional[str] = None) -> list[Step]:
+              before: Optional[str] = None, speeds: Optional[tuple] = None) -> list[Step]:
     """Sinumerik CYCLE84/CYCLE840 at the current position [GK, Siemens cycles manual]: G0 to
     RFP+SDIS, tap to the depth (G331: spindle-synchronised), dwell DTB, spindle reversed and tap
     back (G332) to RFP+SDIS, spindle `after` (SDAC; else as before), G0 to RTP. The caller marks
     the two linear steps as synchronised (the record's pitch). `before`: the spindle's state at
     the call, which the control's G332 returns to before SDAC applies (nctrans.interp.rigid_tap);
-    None when the cycle does not tap with G331/G332."""
+    None when the cycle does not tap with G331/G332.
+
+    `speeds` (CYCLE84 SST/SST1): ((tap speed, tap feed), (retraction speed, retraction feed),
+    speed before the call). The cycle taps at SST, retracts at SST1, and at the end programs the
+    speed that was active before the call again with SDAC's direction [GK, Siemens cycles
+    manual, CYCLE84 sequence]; a ("spindle", direction, speed) step changes the speed, a
+    ("feed", F) step the feed of the synchronised moves (lead x speed)."""
     ax = DRILL_AXIS[plane]
     up = 1.0 if approach >= bottom else -1.0
     reverse = "ccw" if forward == "cw" else "cw"
-    steps: list[Step] = [("rapid", {ax: approach}), ("linear", {ax: bottom})]
+    (tap_s, tap_f), (back_s, back_f), restore = speeds or ((None, None), (None, None), None)
+    steps: list[Step] = [("rapid", {ax: approach})]
+    if tap_s is not None:
+        steps += [("spindle", forward, tap_s), ("feed", tap_f)]
+    steps.append(("linear", {ax: bottom}))
     if dwell_s:
         steps.append(("dwell", dwell_s))
-    steps += [("spindle", reverse), ("linear", {ax: approach})]
-    if before is not None and before != reverse:
+    steps.append(("spindle", reverse) if back_s is None else ("spindle", reverse, back_s))
+    if back_f is not None:
+        steps.append(("feed", back_f))
+    steps.append(("linear", {ax: approach}))
+    if before is not None and before != reverse and (restore is None or before != (after or forward)):
         steps.append(("spindle", before))
-    steps.append(("spindle", after or forward))
+    steps.append(("spindle", after or forward) if restore is None else ("spindle", after or forward, restore))
     steps.append(("rapid", {ax: retract if (retract - approach) * up > 0 else approach}))
     return steps
 

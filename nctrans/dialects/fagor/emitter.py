@@ -219,6 +219,8 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.feed_mode = "per_min"
         self.tap_cancelled = False                    # an M3/M4/M5/M19 ended G63 on the control
         self.s_negative = False                       # a G63 wrote S negative: positive before M3/M4
+        self.last_feed: Optional[str] = None          # the F the source programmed last, as written
+        self.feed_clobbered = False                   # a G63 wrote its own F since: write it again
         self.spindle_dir: Optional[str] = None
         # An ISO source keeps its length register (G43 H<k>) over a tool change, where a Fagor
         # M06 brings D1 of the new tool: what the ISO program has in force ("off", a register
@@ -478,12 +480,18 @@ class FagorEmitter(FagorSpelling, Emitter):
 
     def w_Motion(self, s: n.Motion, word, new_line, rest: list):
         self.motion_words(s, word)
+        if (self.feed_clobbered and self.motion != "thread" and s.target and self.last_feed
+                and not any(isinstance(x, n.Feed) for x in rest)):
+            word("F", self.last_feed)        # a G63's F (lead x S) is the modal feed after it
+            self.feed_clobbered = False
         new_line()
         return 0
 
     def w_Feed(self, s: n.Feed, word, new_line, rest: list):
         val = self.value
-        word("F", "F" + val(s.value))
+        self.last_feed = "F" + val(s.value)
+        self.feed_clobbered = False
+        word("F", self.last_feed)
 
     def w_SpindleSpeed(self, s: n.SpindleSpeed, word, new_line, rest: list):
         val = self.value
@@ -819,6 +827,7 @@ class FagorEmitter(FagorSpelling, Emitter):
                      "the spindle turning by the sign of S)")
         feed = abs(lead) if self.feed_mode == "per_rev" else abs(lead) * self.speed
         word("F", "F" + format_number(round(feed, 6)))
+        self.feed_clobbered = True
         negative = self.spindle_dir == "ccw"
         word("S", "S" + format_number(-self.speed if negative else self.speed))
         self.s_negative = negative
