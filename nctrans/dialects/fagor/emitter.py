@@ -22,6 +22,7 @@ from nctrans import spilled
 from nctrans.dialects.base import EmitResult
 from nctrans.dialects.base import get as get_dialect
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
+from nctrans.dialects.tool_timing import ToolTiming
 from nctrans.ir import nodes as n
 from nctrans.plainrun import RUNS, run_blocks
 from nctrans.ir import walk as ir_walk
@@ -213,6 +214,8 @@ class FagorEmitter(FagorSpelling, Emitter):
         # the tool in the spindle (T<n> M06, constant numbers only) and the T selected for it
         self.tool_selected: Optional[float] = None
         self.tool_active: Optional[float] = None
+        # the tool words moved to where this control's words change the tool as the source's do
+        self.tool_timing = ToolTiming(program.dialect, "fagor")
         self.in_sub = False
         # spindle-synchronised moves ("thread") are written as G63: S and the feed mode they need
         self.speed: Optional[float] = None            # the last constant S written (rev/min)
@@ -327,46 +330,55 @@ class FagorEmitter(FagorSpelling, Emitter):
                 except NotExpressible as e:     # refused at its line, as inside a block
                     self.refuse(str(e))
             if t is n.Block:
+                if _is_target(node, self.targets):
+                    self.tool_timing.forget()   # the tool held depends on the path taken
                 self.block(node)
-            elif t is n.If:
-                self._if(node, "$IF")
-                self.out.append("$ENDIF")
-            elif t is n.While:
-                self._flow_line(f"$WHILE {self._cond(node.cond)}")
-                self.nodes(node.body)
-                self.out.append("$ENDWHILE")
-            elif t is n.Loop:
-                self.out.append("$WHILE 1")
-                self.nodes(node.body)
-                self.out.append("$ENDWHILE")
-            elif t is n.RepeatUntil:
-                self.out.append("$DO")
-                self.nodes(node.body)
-                c = node.cond
-                keep = c.operand if isinstance(c, n.Unary) and c.op == "not" else n.Unary("not", c)
-                self._flow_line(f"$ENDDO {self._cond(keep)}")
-            elif t is n.ForLoop:
-                try:
-                    var = self.var_text(node.var)
-                    step = node.step if node.step is not None else n.Num(1.0)
-                    self.out.append(f"$FOR {var}={self.expr(node.start)},"
-                                    f"{self.expr(node.end)},{self.expr(step)}")
-                except NotExpressible as e:
-                    self.refuse(str(e))
-                self.nodes(node.body)
-                self.out.append("$ENDFOR")
-            elif t is n.Case:
-                try:
-                    subj = self.expr(node.subject)
-                    for value, label in node.branches:
-                        self.out.append(f"$IF [{subj}]==[{self.expr(value)}] $GOTO "
-                                        f"{self._target(label)}")
-                    if node.default is not None:
-                        self.out.append(f"$GOTO {self._target(node.default)}")
-                except NotExpressible as e:
-                    self.refuse(str(e))
-            else:
-                self.refuse(f"the structure {t.__name__}")
+                continue
+            self.tool_timing.forget()           # loops and branches: the tool held depends on the path
+            self._structure(node, t)
+            self.tool_timing.forget()
+
+    def _structure(self, node, t) -> None:
+        """A loop, branch or CASE, with its body."""
+        if t is n.If:
+            self._if(node, "$IF")
+            self.out.append("$ENDIF")
+        elif t is n.While:
+            self._flow_line(f"$WHILE {self._cond(node.cond)}")
+            self.nodes(node.body)
+            self.out.append("$ENDWHILE")
+        elif t is n.Loop:
+            self.out.append("$WHILE 1")
+            self.nodes(node.body)
+            self.out.append("$ENDWHILE")
+        elif t is n.RepeatUntil:
+            self.out.append("$DO")
+            self.nodes(node.body)
+            c = node.cond
+            keep = c.operand if isinstance(c, n.Unary) and c.op == "not" else n.Unary("not", c)
+            self._flow_line(f"$ENDDO {self._cond(keep)}")
+        elif t is n.ForLoop:
+            try:
+                var = self.var_text(node.var)
+                step = node.step if node.step is not None else n.Num(1.0)
+                self.out.append(f"$FOR {var}={self.expr(node.start)},"
+                                f"{self.expr(node.end)},{self.expr(step)}")
+            except NotExpressible as e:
+                self.refuse(str(e))
+            self.nodes(node.body)
+            self.out.append("$ENDFOR")
+        elif t is n.Case:
+            try:
+                subj = self.expr(node.subject)
+                for value, label in node.branches:
+                    self.out.append(f"$IF [{subj}]==[{self.expr(value)}] $GOTO "
+                                    f"{self._target(label)}")
+                if node.default is not None:
+                    self.out.append(f"$GOTO {self._target(node.default)}")
+            except NotExpressible as e:
+                self.refuse(str(e))
+        else:
+            self.refuse(f"the structure {t.__name__}")
 
     def _if(self, node: n.If, kw: str) -> None:
         self._flow_line(f"{kw} {self._cond(node.cond)}")
@@ -424,7 +436,11 @@ class FagorEmitter(FagorSpelling, Emitter):
             if alone:
                 new_line()
 
-        body = b.body
+        body, why = self.tool_timing.retime(b.body)
+        if why is not None:
+            self.refuse(why)
+        for note in self.tool_timing.notes:
+            self.lowered(note)
         i = 0
         while i < len(body):
             s = body[i]

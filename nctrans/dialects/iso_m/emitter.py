@@ -37,6 +37,7 @@ from nctrans.interp import corner_elements
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, flat_forms, format_number, rewrites
 from nctrans.ir import nodes as n
+from nctrans.dialects.tool_timing import ToolTiming
 from nctrans.ir import walk
 from nctrans.ir.walk import constant
 from nctrans.plainrun import RUNS, PlainRun, run_blocks
@@ -168,6 +169,9 @@ class IsoEmitter(IsoSpelling, Emitter):
     # the offset: written without T.. M6, which would change the tool (and stop the spindle) here
     drops_staying_turret: bool = True
     turret_tool: Optional[int] = None
+    # its T word changes the tool wherever it is written (ISO turning's turret), whatever the
+    # machine's tool_change.by_t_word (nctrans.dialects.tool_timing)
+    t_word_is_turret: bool = False
     # power-on modes a program from another control relies on, written out where ours differ
     power_on_groups: tuple[str, ...] = ("feed_mode", "plane")
 
@@ -256,12 +260,16 @@ class IsoEmitter(IsoSpelling, Emitter):
                               and not (program.meta or {}).get("flattened_from"))
         self.rel_selected: Optional[int] = None
         self.rel_tool: Optional[int] = 0
+        # the tool words moved to where this control's words change the tool as the source's do
+        self.tool_timing = ToolTiming(program.dialect, self.dialect, self.t_word_is_turret)
 
     def forget(self) -> None:
         super().forget()
         self.distance_known = False
         self.spindle_tool = None
         self.turret_tool = None
+        if getattr(self, "tool_timing", None) is not None:
+            self.tool_timing.forget()
         if getattr(self, "edge_lengths", None) is not None:
             self.edge_lengths.reached_from_elsewhere()
 
@@ -734,6 +742,8 @@ class IsoEmitter(IsoSpelling, Emitter):
             comment = f"LABEL {b.label}" + (f" {comment}" if comment else "")
         tail = f" {self._comment(comment)}" if comment is not None else ""
         if not lines:
+            if b.body and not (prefix or tail):
+                return          # its words were moved or said by others (a held T, a lathe's G43)
             text = (prefix + tail.lstrip()).strip() if (prefix or tail) else ""
             self.out.append(text)
             return
@@ -915,6 +925,11 @@ class IsoEmitter(IsoSpelling, Emitter):
         return [s for i, s in enumerate(body) if i not in turns and i not in tools]
 
     def statements(self, body) -> list[list[str]]:
+        body, why = self.tool_timing.retime(body)
+        if why is not None:
+            self.refuse(why)
+        for note in self.tool_timing.notes:
+            self.lowered(note)
         if self.drops_staying_turret:
             body = self._turret_stays(body)
         lines: list[_Line] = [_Line()]

@@ -34,6 +34,7 @@ class TurningEmitter(iso.IsoEmitter):
     lowered_for = "ISO"
     writes_edge_lengths = False     # a lathe's tool length is not applied along Z (tool_edges)
     drops_staying_turret = False    # its T word is the turret's own (T0111 says the offset)
+    t_word_is_turret = True
 
     def __init__(self, program: n.Program):
         super().__init__(program)
@@ -134,8 +135,14 @@ class TurningEmitter(iso.IsoEmitter):
     def w_ToolSelect(self, s):
         t = s.tool
         if type(t) is n.Num and t.value == int(t.value) and 0 <= t.value < 100:
-            self.t_tool = int(t.value)
-            self.t_offset = self.t_tool if self.block_offset is None else self._own(self.block_offset, self.t_tool)
+            new = int(t.value)
+            if self.block_offset is not None:
+                self.t_offset = self._own(self.block_offset, new)
+            elif self.tool_relative or self.t_offset is None or self.t_tool is None:
+                self.t_offset = new     # the new tool's own (Sinumerik/Fagor: its D1 comes in)
+            # else: an ISO mill's register in force stays in force through the change (T0201
+            # after H1: a later G43 H2 writes T0202)
+            self.t_tool = new
             self.t_chosen = {}
             return [("T", f"T{self.t_tool:02d}{self.t_offset:02d}")]
         self.t_tool = self.t_offset = None

@@ -40,6 +40,7 @@ from nctrans.diagnostics import Diagnostic, at_span
 from nctrans.calls import call_arguments
 from nctrans.dialects.base import EmitResult
 from nctrans.dialects.emit import Emitter, NotExpressible, rewrites
+from nctrans.dialects.tool_timing import ToolTiming
 from nctrans.dialects.sinumerik.spelling import SinumerikSpelling
 from nctrans.dialects.sinumerik.spelling import format_number as _fmt
 from nctrans.ir import nodes as ir
@@ -130,6 +131,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.pending = None
         self.targets = walk.program_jump_targets(program)
         self.unit_nodes: list = []
+        # the tool words moved to where this control's words change the tool as the source's do
+        self.tool_timing = ToolTiming(program.dialect, DIALECT)
         # G65 macros written as PROCs with named parameters (nctrans.lower.macro_procs), and while
         # one is written, its locals #n by name
         self.procs = macro_procs.plan(program) if program.dialect != DIALECT else {}
@@ -1163,6 +1166,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             return
         if (b.label and b.label in self.targets) or (b.number and b.number in self.targets):
             self.pos = {}            # a jump target: the position depends on the path taken
+            self.tool_timing.forget()
             if self.edges is not None:
                 self.edge_step(ind)     # the path falling through arrives in step, as every
                 # jump does (a Goto is written in step); what the unit changes depends on the path
@@ -1172,8 +1176,13 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                         self.unit_nodes, self.callee_body)
                 self.edges.forget_fields(set().union(
                     *(regions.get(_jump_key(x), set()) for x in (b.label, b.number) if x)))
-        decls = [s for s in b.body if isinstance(s, ir.VarDecl)]
-        rest = [s for s in b.body if not isinstance(s, ir.VarDecl)]
+        body, why = self.tool_timing.retime(b.body)
+        if why is not None:
+            self.refuse(why)
+        for note in self.tool_timing.notes:
+            self.lowered(note)
+        decls = [s for s in body if isinstance(s, ir.VarDecl)]
+        rest = [s for s in body if not isinstance(s, ir.VarDecl)]
         line = _Line(only=len(rest) == 1, join=self.p.dialect == DIALECT)
         groups: list[list] = []
         for d in decls:
@@ -1332,6 +1341,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                     self.ctl(ind, alarm, deco)
                 continue
             self.pos = {}            # loops and branches: positions depend on the path taken
+            self.tool_timing.forget()
             self.edge_step(ind)      # every path through the structure starts in step
             if self.edges is not None and not isinstance(n, ir.If):
                 self.edges.forget_changed_by([n])    # a loop's body follows its own last pass
@@ -1369,6 +1379,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.span = span
                 self.refuse(str(e))
             self.pos = {}
+            self.tool_timing.forget()
             if self.edges is not None:       # every path leaves in step; what it changed is not known
                 self.edges.forget_changed_by([n])
 
