@@ -105,7 +105,7 @@ def test_a_kept_or_added_angle_the_seed_leaves_open_is_refused(text, line):
 
 @pytest.mark.parametrize("block", [
     "G2 X10. Y90. R10.",                # a circle with polar words
-    "G81 X10. Y90. Z-5. R2. F100",      # a cycle position: alarm 61814 unless _ZSFI[3] = 1
+    "G81 X10. Y90. Z-5. R2. F100 K3",   # a repeated cycle position (one K=1 position is modelled)
     "G92 X0 Y0",                        # a dimension word that is no motion
     "G53 X0 Y0",
 ])

@@ -15,6 +15,10 @@ What the seed defines, and so what is modelled:
   on at 45 degrees). About the zero, an angle left out (G90) or added to (G91: `G91 Y30` alone, the
   bolt circle) is the current point's angle, where that is the angle last programmed about the zero.
 - Words of other axes (the plane's third axis) are Cartesian as always.
+- Hole positions of canned cycles (G73..G89) where the rules option `polar_cycle_positions` is
+  "polar" (iso-m, a Fanuc [GK]: its manual's bolt hole circle, `G16` then `G81 X100 Y30 Z-20 R-5`,
+  `Y150`, `Y270`): the plane words of a cycle block are radius and angle as in a motion block; the
+  cycle then drills at that point, its drilling-axis words (Z, R) as always.
 
 What it does not define, and so is refused at its line (NC117, the block moves nothing):
 - G91 with a radius and no angle (no angle about the new pole);
@@ -22,8 +26,9 @@ What it does not define, and so is refused at its line (NC117, the block moves n
   programmed (after a Cartesian move, a move about another pole, or as the first polar block):
   keeping one or the other is not the seed's to say;
 - a circle (G2/G3) with a polar end point (the seed gives no centre rule);
-- a canned cycle position under G16: alarm 61814 unless the setting `_ZSFI[3]` is 1 (L2427,
-  L6385), and the seed does not say how the cycle reads it then;
+- a canned cycle position under G16 where the dialect's rules say the control alarms
+  (`polar_cycle_positions` not "polar": the seed's Sinumerik ISO mode alarms 61814 unless the
+  setting `_ZSFI[3]` is 1, L2427, L6385), or one repeated by K;
 - G53, G28/G30, G92, G52, G68 or G51 with plane axis words under G16 (the seed names motion only).
 """
 from __future__ import annotations
@@ -32,6 +37,7 @@ import math
 from typing import Optional
 
 from nctrans.interp.frames import PLANE_AXES
+from nctrans.rules import option
 
 RULE = "NC117"
 
@@ -83,8 +89,14 @@ def cartesian(interp, vals: list, machine: bool = False) -> Optional[list]:
         refuse(interp, "a circle or other non-linear motion with polar words")
         return None
     if st.cycle != "off" or interp.modal_cycle is not None:
-        refuse(interp, "a canned cycle position (alarm 61814 unless _ZSFI[3] = 1)")
-        return None
+        if interp.modal_cycle is not None or option(interp.program.dialect, "polar_cycle_positions") != "polar":
+            refuse(interp, "a canned cycle position (alarm 61814 unless _ZSFI[3] = 1)")
+            return None
+        if int(round(interp.cycle_params.get("repeat", 1) or 1)) != 1:
+            # K repeats the hole by the block's increments; whether an angle step repeats about
+            # the pole is not documented in the seed or [GK]
+            refuse(interp, "a repeated (K) canned cycle position")
+            return None
     cur1, cur2 = interp.pos.get(a1, 0.0), interp.pos.get(a2, 0.0)
     if radius is not None and inc_radius:
         if angle is None:
