@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from nctrans import api, pipeline
-from nctrans.interp.undercuts import din509, din76, undercut_steps
+from nctrans.interp.undercuts import din509, din76, din76_internal, undercut_steps
 from nctrans.machine import Tool, default_lathe
 from nctrans.source import from_text
 
@@ -98,6 +98,42 @@ def test_thread_undercut_form_a_and_b_by_hand():
     assert got[:3] == _approx([("rapid", 13, -21.5), ("linear", 12, -22.5), ("linear", 9.8, -22.5 - 2.2 / TAN30)])
 
 
+def test_internal_thread_undercut_forms_c_and_d_by_hand():
+    # M20 internal: coarse pitch 2.5; DIN 76 internal row 2.5 [GK]: dg = d + 0.5 = 20.5 (radius
+    # 10.25), g2 13 (C) / 9.3 (D), r 1.2. Cut into the core hole at the minor diameter D1 = 20 -
+    # 1.082532 x 2.5 = 17.29367 (radius 8.646835): depth t = (20.5 - 17.29367) / 2 = 1.603165.
+    # VARI 2 (tip +X -Z): inside, the shoulder at Z-30 towards -Z. Start 1 inside the hole and 1
+    # beyond: X7.646835 Z-30+13+1 = -16; onto the hole X8.646835 Z-17; the run-out at 30 degrees,
+    # 1.603165 / tan 30 = 2.776763 long, to X10.25 Z-19.776763; base to Z-28.8 (r from the face);
+    # the radius about (8.646835 + 1.603165 - 1.2, -28.8) = (9.05, -28.8) to X9.05 Z-30; down the
+    # face to the hole X8.646835, off by 1 to X7.646835; G0 back.
+    r1 = (20 - 1.082532 * 2.5) / 2
+    got, diags, recs = _run('CYCLE96(20, -30, "C", 2)')
+    assert [d for d in diags if d.severity != "info"] == []
+    assert got == _approx([("rapid", r1 - 1, -16), ("linear", r1, -17), ("linear", 10.25, -17 - 2.776763),
+                           ("linear", 10.25, -28.8), ("arc", 9.05, -30), ("linear", r1, -30),
+                           ("linear", r1 - 1, -30), ("rapid", r1 - 1, -16)])
+    (arc,) = [r for r in recs if r.kind == "arc"]
+    assert arc.center["X"] == pytest.approx(9.05) and arc.center["Z"] == pytest.approx(-28.8)
+    # form D: g2 9.3: start at Z-30+9.3+1 = -19.7, onto the hole at Z-20.7
+    got, diags, _ = _run('CYCLE96(20, -30, "D", 2)')
+    assert got[:3] == _approx([("rapid", r1 - 1, -19.7), ("linear", r1, -20.7),
+                               ("linear", 10.25, -20.7 - 2.776763)])
+    # M8 (P 1.25) with the shoulder towards +Z (VARI 1): dg 8.5, D1 = 8 - 1.353165 = 6.646835,
+    # t = (8.5 - 6.646835) / 2 = 0.926583; g2 (C) 6.7: the undercut from Z0 to Z-6.7 going -Z
+    got, diags, _ = _run('CYCLE96(8, 0, "C", 1)')
+    r1 = (8 - 1.082532 * 1.25) / 2
+    assert got[:3] == _approx([("rapid", r1 - 1, -7.7), ("linear", r1, -6.7),
+                               ("linear", 4.25, -6.7 + 0.926583 / TAN30)])
+
+
+def test_internal_undercut_converts_to_iso_turning():
+    text = _text('CYCLE96(20, -30, "C", 2)\nG0 Z5\nCYCLE96(20, -30, "D", 2)')
+    conv = api.transpile(text, "sinumerik", "iso-t", machine=_lathe())
+    assert conv.text is not None and "CYCLE96" not in conv.text
+    assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-t", machine=_lathe())
+
+
 def test_inside_undercut_cuts_away_from_the_axis():
     # VARI 2 (tip +X -Z): a bore of diameter 40 with the shoulder at Z-20 towards -Z; the undercut
     # goes outwards to radius 20.3 (row 18..80); the start is 1 inside the bore (radius 19).
@@ -116,7 +152,8 @@ def test_vari_0_takes_the_tools_cutting_edge_position():
 @pytest.mark.parametrize("call,tip,rule", [
     ('CYCLE94(30, -20, "E", 0)', None, "NC115"),   # no tip direction for VARI 0
     ('CYCLE94(30, -20, "E", 6)', None, "NC115"),   # a tip along an axis names no corner
-    ('CYCLE96(24, -30, "C", 3)', None, "NC115"),   # internal thread undercut
+    ('CYCLE96(24, -30, "C", 3)', None, "NC116"),   # an internal undercut at an outside position
+    ('CYCLE96(24, -30, "A", 2)', None, "NC116"),   # an external undercut at an inside position
     ('MCALL CYCLE94(30, -20, "E", 3)', None, "NC115"),
     ('CYCLE94(30, -20, "G", 3)', None, "NC116"),   # no such form
     ('CYCLE94(30, -20, "E", 9)', None, "NC116"),
@@ -167,7 +204,7 @@ def _material(u, w, t, W, r, t2, run, tol=1e-6):
 
 
 @settings(max_examples=120, deadline=None)
-@given(st.floats(1, 200), st.floats(-100, 100), st.sampled_from(["E", "F", "A", "B"]),
+@given(st.floats(1, 200), st.floats(-100, 100), st.sampled_from(["E", "F", "A", "B", "C", "D"]),
        st.sampled_from([1, 2, 3, 4]))
 def test_undercuts_never_cut_outside_the_outline_and_end_where_they_start(diameter, spl, form, pos):
     if form in "EF":
@@ -177,9 +214,12 @@ def test_undercuts_never_cut_outside_the_outline_and_end_where_they_start(diamet
         d = min(sizes, key=lambda s: abs(s - diameter / 4))
         pitch = {3: .5, 4: .7, 5: .8, 6: 1, 8: 1.25, 10: 1.5, 12: 1.75, 14: 2, 16: 2, 18: 2.5, 20: 2.5,
                  22: 2.5, 24: 3, 27: 3, 30: 3.5, 33: 3.5, 36: 4, 39: 4, 42: 4.5, 45: 4.5, 48: 5}[d]
-        cut, run, diameter = din76(pitch, form), 30.0, float(d)
+        cut, run, diameter = din76(pitch, form) if form in "AB" else None, 30.0, float(d)
     inside, plus_z = pos in (1, 2), pos in (1, 4)
     r0 = diameter / 2
+    if form in "CD":                 # internal: cut into the core hole, from inside it
+        cut, r0 = din76_internal(pitch, form, diameter)
+        inside = True
     steps = undercut_steps(cut, r0, spl, inside, plus_z, 1.0)
     e, s = (-1 if inside else 1), (-1 if plus_z else 1)
 

@@ -465,6 +465,17 @@ class Din76Row:
 
 
 @dataclass
+class Din76InternalRow:
+    """One row of the DIN 76 internal thread undercut table (forms C/D), by the pitch."""
+    __pydantic_config__ = {"extra": "forbid"}
+    pitch: float
+    diameter_more: float          # undercut diameter - nominal diameter
+    width_normal: float           # form C
+    width_short: float            # form D
+    radius: float
+
+
+@dataclass
 class UndercutTables:
     """rules/cycles.toml [undercut]: the CYCLE94 / CYCLE96 tables (nctrans.interp.undercuts)."""
     __pydantic_config__ = {"extra": "forbid"}
@@ -474,6 +485,8 @@ class UndercutTables:
     clearance: float = 1.0
     din509: list[Din509Row] = field(default_factory=list)
     din76: list[Din76Row] = field(default_factory=list)
+    din76_internal: list[Din76InternalRow] = field(default_factory=list)
+    minor_diameter_factor: float = 1.082532
 
 
 @dataclass
@@ -542,9 +555,10 @@ class CycleTable:
 
 
 def _undercut_tables(d: dict) -> UndercutTables:
-    rows = {k: v for k, v in d.items() if k not in ("din509", "din76")}
+    rows = {k: v for k, v in d.items() if k not in ("din509", "din76", "din76_internal")}
     return UndercutTables(**rows, din509=[Din509Row(**r) for r in d.get("din509", [])],
-                          din76=[Din76Row(**r) for r in d.get("din76", [])])
+                          din76=[Din76Row(**r) for r in d.get("din76", [])],
+                          din76_internal=[Din76InternalRow(**r) for r in d.get("din76_internal", [])])
 
 
 @lru_cache(maxsize=1)

@@ -3,7 +3,7 @@ planned as plain feeds, arcs and rapids.
 
 `CYCLE94(SPD, SPL, FORM, VARI)` cuts a DIN 509 undercut of form E or F into the corner between a
 cylinder of diameter SPD and a shoulder face at SPL; `CYCLE96(DIATH, SPL, FORM, VARI)` cuts a DIN 76
-thread undercut (form A normal, B short) into a thread of nominal diameter DIATH at the shoulder at
+thread undercut (form A normal, B short external; C normal, D short internal) into a thread of nominal diameter DIATH at the shoulder at
 SPL. The undercut's dimensions are looked up in tables (rules/cycles.toml [undercut], each fact with
 where it comes from); the plan is pure geometry (`undercut_steps`, testable without an interpreter)
 in X (radius) and Z; `run_undercut` plays it through the lathe's turning emitter, so conversion,
@@ -30,11 +30,14 @@ Modelling choices [NC] (what the manual leaves to the control, or what is not es
   the face by the clearance, and returns to the start with G0;
 - form F: the face recess t2 runs from the radius straight up to the face at the DIN angle of 8°
   (the radius meets it with a small kink instead of tangentially);
-- not modelled, refused at the call's line with no motion (NC115): CYCLE96 forms C and D (an
-  internal thread's undercut is measured from its core diameter, which is not established here;
-  no seed or stored page gives DIN 76's internal rows, and the external A/B table is itself from
-  general knowledge, to confirm: a guessed internal table would be silently wrong),
-  VARI 5..8, VARI 0 without a tip direction in the machine model, MCALL.
+- CYCLE96 forms C and D (internal threads): the DIN 76 internal table [GK, to confirm against
+  the standard; rules/cycles.toml says where it comes from] gives dg = d + 0.3/0.5, g2 and r by
+  the pitch; the undercut is cut into the core hole, whose surface is taken as the basic minor
+  diameter D1 = d - 1.082532 P (ISO 724) [NC: where the control's cycle starts an internal
+  undercut is not documented here]: depth (dg - D1) / 2, the clearance point 1 mm inside the core
+  hole. A form and a position that disagree (C/D outside, A/B inside) are NC116;
+- not modelled, refused at the call's line with no motion (NC115): VARI 5..8, VARI 0 without a
+  tip direction in the machine model, MCALL.
 """
 from __future__ import annotations
 
@@ -96,6 +99,22 @@ def din76(pitch: float, form: str) -> Undercut:
             width = row.width_normal if form == "A" else row.width_short
             return Undercut(row.diameter_less / 2.0, width, row.radius, table.din76_run_out)
     raise impossible(f"for a pitch of {pitch:g} mm, which the DIN 76 table does not list")
+
+
+def din76_internal(pitch: float, form: str, diameter: float) -> tuple[Undercut, float]:
+    """The DIN 76 internal thread undercut (C normal, D short) for a pitch and nominal diameter,
+    and the radius of the surface it is cut into: the core hole at the basic minor diameter
+    D1 = d - 1.082532 P [GK ISO 724; where the cycle starts it is nctrans' choice, NC]. The depth
+    below that surface is (dg - D1) / 2 with dg = d + diameter_more."""
+    from nctrans.interp.cycles import cycle_table
+    table = cycle_table().undercut
+    for row in table.din76_internal:
+        if abs(row.pitch - pitch) <= EPS:
+            width = row.width_normal if form == "C" else row.width_short
+            minor = diameter - table.minor_diameter_factor * pitch
+            depth = (diameter + row.diameter_more - minor) / 2.0
+            return Undercut(depth, width, row.radius, table.din76_run_out), minor / 2.0
+    raise impossible(f"for a pitch of {pitch:g} mm, which the DIN 76 internal table does not list")
 
 
 def position(vari: float, tip: Optional[int]) -> tuple[bool, bool]:
@@ -194,16 +213,20 @@ def plan(interp, cyc, s) -> list[Step]:
         cut = din509(diameter, form)
     else:
         form = _form(interp, s, "ABCD")
-        if form in "CD":
-            raise unmodelled(f"with FORM {form} (an internal thread's undercut): not modelled; nctrans "
-                             "models the external forms A and B (no seed gives DIN 76's internal "
-                             "dimensions, and where the cycle measures them from is not established)")
         diameter = abs(p.get("DIATH", 0.0))
         pitch = coarse_pitch(diameter)
         if pitch is None:
             raise impossible(f"with DIATH {diameter:g}: no metric coarse thread of that diameter "
                              "([metric_coarse_pitch]) gives the pitch")
-        cut = din76(pitch, form)
+        inside, plus_z = position(p.get("VARI", 0.0), _active_tip(interp))
+        if inside != (form in "CD"):
+            raise impossible(f"with FORM {form} ({'an internal' if form in 'CD' else 'an external'} "
+                             f"thread's undercut) at an {'inside' if inside else 'outside'} position")
+        if form in "CD":
+            cut, surface = din76_internal(pitch, form, diameter)
+        else:
+            cut, surface = din76(pitch, form), diameter / 2.0
+        return undercut_steps(cut, surface, p.get("SPL", 0.0), inside, plus_z, clearance)
     inside, plus_z = position(p.get("VARI", 0.0), _active_tip(interp))
     return undercut_steps(cut, diameter / 2.0, p.get("SPL", 0.0), inside, plus_z, clearance)
 
