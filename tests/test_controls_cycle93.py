@@ -373,3 +373,17 @@ def test_sloping_flanks_with_corners_converted_to_iso_turning_is_equivalent():
     conv = api.transpile(text, "sinumerik", "iso-t", machine=_lathe(3.0))
     assert conv.text is not None and "CYCLE93" not in conv.text
     assert api.equiv(text, conv.text, read_a="sinumerik", read_b="iso-t", machine=_lathe(3.0))
+
+
+def test_sta1_zero_is_the_paraxial_groove_and_an_inclined_contour_stays_refused():
+    # STA1 0 written out is the groove with STA1 omitted (a subprogram sees an omitted argument
+    # as 0, seed L4722)
+    given, _, _ = _run("CYCLE93(40, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)")
+    omitted, _, _ = _run("CYCLE93(40, -10, 8, 4, , 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)")
+    assert given and given == omitted
+    # STA1 30 with a 3 mm tool: a base sloping at 30 degrees under a flat blade 3 wide leaves
+    # 3 x tan 30 = 1.732 at one end: refused at its line, nothing moves
+    got, diags, _ = _run("CYCLE93(40, -10, 8, 4, 30, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 5, 1)")
+    assert got == []
+    (d,) = [d for d in diags if d.line == 4 and d.severity != "info"]
+    assert d.rule == "NC113" and "STA1 30" in d.message and "3 x tan 30" in d.message

@@ -52,9 +52,11 @@ Modelling choices [NC] (the manual leaves them to the control):
 - a corner on a sloping flank is a rounding tangent to flank and contour (or base), or a chamfer
   with equal legs (nctrans.interp.corners, as RND/CHF/CHR);
 - not modelled, refused at the call's line and moving nothing (NC113): an inclined contour
-  (STA1 not 0: the manual [GK] turns the groove with the contour, but the tool does not turn;
-  whether DIAG is then square to the contour or paraxial, and which cutting edge finishes a
-  sloping base, are not documented), MCALL;
+  (STA1 not 0: the manual [GK] turns the groove with the contour, but the tool does not turn, and
+  a flat blade tw wide cannot finish a base sloping at STA1: one corner touches it, the other
+  stays tw x tan STA1 above it, or the blade cuts below it; whether the control leaves that
+  material, finishes the base otherwise, or measures DIAG paraxially is not documented, so any
+  model of it would be a guess at the machine's motion), MCALL;
 - a groove or clearance that would take the path across the turning axis (X below 0) alarms
   (NC114).
 """
@@ -223,12 +225,21 @@ def groove_passes(p: dict[str, float], tool_width: float) -> tuple[list[Step], l
         if not math.isfinite(v):
             raise impossible(f"with {k} not a finite number")
     face, inside, right, chr_ = variant(p.get("VARI", 0.0))
-    if abs(p.get("STA1", 0.0)) > EPS:
-        raise unmodelled(f"on an inclined contour (STA1 {p['STA1']:g}): not modelled (the seeds do not "
-                         "document CYCLE93; the manual [GK] turns the groove with the contour but the tool "
-                         "does not turn: whether DIAG is then square to the contour or paraxial, and which "
-                         "cutting edge finishes a sloping base, is not documented); nctrans models grooves in "
-                         "a contour parallel (longitudinal) or square (face) to the axis, STA1 0")
+    sta1 = p.get("STA1", 0.0)
+    if abs(sta1) > EPS:
+        # A groove turned with the contour has a base sloping at STA1 to the axis, which a grooving
+        # tool that does not turn cannot finish: its flat blade tw wide touches the base with one
+        # corner only, so either the other corner's end (tw wide, tw x tan STA1 deep) stays or the
+        # blade cuts below the base. What the control does there (or whether its groove is turned
+        # at all, DIAG square to the contour or paraxial) is in neither the seeds nor [GK]
+        raise unmodelled(f"on an inclined contour (STA1 {sta1:g}): not modelled (the seeds do not "
+                         "document CYCLE93; the manual [GK] turns the groove with the contour, but a tool "
+                         f"that does not turn cannot finish a base sloping at {sta1:g} degrees with its flat "
+                         f"blade {tool_width:g} wide (it leaves {tool_width:g} x tan {sta1:g} of material at "
+                         "one end of the base, or cuts below it), and how the control's cycle "
+                         "resolves it, or whether DIAG is square to the contour at all, is not documented); "
+                         "nctrans models grooves in a contour parallel (longitudinal) or square (face) to "
+                         "the axis, STA1 0")
     ang1, ang2 = p.get("ANG1", 0.0), p.get("ANG2", 0.0)
     for name, a in (("ANG1", ang1), ("ANG2", ang2)):
         if not 0.0 <= a < 90.0 - 1e-3 + EPS:
