@@ -135,6 +135,6 @@ def test_iso_g84_records_the_lead_f_over_s():
 
 
 def test_tapping_cycle_without_pitch_is_an_error():
-    recs, diags = run("G0 Z50 S500 M3\nCYCLE84(10, 0, 2, -15, , , , , , , 500)\nM30\n", "sinumerik")
+    recs, diags = run("G0 Z50 S500 M3\nCYCLE84(10, 0, 2, -15, , , 3, , , , 500)\nM30\n", "sinumerik")
     assert [d.rule for d in diags if d.line == 2] == ["NC206"]
     assert not [r for r in recs if r.line == 2 and r.kind == "linear"]

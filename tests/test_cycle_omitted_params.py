@@ -78,3 +78,12 @@ def test_feed_and_spindle_direction_from_state_are_said():
     _, diags = _run("POCKET2(50, 0, 2, -5, , 10, 0, 0, , , 5, 2, 0, 1)")
     assert [d.rule for d in diags] == ["NC128"]
     assert "FFD" in diags[0].message and "FFP1" in diags[0].message
+
+
+def test_cycle84_sdac_omitted_is_said():
+    # SDAC 0: no direction after the cycle (3/4/5 are M3/M4/M5); the analysis turns the spindle
+    # back to the direction in force (M3) and says so (NC128)
+    recs, diags = _run("CYCLE84(50, 0, 2, -10, , 0, , , 1.5, 0, 1000)")
+    assert [d.rule for d in diags] == ["NC128"] and "SDAC" in diags[0].message
+    _, diags = _run("CYCLE84(50, 0, 2, -10, , 0, 3, , 1.5, 0, 1000)")
+    assert not diags
