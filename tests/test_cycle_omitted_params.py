@@ -3,6 +3,8 @@ argument as 0 (seed L4722). RTP left out retracts to 0 (NC127); a feed or CYCLE8
 is taken from the program's state and said at the line (NC128)."""
 from __future__ import annotations
 
+from hypothesis import given, settings, strategies as hs
+
 from nctrans import pipeline
 from nctrans.interp.milling_cycles import levels_of
 from nctrans.machine import Machine, Tool
@@ -87,3 +89,18 @@ def test_cycle84_sdac_omitted_is_said():
     assert [d.rule for d in diags] == ["NC128"] and "SDAC" in diags[0].message
     _, diags = _run("CYCLE84(50, 0, 2, -10, , 0, 3, , 1.5, 0, 1000)")
     assert not diags
+
+
+@settings(max_examples=25, deadline=None)
+@given(hs.sampled_from(["CYCLE81", "CYCLE82", "CYCLE83", "CYCLE85", "CYCLE89"]),
+       hs.integers(-10, 10), hs.integers(0, 5), hs.integers(1, 30))
+def test_an_omitted_rtp_is_rtp_zero(name, rfp, sdis, depth):
+    # whatever the cycle and levels, leaving RTP out drives the toolpath of RTP 0 written out,
+    # and only the omitted one says NC127 (feeds given so that nothing else is said)
+    rest = {"CYCLE81": "", "CYCLE82": ", 0.5", "CYCLE83": ", , , 2, 0, 0, 1, 0",
+            "CYCLE85": ", 0, 100, 200", "CYCLE89": ", 0.5"}[name]
+    args = f"{rfp}, {sdis}, {rfp - depth}{rest}"
+    recs, diags = _run(f"{name}(, {args})")
+    recs0, diags0 = _run(f"{name}(0, {args})")
+    assert [(r.kind, r.end) for r in recs] == [(r.kind, r.end) for r in recs0]
+    assert [d.rule for d in diags] == ["NC127"] and not diags0
