@@ -35,6 +35,9 @@ class MacroProc:
     params: list[tuple[int, str]] = field(default_factory=list)
     plain_locals: list[int] = field(default_factory=list)
     vacancy_tested: set[int] = field(default_factory=set)   # read, never set: $P_SUBPAR answers
+    # read before it is set, then set, and compared (== / !=): its vacancy is carried by a flag the
+    # procedure keeps (GIVEN_<letter>: $P_SUBPAR on entry, updated at each assignment)
+    vacancy_flags: set[int] = field(default_factory=set)
 
     def position(self, local: int) -> int | None:
         """1-based parameter position of a local, as a call passes it."""
@@ -70,17 +73,21 @@ def plan(program: ir.Program) -> dict[str, MacroProc]:
         found = _locals_used(sub.body)
         if found is None or any(c.kind != "g65" for c in _calls(sub.body)):
             continue
-        used, written, bare, _ = found
+        used, written, bare, compares = found
         passed = [{v.key for v in c.bindings.values() if isinstance(v.key, int)} for c in mine]
         arguments = {k for k in used - written if k in by_local}
+        overwritten = {k for k in arguments_read_first(sub.body) & written if k in by_local}
+        if _unguarded(sub.body, overwritten & bare):
+            continue                         # set and used whole: the dropped word depends on it
         if any(_unguarded(sub.body, arguments & bare) - p for p in passed):
             continue                         # a call leaves out an argument the body uses bare
         params = sorted(k for k in arguments.union(*passed) if k in by_local)
         use = local_use(sub.body)
         if use is None or use.left_out(set(params))[1]:
             continue                         # a plain local read while vacant: DEF would read 0
+        flags = {k for k in overwritten & compares if k in params}
         out[key(name)] = MacroProc([(k, by_local[k]) for k in params],
-                                   sorted(k for k in used if k not in params), arguments)
+                                   sorted(k for k in used if k not in params), arguments, flags)
     return out
 
 
@@ -108,14 +115,20 @@ def standalone(program: ir.Program) -> tuple[Standalone | None, str]:
         return None, "it reaches variables by a computed number (#[expr]), which may be its locals"
     if any(c.kind != "g65" for c in _calls(body)):
         return None, "it calls subprograms that share its locals (M98)"
-    used, written, bare, _ = found
+    used, written, bare, compares = found
     order = [k for k in LETTER_LOCALS if k in by_local]
     use = local_use(body)
     if use is None or use.left_out(set(order))[1]:
         return None, "a local without an argument letter is read while vacant (a PROC's DEF reads 0)"
     arguments = {k for k in used - written if k in by_local}
+    overwritten = {k for k in arguments_read_first(body) & written if k in by_local}
+    risky = _unguarded(body, overwritten & bare)
+    if risky:
+        k = min(risky)
+        return None, (f"it uses the argument #{k} as a whole value where it may be vacant and also "
+                      "sets it (whether the word is dropped depends on which value it holds)")
     proc = MacroProc([(k, by_local[k]) for k in order], sorted(k for k in used if k not in by_local),
-                     arguments)
+                     arguments, {k for k in overwritten & compares if k in by_local})
     return Standalone(proc, _unguarded(body, arguments & bare)), ""
 
 
@@ -299,9 +312,18 @@ def reads_arguments(body: list) -> bool:
     return first_argument_read(body) is not None
 
 
-def first_argument_read(body: list) -> tuple[ir.Span | None, int] | None:
+def arguments_read_first(body: list) -> set[int]:
+    """The locals #1-#33 a body reads (in source order) before it sets them: its G65 arguments."""
+    out: set[int] = set()
+    first_argument_read(body, out)
+    return out
+
+
+def first_argument_read(body: list, reads: set | None = None) -> tuple[ir.Span | None, int] | None:
     """(the span of the first node, in source order, that reads a G65 argument, its number): the
-    first read of a local #1-#33 the program never sets; None when it reads none."""
+    first read of a local #1-#33 before (in source order) the program sets it; None when it reads
+    none. A macro may overwrite an argument after testing it (Renishaw O9810: IF[#26EQ#0]GOTO..
+    then #26=#26+..): that #26 is still an argument."""
     read: set = set()
     written: set = set()
     first: dict[int, ir.Span | None] = {}
@@ -309,7 +331,8 @@ def first_argument_read(body: list) -> tuple[ir.Span | None, int] | None:
 
     def expr(e) -> None:
         if isinstance(e, ir.Var):
-            if e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX:
+            if e.space == "num" and isinstance(e.key, int) and 1 <= e.key <= LOCAL_MAX \
+                    and e.key not in written:
                 read.add(e.key)
                 first.setdefault(e.key, where[0])
             for i in e.indices or ():
@@ -338,7 +361,9 @@ def first_argument_read(body: list) -> tuple[ir.Span | None, int] | None:
         else:
             for attr in ("cond", "subject", "start", "end", "step"):
                 expr(getattr(node, attr, None))
-    arguments = read - written
+    arguments = read                # each read before the program set it
+    if reads is not None:
+        reads |= read
     if not arguments:
         return None
     key = min(arguments, key=lambda k: (first[k].line if first[k] is not None else 0, k))

@@ -12,7 +12,9 @@ What a branch shows (Fanuc macro B: vacant equals only vacant under EQ/NE, and r
 every other operation): `#k EQ #0` false or `#k NE #0` true shows #k passed; a comparison of #k
 with a constant (`#k LT 0.1`) shows it passed on the side where its value with #k = 0 is not the
 outcome (a vacant #k would have gone the other way); AND / OR / NOT combine as usual. A path ends
-at M99, M30 or an alarm (#3000: the control stops). Anything the
+at M99, M30 or an alarm (#3000: the control stops). An assignment to a candidate (a macro that
+sets an argument it was passed, Renishaw O9810's #26=#26+..) makes it passed after it, unless it
+assigns #0 (vacant again) or copies another candidate (passed where that one is). Anything the
 pass does not follow (computed GOTO, structures ISO does not have) leaves every use unguarded.
 """
 from __future__ import annotations
@@ -114,6 +116,9 @@ class _Flow:
                     if used:
                         self.steps.append(("use", used))
                     ts = type(st)
+                    if ts is ir.Assign and not st.target.indices and \
+                            _local(st.target, self.candidates) is not None:
+                        self.steps.append(("set", st.target.key, st.value))
                     if ts is ir.Goto:
                         if st.computed is not None:
                             raise _GiveUp
@@ -166,6 +171,11 @@ class _Flow:
             outs: list[tuple[int, frozenset]] = []
             if step[0] == "use":
                 outs.append((i + 1, state))
+            elif step[0] == "set":
+                _, k, value = step
+                source = _local(value, universe)
+                passed = (not _vacant(value)) and (source is None or source in state)
+                outs.append((i + 1, (state | {k}) if passed else (state - {k})))
             elif step[0] == "jump":
                 _, target, cond = step
                 to = self.labels[target]

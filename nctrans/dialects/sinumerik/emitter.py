@@ -154,6 +154,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.call_comp: dict[str, set] = {}     # callee -> compensation states at its calls
         self.jump_regions: dict[int, dict] = {}  # per unit: label -> what jumps to it may change
         self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
+        self.vacancy_flags: dict[int, str] = {}  # local the PROC sets -> flag carrying its vacancy
         self.macro_file = None                 # an ISO macro file written as a PROC (run())
         # (file, line) -> why: constructs convert() asks to refuse at their place (NC412)
         self.in_place: dict = dict((program.meta or {}).get("refuse_in_place") or {})
@@ -203,7 +204,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                          if m == "argument_programmed"), None)
         if spelling is None:
             return None
-        given = f"{spelling}[{self.vacancy[left.key]}]"
+        given = self.vacancy_flags.get(left.key) or f"{spelling}[{self.vacancy[left.key]}]"
         self.info("vacancy", "ISO vacancy tests of a macro argument written with "
                              f"{spelling}[i] (whether the call programmed the parameter)")
         if vacant(right):
@@ -556,7 +557,25 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         out.words.append(self.code_for("stop", "optional" if s.optional else "program"))
 
     def w_Assign(self, s: ir.Assign, out: "_Line") -> None:
-        out.words.append(f"{self.var(s.target, target=True)}={self.expr(s.value)}")
+        flag = self.vacancy_flags.get(s.target.key) if s.target.space == "num" and not s.target.indices else None
+        vacant = type(s.value) is ir.Var and s.value.space == "num" and s.value.key == 0
+        # #k=#0 of a flagged argument: vacant again, which reads 0 in arithmetic as the parameter does
+        value = "0" if flag is not None and vacant else self.expr(s.value)
+        out.words.append(f"{self.var(s.target, target=True)}={value}")
+        if flag is not None:
+            out.words.append(f"{flag}={self.vacancy_after(s.value)}")
+
+    def vacancy_after(self, value) -> str:
+        """Whether an ISO local holds a value after `#k=value` (macro B: #0 is vacant, a bare copy
+        copies the vacancy, any arithmetic or constant is a value: vacant reads 0 there)."""
+        if type(value) is ir.Var and value.space == "num" and not value.indices:
+            if value.key == 0:
+                return "FALSE"
+            if value.key in self.vacancy_flags:
+                return self.vacancy_flags[value.key]
+            if value.key in self.vacancy:
+                return f"$P_SUBPAR[{self.vacancy[value.key]}]"
+        return "TRUE"
 
     def w_VarDecl(self, s: ir.VarDecl, out: "_Line") -> None:
         out.alone(self.vardecl([s]))
@@ -1522,6 +1541,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             self.lines.append(f"DEF INT {self.call_variables[0]}")
             self.lines.append(f"DEF STRING[32] {self.call_variables[1]}")
         if self.macro_file is not None:
+            self.vacancy_flags_on_entry(self.macro_file.proc)
             self.argument_checks(self.macro_file)
             return
         self.prologue(meta.get("defaults") or {})
@@ -1558,10 +1578,28 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                                 "without a letter -> LOC<n>)")
         self.local_names = {k: f"ARG_{letter}" for k, letter in proc.params}
         self.local_names.update({k: f"LOC{k}" for k in proc.plain_locals})
-        self.vacancy = {k: proc.position(k) for k in proc.vacancy_tested}
+        self.vacancy = {k: proc.position(k) for k in proc.vacancy_tested | proc.vacancy_flags}
         self.lines.append(f"PROC {name}(" + ", ".join(f"REAL ARG_{letter}" for _, letter in proc.params) + ")")
         if proc.plain_locals:
             self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
+        self.declare_vacancy_flags(proc)
+
+    def declare_vacancy_flags(self, proc: "macro_procs.MacroProc") -> None:
+        """An argument the macro tests for vacancy after setting it (Renishaw O9810: IF[#26EQ#0]
+        after #26=#26+..): $P_SUBPAR only says whether the call passed it, so a BOOL flag carries
+        its vacancy, $P_SUBPAR[i] on entry (written by vacancy_flags_on_entry), updated at each
+        assignment."""
+        letters = dict(proc.params)
+        self.vacancy_flags = {k: f"GIVEN_{letters[k]}" for k in sorted(proc.vacancy_flags)}
+        if self.vacancy_flags:
+            self.info("vacancy-flag", "an argument the macro tests for vacancy after setting it "
+                                      "carries its vacancy in a flag GIVEN_<letter> ($P_SUBPAR[i] on "
+                                      "entry, set at each assignment)")
+            self.lines.append("DEF BOOL " + ", ".join(self.vacancy_flags.values()))
+
+    def vacancy_flags_on_entry(self, proc: "macro_procs.MacroProc") -> None:
+        for k, flag in self.vacancy_flags.items():
+            self.lines.append(f"{flag}=$P_SUBPAR[{proc.position(k)}]")
 
     def argument_checks(self, macro: "macro_procs.Standalone") -> None:
         """An argument the macro uses as a whole value (X#24: ISO drops the word when the call
@@ -1601,7 +1639,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                           f"(#n -> ARG_<letter>, locals without a letter -> LOC<n>)")
                 self.local_names = {k: f"ARG_{letter}" for k, letter in proc.params}
                 self.local_names.update({k: f"LOC{k}" for k in proc.plain_locals})
-                self.vacancy = {k: proc.position(k) for k in proc.vacancy_tested}
+                self.vacancy = {k: proc.position(k) for k in proc.vacancy_tested | proc.vacancy_flags}
                 params = [f"REAL ARG_{letter}" for _, letter in proc.params]
             for prm in sub.params:
                 dims = "[" + ",".join(str(x) if x else "" for x in prm.dims) + "]" if prm.dims else ""
@@ -1613,6 +1651,9 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.lines.append(head)
             if proc is not None and proc.plain_locals:
                 self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
+            if proc is not None:
+                self.declare_vacancy_flags(proc)
+                self.vacancy_flags_on_entry(proc)
             self.st = _State()
             # a subprogram of a diameter-programming source (ISO-T) is read in diameter too
             self.st.diameter = ((meta.get("defaults") or {}).get("diameter") == "diameter")
@@ -1623,7 +1664,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 if len(comp) == 1:      # every call is made with compensation on / off
                     self.edges.iso.comp = next(iter(comp))
             self.unit(sub.body)
-            self.local_names, self.vacancy = {}, {}
+            self.local_names, self.vacancy, self.vacancy_flags = {}, {}, {}
 
 
 def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
