@@ -762,7 +762,7 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
                 tb.close()
     finally:
         RESTART_MAIN.reset(restarts)
-    diags = ta.diagnostics + tb.diagnostics
+    diags = list(once_each(ta.diagnostics + tb.diagnostics))    # a file both sides read: once
     if diff is not None and diff.at_end and _budget_spent(ta.diagnostics) and _budget_spent(tb.diagnostics):
         # both endless (a LOOP, M99 restarting a main program), both cut by the step budget at
         # different points: they agreed on everything both ran

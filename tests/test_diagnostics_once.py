@@ -48,3 +48,10 @@ def test_missing_pcall_file_reported_once_per_call(tmp_path, monkeypatch, capsys
     # line 3's refusal names line 2 as where its reason is, not as if line 3's file were SUBX.NC
     refusal3 = next(x for x in out.splitlines() if x.startswith("main.pim:3:1: error[NC402]"))
     assert "at line 2, subprogram SUBX.NC not found" in refusal3
+
+
+def test_equiv_of_a_program_with_itself_reports_once(tmp_path):
+    (tmp_path / "main.pim").write_text(FAGOR)
+    result = api.equiv(tmp_path / "main.pim", tmp_path / "main.pim")
+    # both sides read the same file: lines 2 and 3 once each, not twice
+    assert sorted(d.line for d in result.diagnostics if d.rule == "NC103") == [2, 3]

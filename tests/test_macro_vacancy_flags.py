@@ -106,3 +106,20 @@ def test_flow_sees_a_set_argument_vacant_again():
                                  "O9815.nc").program
     found, why = macro_procs.standalone(program)
     assert found is not None and found.proc.vacancy_flags == {26} and found.bare == set()
+
+
+def test_macro_file_to_fagor_returns_instead_of_looping(tmp_path):
+    # before: the M99 of a macro file was written as $WHILE 1 ... $ENDWHILE: an endless loop
+    iso, fag = tmp_path / "iso", tmp_path / "fagor"
+    iso.mkdir()
+    fag.mkdir()
+    (iso / "O9006.nc").write_text("O9006\n#10=#24+1.\nG1 X#10 F100.\nM99\n")
+    (iso / "O1006.nc").write_text("O1006\nG0 X0 Y0 Z10.\nG65 P9006 X5.\nM30\n")
+    sub = api.transpile(iso / "O9006.nc", read="iso-m", write="fagor")
+    assert "$WHILE" not in sub.text and sub.text.rstrip().splitlines()[-1] == "M17"
+    (fag / "O9006.nc").write_text(sub.text)
+    (fag / "O1006.nc").write_text(api.transpile(iso / "O1006.nc", read="iso-m", write="fagor").text)
+    # hand: X5. passed -> #10 = 5+1 = 6 -> G1 X6
+    xs = [r.end["X"] for r in api.toolpath(fag / "O1006.nc", "fagor") if r.kind == "linear"]
+    assert xs == [6.0]
+    assert api.equiv(iso / "O1006.nc", fag / "O1006.nc", read_b="fagor").equivalent

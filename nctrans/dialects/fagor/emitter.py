@@ -26,7 +26,7 @@ from nctrans.dialects.tool_timing import ToolTiming
 from nctrans.ir import nodes as n
 from nctrans.plainrun import RUNS, run_blocks
 from nctrans.ir import walk as ir_walk
-from nctrans.lower import restart_loop
+from nctrans.lower import macro_procs, restart_loop
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans import alarm_numbers
 from nctrans.rules import load_table, option as rules_option
@@ -217,6 +217,10 @@ class FagorEmitter(FagorSpelling, Emitter):
         # the tool words moved to where this control's words change the tool as the source's do
         self.tool_timing = ToolTiming(program.dialect, "fagor")
         self.in_sub = False
+        # an ISO macro file (it reads G65 arguments and ends with M99): its M99 is the return
+        body = program.body
+        self.macro_file = (program.dialect != DIALECT and type(body) is list
+                           and macro_procs.ends_with_restart(body) and macro_procs.reads_arguments(body))
         # spindle-synchronised moves ("thread") are written as G63: S and the feed mode they need
         self.speed: Optional[float] = None            # the last constant S written (rev/min)
         self.feed_mode = "per_min"
@@ -275,6 +279,11 @@ class FagorEmitter(FagorSpelling, Emitter):
         inside $WHILE 1 ... $ENDWHILE (lowered alone it would be one pass and a program end)."""
         last = restart_loop.restart_block(body) if self.program.dialect != DIALECT else None
         if last is None:
+            return body
+        if self.macro_file:
+            self.span = body[last].span
+            self.lowered("M99 of a macro file (it reads G65 arguments) is its return: written "
+                         f"{self.code_for('return')}")
             return body
         self.span = body[last].span
         self.lowered("M99 in a main program (it starts again for ever) written as $WHILE 1 ... $ENDWHILE")
@@ -627,6 +636,9 @@ class FagorEmitter(FagorSpelling, Emitter):
         word("M", self.code_for("return") if self.in_sub else self.code_for("program_end", "end_rewind"))
 
     def w_ProgramEnd(self, s: n.ProgramEnd, word, new_line, rest: list):
+        if s.kind == "restart" and self.macro_file:
+            word("M", self.code_for("return"))         # a macro file's M99: its return
+            return
         if s.kind == "restart":
             raise NotExpressible("a program restart (M99 in a main program)")
         word("M", self.code_for("program_end", "end" if s.kind == "end" else "end_rewind"))
