@@ -203,11 +203,12 @@ def _whole_note(refusal: Diagnostic, target: Dialect) -> Diagnostic:
                       d.end_line, d.end_column)
 
 
-def header(program: Program) -> str:
-    """The header comment of a converted program: what it was converted from, and by what."""
+def header(program: Program, target: str) -> str:
+    """The header comment of a converted program: what it was converted from, to which dialect
+    (detection reads that back: nctrans.detection.written_by_nctrans), and by what."""
     from nctrans import __version__
     file = program.file.replace("(", "[").replace(")", "]")
-    return f"converted by nctrans {__version__} from {program.dialect}: {file}"
+    return f"converted by nctrans {__version__} from {program.dialect} to {target}: {file}"
 
 
 def lower_for(program: Program, target: Dialect, diags: list[Diagnostic]) -> Program:
@@ -356,7 +357,7 @@ def _convert(program: Program, target: Dialect, *, flatten_with: Optional[Callab
     if strict_mode:
         diags = strict(diags)
     refused = any(d.severity == "error" for d in diags)
-    text = None if refused else target.with_header(result.text, header(program))
+    text = None if refused else target.with_header(result.text, header(program, target.name))
     return Conversion(text, diags, flattened)
 
 
@@ -423,7 +424,7 @@ def _with_header(target: Dialect, program: Program,
     def write_with_header(text: str) -> None:
         if first[0]:
             first[0] = False
-            text = target.with_header(text, header(program))
+            text = target.with_header(text, header(program, target.name))
         write(text)
     return write_with_header
 

@@ -95,9 +95,31 @@ def _sniff(d: base.Dialect, text: str) -> float:
     return min(max(float(d.sniff(text)), 0.0), 1.0)
 
 
+# The header comment nctrans writes into a converted program (nctrans.convert.header), among its
+# opening lines: "converted by nctrans 0.1.0 from iso-m to iso-t: part.nc".
+_OWN_HEADER = re.compile(r"converted by nctrans \S+ from [\w.-]+ to ([\w.-]+): ")
+_HEADER_LINES = 6
+
+
+def written_by_nctrans(text: str) -> Optional[str]:
+    """The dialect a file nctrans wrote says it is in (its header comment), or None. Its content
+    alone may not tell: a lathe program written from a mill program has no lathe construct, and
+    the header's own comment shape speaks for another family."""
+    for line in text[:4000].split("\n", _HEADER_LINES)[:_HEADER_LINES]:
+        m = _OWN_HEADER.search(line)
+        if m is not None:
+            return m.group(1)
+    return None
+
+
 def detect(text: str, filename: Optional[str] = None, candidates: Optional[list[str]] = None) -> Guess:
-    """Guess the dialect of `text` (optionally named `filename`) among the registered dialects."""
+    """Guess the dialect of `text` (optionally named `filename`) among the registered dialects; a
+    file nctrans converted is in the dialect its header names."""
     names = [n for n in candidates or base.names() if base.get(n) is not None]
+    own = written_by_nctrans(text)
+    if own in names:
+        return Guess(own, 1.0, {n: float(n == own) for n in names}, {n: float(n == own) for n in names},
+                     {}, False, {n: float(n == own) for n in names})
     dialects = [base.get(n) for n in names]
     evidence = {n: 0.0 for n in names}
     first: dict[str, tuple[int, int, str]] = {}

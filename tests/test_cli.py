@@ -264,7 +264,7 @@ def test_convert_to_stdout_file_and_out_dir(fake, capsys):
     Path("a.fk").write_text("G0 X1\nG1 X2 F100\n")
     Path("b.fk").write_text("G0 X5\n")
     rc, out, _ = run(capsys, "convert", "a.fk", "--to", "fake")
-    head = f"; converted by nctrans {nctrans.__version__} from fake: a.fk\n"     # the header comment
+    head = f"; converted by nctrans {nctrans.__version__} from fake to fake: a.fk\n"     # the header comment
     assert rc == 0 and out == head + "N1 ; 2 statements\nN2 ; 3 statements\n"
     rc, out, _ = run(capsys, "convert", "a.fk", "--to", "fake", "-o", "out/x.txt")
     assert rc == 0 and out == "" and Path("out/x.txt").read_text().startswith(head + "N1 ;")

@@ -145,9 +145,11 @@ def test_length_and_radius_of_different_registers_are_not_one_edge():
 def test_radius_without_length_is_written_by_the_machines_data_with_a_warning():
     # no G43: ISO compensates by register 2's radius with no length; Sinumerik D2 adds register
     # 2's length too. The built-in machine holds no offsets: D2 is the same there, said (NC405)
-    text = "G0 X0 Y0 Z5\nG1 G41 D2 X10 Y0 F100\nY10\nG40 X20\nM30\n"
+    # (T1 M6: with no tool change before it an ISO register has no Sinumerik D at all,
+    # test_register_without_tool)
+    text = "T1 M6\nG0 X0 Y0 Z5\nG1 G41 D2 X10 Y0 F100\nY10\nG40 X20\nM30\n"
     conv = api.transpile(text, "iso-m", "sinumerik")
-    assert conv.text is not None and [d.line for d in conv.diagnostics if d.rule == "NC405"] == [2]
+    assert conv.text is not None and [d.line for d in conv.diagnostics if d.rule == "NC405"] == [3]
     assert api.equiv(text, conv.text, read_a="iso-m", read_b="sinumerik")
     # on a machine whose register 2 has a length (tool 2: 50) D2 would cut 50 mm higher
     conv = convert(text)

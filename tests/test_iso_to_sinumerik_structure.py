@@ -138,7 +138,8 @@ def test_any_g65_arguments_move_the_same_as_proc_parameters(tmp_path_factory, ca
 # ---------------------------------------------------------------- modal-state numbers
 
 def test_modal_state_numbers_read_the_g_group_index(tmp_path):
-    src = ("G90 G17 G21 G54\n#100=#4007\nG1 G41 D1 X1 F100\n#101=#4007\nG55 G18\n"
+    # (T1 M6: an ISO register D1 with no tool change before it has no Sinumerik D, test_register_without_tool)
+    src = ("G90 G17 G21 G54\nT1 M6\n#100=#4007\nG1 G41 D1 X1 F100\n#101=#4007\nG55 G18\n"
            "IF[#4014 EQ 55] GOTO 10\nG1 X99\nN10 G0 X[#100+#101+#4002+#4003]\nG40 G17 X0\nM30\n")
     conv = _converted(src)
     # hand-derived: G40/G41/G42 are indexes 1-3 of group 7, G500/G54..G57 1-5 of group 8,
@@ -170,7 +171,7 @@ _MODES = {"plane": ["G17", "G18", "G19"], "distance": ["G90", "G91"], "comp": ["
        number=st.sampled_from([4002, 4003, 4007, 4014]))
 def test_any_modal_state_reads_the_same_number_converted(tmp_path_factory, picks, number):
     body = "".join(f"{' '.join(p)}\n#100=#100*2+#{number}\nG1 X0.5 F100\nG40 G90\n" for p in picks)
-    src = f"G90 G17 G21 G54\n#100=0\n{body}G0 X[#100/1000]\nM30\n"
+    src = f"G90 G17 G21 G54\nT1 M6\n#100=0\n{body}G0 X[#100/1000]\nM30\n"
     conv = _converted(src)
     assert "$P_GG[" in conv.text
     _equiv(tmp_path_factory.mktemp("modal"), src, conv.text)

@@ -37,10 +37,10 @@ def test_converting_twice_gives_the_same_bytes(monkeypatch, text):
 
 def test_header_names_source_dialect_and_version():
     conv = nctrans.transpile("G0 X1\nM30\n", read="iso-m", write="sinumerik", file="part.nc")
-    assert conv.text.splitlines()[0] == f"; converted by nctrans {nctrans.__version__} from iso-m: part.nc"
+    assert conv.text.splitlines()[0] == f"; converted by nctrans {nctrans.__version__} from iso-m to sinumerik: part.nc"
     back = nctrans.transpile(conv.text, read="sinumerik", write="iso-m", file="part.mpf")
     lines = back.text.splitlines()
-    assert lines[0] == "%" and lines[1] == f"(converted by nctrans {nctrans.__version__} from sinumerik: part.mpf)"
+    assert lines[0] == "%" and lines[1] == f"(converted by nctrans {nctrans.__version__} from sinumerik to iso-m: part.mpf)"
 
 
 @pytest.mark.parametrize("name,source,target", [

@@ -198,3 +198,17 @@ def test_an_iso_turning_turret_that_stays_is_no_second_change_on_a_mill():
     for target in ("fagor", "sinumerik", "iso-m"):
         conv = nctrans.transpile(text, read="iso-t", write=target, machine=MILL)
         assert _tools(conv.text, target, MILL) == _tools(text, "iso-t", MILL) == [1], (target, conv.text)
+
+
+def test_a_preselect_that_changes_on_the_conversions_lathe_is_said_at_the_m6():
+    # the Sinumerik mill program on the built-in lathe: T2 (line 5) changes the tool there, so the
+    # G1 Z-1 / X10 are cut with tool 2 and written so; the M6 at line 8 changes nothing: NC124
+    conv = nctrans.transpile(SIN_MILL, read="sinumerik", write="iso-t")
+    assert [d.line for d in conv.diagnostics if d.rule == "NC124"] == [8]
+    # on a mill machine the M6 is the change, nothing to say
+    conv = nctrans.transpile(SIN_MILL, read="sinumerik", write="iso-t", machine=MILL)
+    assert not [d for d in conv.diagnostics if d.rule == "NC124"]
+    # T and M6 in one block (or nothing cut between): nothing to say
+    text = "G17 G90 G71\nT1 M6\nD1\nG0 X0 Y0 Z10\nT2\nM6\nD1\nG0 Z10\nM30\n"
+    assert not [d for d in nctrans.transpile(text, read="sinumerik", write="iso-t").diagnostics
+                if d.rule == "NC124"]

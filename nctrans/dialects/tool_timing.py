@@ -49,6 +49,9 @@ class ToolTiming:
         self.in_place: Optional[float] = None   # the tool a turret change put in place, if known
         self.loaded: Optional[float] = None     # the tool the last M6 loaded, if known
         self.notes: list[str] = []      # NC401 notes of the last block retimed
+        self.warnings: list[str] = []   # NC124 of the last block retimed
+        self.t_alone = False            # a source T changed the tool in a block of its own ...
+        self.cut_since = False          # ... and a move followed it before any M6
 
     @property
     def active(self) -> bool:
@@ -60,11 +63,29 @@ class ToolTiming:
         self.t_seen = False
         self.in_place = None
         self.loaded = None
+        self.t_alone = self.cut_since = False
+
+    def apply(self, emitter, body: list) -> list:
+        """The block's statements retimed for `emitter`, its refusal (NC402), notes (NC401) and
+        warnings (NC124) reported there."""
+        body, why = self.retime(body)
+        if why is not None:
+            emitter.refuse(why)
+        for note in self.notes:
+            emitter.lowered(note)
+        if self.warnings:
+            from nctrans.diagnostics import at_span
+            for text in self.warnings:
+                emitter.diags.append(at_span("NC124", "warning", text, emitter._where()))
+        return body
 
     def retime(self, body: list) -> tuple[list, Optional[str]]:
         """(the block's statements with its tool words where the target needs them, the reason an
         M6 cannot be written or None)."""
         self.notes = []
+        self.warnings = []
+        if self.source_changes:
+            self._watch_preselect(body)
         if not self.converting or not any(type(s) in (n.ToolSelect, n.ToolChange) for s in body):
             return body, None
         if not self.target_turret:
@@ -74,6 +95,31 @@ class ToolTiming:
         if self.target_changes:
             return self._hold_until_change(body)
         return self._change_at_t(body), None
+
+    def _watch_preselect(self, body: list) -> None:
+        """NC124 at an M6 that follows, after moves, a T of its own block where the source's T
+        changes the tool (the machine of the conversion): the T changed it there and the moves
+        between were cut with the new tool, which the conversion keeps; a program that writes the
+        M6 was likely written for a changer that loads at M6, where the old tool cuts them."""
+        sel = chg = False
+        for s in body:
+            t = type(s)
+            if t is n.ToolSelect:
+                sel = True
+            elif t is n.ToolChange and not s.turret:
+                chg = True
+            elif t is n.Motion and self.t_alone:
+                self.cut_since = True
+        if chg and not sel and self.t_alone and self.cut_since:
+            self.warnings.append(
+                "this M6 changes nothing on the machine the conversion is for: there the T word "
+                "before it changed the tool (rules tool_change.by_t_word: a lathe's turret, or a "
+                "control set to change by T), and the moves between are cut with the new tool, as "
+                "written here; "
+                "on a changer that loads at M6 the old tool cuts them: convert with that machine "
+                "(--machine; its [tool_change] by_t_word = false)")
+        if sel or chg:
+            self.t_alone, self.cut_since = sel and not chg, False
 
     def _turret_stays(self, body: list) -> list:
         """A lathe's T word naming the tool at the cutting position (ISO turning T0102 after

@@ -65,7 +65,11 @@ def loaded_tool_radius(it) -> Optional[float]:
 def check_entry(it) -> None:
     """Before the first move of a G41/G42 episode: NC123 and radius 0 where the radius is the
     unknown tool's. `it`: the Interpreter (st, machine, comp_radius, default_edge, diag)."""
-    if not it.offsets_of_tool or it.st.tool is not None:
+    if not it.offsets_of_tool:
+        if getattr(it, "hook", None) is not None and it.st.tool is None:
+            register_unknown(it)
+        return
+    if it.st.tool is not None:
         return
     d = it.st.radius_index
     defaulted = d is None and bool(it.default_edge)
@@ -86,3 +90,24 @@ def check_entry(it) -> None:
             it.comp_on_span)
     it.st.radius_index = d
     it.comp_radius = 0.0
+
+
+def register_unknown(it) -> None:
+    """NC125 in a run written as plain motion (a flatten hook: a lowering, --flatten) with no tool
+    change before it: G41/G42 by an ISO offset register d (a register of the control's table,
+    whatever tool is loaded) that the machine file does not give (no radius_offsets entry d, no
+    tool d). The analysis reads it as 0, which is no fact of any machine; plain motion would fold
+    that 0 into the coordinates. A lowering nctrans chooses refuses it (lower/flatten.
+    takes_unknown_path); --flatten keeps the warning. (With a tool changed before it, the
+    lowering of a target that writes that tool's own offset, not the register, is not refused
+    here: the built-in machines give no register, and their radius 0 is the analysis' own.)"""
+    d = it.st.radius_index
+    m = it.machine
+    if not d or m is None or d in getattr(m, "radius_offsets", {}) or m.tool(int(d)) is not None:
+        return
+    code = "G41" if it.st.comp_side == "left" else "G42"
+    it.diag("NC125", "warning",
+            f"{code} by offset register D{d}, which the machine file does not give (no radius_offsets "
+            f"entry {d}, no tool {d}): plain motion would fold a radius of 0 into the coordinates, "
+            "and the control's register holds whatever radius was set there. Give the register in "
+            "the machine file (--machine)", it.comp_on_span)

@@ -706,8 +706,9 @@ def takes_unknown_path(d: Diagnostic) -> bool:
     a warning: a condition taken as false, a word ignored; a probe result, a PLC input): plain
     motion written from that run would fix one path the machine may not take. `--flatten` asks for
     it and says so (the warning stays); a lowering nctrans chooses on its own refuses it. NC123
-    likewise: a cutter compensation radius of a tool the program never chose (interp/comp_radius)."""
-    return d.rule in ("NC107", "NC123") and d.severity == "warning"
+    likewise: a cutter compensation radius of a tool the program never chose, and NC125: of an
+    ISO register the machine file does not give (interp/comp_radius)."""
+    return d.rule in ("NC107", "NC123", "NC125") and d.severity == "warning"
 
 
 def _incomplete(d: Diagnostic) -> bool:

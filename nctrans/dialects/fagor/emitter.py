@@ -445,11 +445,7 @@ class FagorEmitter(FagorSpelling, Emitter):
             if alone:
                 new_line()
 
-        body, why = self.tool_timing.retime(b.body)
-        if why is not None:
-            self.refuse(why)
-        for note in self.tool_timing.notes:
-            self.lowered(note)
+        body = self.tool_timing.apply(self, b.body)
         i = 0
         while i < len(body):
             s = body[i]
@@ -574,6 +570,12 @@ class FagorEmitter(FagorSpelling, Emitter):
                 # a Fagor D1 is that tool's own corrector (nctrans.interp.comp_radius)
                 raise NotExpressible(f"radius register D1 while T{self.tool_active:g} is in the spindle: "
                                      f"a Fagor D1 is the corrector of T{self.tool_active:g}, not register 1")
+            if self.register_radius and k and self.tool_active is None and not _flat_radius(k):
+                # no tool change before it: a Fagor D<k> is a corrector of the tool the machine
+                # holds from before (its analysis: NC123, radius 0), register k is not
+                raise NotExpressible(f"radius register D{k:g} with no tool change before it: a Fagor "
+                                     f"D{k:g} is a corrector of the tool the machine holds, which the "
+                                     f"program does not say, not register {k:g}")
             word("D", "D" + val(s.index))
             self.radius_index = s.index
             if not self.length_on and _num(s.index) != 0:
@@ -987,6 +989,18 @@ def _machine_kind(dialect: str) -> Optional[str]:
 
 def _table_option(dialect: str, key: str) -> Any:
     return rules_option(dialect, key)
+
+
+def _flat_radius(k: float) -> bool:
+    """Whether the conversion's machine file gives offset number k as a flat radius
+    (radius_offsets), which a D reads whatever tool is in the spindle."""
+    from nctrans.dialects.emit import CONVERSION_MACHINE
+    get = CONVERSION_MACHINE.get()
+    try:
+        machine = get() if get is not None else None
+    except Exception:           # a machine file that does not load: said where it is used
+        return False
+    return machine is not None and k in getattr(machine, "radius_offsets", {})
 
 
 def _num(e) -> Optional[float]:

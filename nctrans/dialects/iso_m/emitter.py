@@ -925,11 +925,7 @@ class IsoEmitter(IsoSpelling, Emitter):
         return [s for i, s in enumerate(body) if i not in turns and i not in tools]
 
     def statements(self, body) -> list[list[str]]:
-        body, why = self.tool_timing.retime(body)
-        if why is not None:
-            self.refuse(why)
-        for note in self.tool_timing.notes:
-            self.lowered(note)
+        body = self.tool_timing.apply(self, body)
         if self.drops_staying_turret:
             body = self._turret_stays(body)
         lines: list[_Line] = [_Line()]

@@ -66,8 +66,11 @@ class EdgeSelection:
     """The ISO length / radius state and the Sinumerik edge written for it, one block at a time:
     feed the block's statements to `statement`, then ask `block_end` for the D word it needs."""
 
-    def __init__(self) -> None:
+    def __init__(self, writes_radius: bool = False) -> None:
         self.iso = _Iso()
+        # the program writes radius offset data itself (G10, #2401..): its registers are its own
+        # (written as the flat $TC_DP6 of the D), not the held tool's unknown edge
+        self.writes_radius = writes_radius
         self.edge: Known = 0            # the Sinumerik D in force (no D: nothing at power-on)
         self.in_step = True             # the edge gives what the ISO program has
         self.assumed: Optional[str] = None  # set when an edge was chosen by the machine's data
@@ -187,6 +190,7 @@ class EdgeSelection:
         """The D numbers that give the ISO state (at least one), or NoEdge saying why. By the edge
         numbering first (true on any machine); else by the values of the machine the conversion
         is for (`assumed` says so: the NC405 warning)."""
+        self.no_tool_radius()           # no machine data makes that edge's radius known
         try:
             return self.by_numbering()
         except NoEdge as why:
@@ -207,12 +211,9 @@ class EdgeSelection:
             return set()
         if iso.comp == "on" and not isinstance(iso.radius, (int, type(None))):
             return set()
-        if self._machine is None:
-            try:
-                self._machine = get()
-            except Exception:       # a machine file that does not load: said where it is used
-                return set()
-        m = self._machine
+        m = self._conversion_machine()
+        if m is None:
+            return set()
         length = m.length_offset(iso.register) if iso.length == "plus" else 0.0
         radius = m.radius_offset(iso.radius) if iso.comp == "on" and iso.radius else 0.0
         tool = self.iso.tool
@@ -221,10 +222,40 @@ class EdgeSelection:
         for e in edges:
             if e == 1 and (tool == UNKNOWN or tool is None):
                 continue
+            if iso.comp == "on" and e and tool in (0, None) and e not in m.radius_offsets:
+                continue                # the radius of an edge of no tool changed: not known
             el, er = _edge_values(m, tool, e)
             if abs(el - length) < 1e-9 and (iso.comp != "on" or abs(er - radius) < 1e-9):
                 found.add(e)
         return found
+
+    def _conversion_machine(self):
+        """The machine the conversion is for (None outside one, or where its file does not load:
+        said where it is used)."""
+        get = _MACHINE.get()
+        if self._machine is None and get is not None:
+            try:
+                self._machine = get()
+            except Exception:
+                return None
+        return self._machine
+
+    def no_tool_radius(self) -> None:
+        """NoEdge where compensation is on by an ISO radius register d and no tool change
+        precedes it: a Sinumerik D<d> is an edge of the tool the machine holds from before, whose
+        radius the program does not say (the analysis: NC123, radius 0), unless the machine file
+        gives d as a flat offset number (radius_offsets)."""
+        iso = self.iso
+        if iso.comp != "on" or iso.tool not in (0, None) or iso.radius in (0, None, UNKNOWN) \
+                or self.writes_radius:
+            return
+        m = self._conversion_machine()
+        if m is not None and iso.radius in m.radius_offsets:
+            return
+        raise NoEdge(f"cutter radius compensation by ISO radius register D{iso.radius} with no tool "
+                     f"change before it: register {iso.radius} holds its radius whatever tool is in "
+                     f"the spindle, but a Sinumerik D{iso.radius} is an edge of the active tool, here "
+                     "the one the machine holds from before, which the program does not say")
 
     def by_numbering(self) -> set[int]:
         iso = self.iso
@@ -377,3 +408,30 @@ def jump_regions(nodes: list, callee=None) -> dict[str, set[str]]:
             continue
         out.setdefault(target, set()).update(touches(nodes[min(i, j):max(i, j) + 1], callee))
     return out
+
+
+def writes_radius_data(program) -> bool:
+    """Whether `program` writes tool radius offset data anywhere: G10 (a DataSetting of a radius
+    kind) or a numbered variable of its dialect's radius registers (rules numbered_variables with
+    source "tool_radius" or wear_of "radius")."""
+    from nctrans.interp.sysvars import entries
+    from nctrans.ir.walk import walk
+    from nctrans.plainrun import RUNS
+    spans = [(int(e["first"]), int(e["last"])) for e in entries(program.dialect)
+             if e.get("source") == "tool_radius" or e.get("wear_of") == "radius"]
+    units = [program.body, *(sub.body for sub in program.subprograms.values())]
+    for body in units:
+        # a compact body's runs of plain blocks are text not walked here: what they write is not
+        # seen (an ISO register with no tool change is then refused, never guessed)
+        body = [x for x in getattr(body, "items", body) if type(x) not in RUNS]
+        for node in walk(body):
+            if type(node) is not ir.Block:
+                continue
+            for s in node.body:
+                t = type(s)
+                if t is ir.DataSetting and "radius" in str(s.kind):
+                    return True
+                if t is ir.Assign and type(s.target) is ir.Var and isinstance(s.target.key, int) \
+                        and any(a <= s.target.key <= b for a, b in spans):
+                    return True
+    return False

@@ -50,7 +50,7 @@ from nctrans.lower import computed_g, macro_procs, modal_numbers, restart_loop
 from nctrans.lower.macro_procs import ends_with_restart as _ends_with_restart
 from nctrans.lower.macro_procs import reads_arguments as _reads_arguments
 from nctrans.plainrun import PlainRun, run_blocks
-from nctrans.dialects.sinumerik.edge_selection import EdgeSelection, NoEdge, jump_regions
+from nctrans.dialects.sinumerik.edge_selection import EdgeSelection, NoEdge, jump_regions, writes_radius_data
 from nctrans.rules import option as rules_option, system_meaning, system_spelling
 from nctrans.plainrun import RUNS
 from nctrans.dialects.iso_m.profiles import is_common
@@ -143,7 +143,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.local_names: dict[int, str] = {}
         # ISO tool length (G43/G44/G49 H) and radius register D as the cutting edge D
         # (nctrans.dialects.sinumerik.edge_selection); a Sinumerik source writes its own D words
-        self.edges = EdgeSelection() if program.dialect == "iso-m" else None
+        self.edges = EdgeSelection(writes_radius_data(program)) if program.dialect == "iso-m" else None
         # an ISO turning T word's offset register (T0401: tool 4, register 1) as the D of the tool:
         # D1 is the tool's own edge, so register 1 under another tool has no D (edge_selection's
         # rule for ISO milling); the turret tool is followed through T and its change
@@ -1195,11 +1195,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                         self.unit_nodes, self.callee_body)
                 self.edges.forget_fields(set().union(
                     *(regions.get(_jump_key(x), set()) for x in (b.label, b.number) if x)))
-        body, why = self.tool_timing.retime(b.body)
-        if why is not None:
-            self.refuse(why)
-        for note in self.tool_timing.notes:
-            self.lowered(note)
+        body = self.tool_timing.apply(self, b.body)
         decls = [s for s in body if isinstance(s, ir.VarDecl)]
         rest = [s for s in body if not isinstance(s, ir.VarDecl)]
         line = _Line(only=len(rest) == 1, join=self.p.dialect == DIALECT)
