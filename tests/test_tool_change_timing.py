@@ -212,3 +212,22 @@ def test_a_preselect_that_changes_on_the_conversions_lathe_is_said_at_the_m6():
     text = "G17 G90 G71\nT1 M6\nD1\nG0 X0 Y0 Z10\nT2\nM6\nD1\nG0 Z10\nM30\n"
     assert not [d for d in nctrans.transpile(text, read="sinumerik", write="iso-t").diagnostics
                 if d.rule == "NC124"]
+
+
+def test_an_iso_milling_m6_that_stops_the_spindle_is_followed_by_its_direction():
+    # ISO turning T0202 indexes the turret with the spindle turning; ISO milling's M6 stops it
+    # (rules tool_change.stops_spindle: Haas, LinuxCNC), so G1 Z-5 after `T2 M6` cut with the
+    # spindle stopped (NC209 when the output is read): M3 is written again after the change
+    conv = nctrans.transpile(ISO_LATHE, read="iso-t", write="iso-m", machine=LATHE)
+    lines = conv.text.splitlines()
+    i = next(i for i, ln in enumerate(lines) if ln.startswith("T2 M6"))
+    assert lines[i + 1] == "M3", conv.text
+    assert [d.line for d in conv.diagnostics if "stops the spindle" in d.message] == [8]
+    out = nctrans.toolpath(conv.text, "iso-m", LATHE)
+    list(out)
+    assert not [d for d in out.diagnostics if d.rule == "NC209"]
+    assert nctrans.equiv(ISO_LATHE, conv.text, read_a="iso-t", read_b="iso-m", machine=LATHE)
+    # with the spindle stopped before the change nothing is written
+    stopped = ISO_LATHE.replace("G0 X60. Z20.\nT0202", "G0 X60. Z20.\nM5\nT0202")
+    conv = nctrans.transpile(stopped, read="iso-t", write="iso-m", machine=LATHE)
+    assert "M3" not in conv.text.split("T2 M6", 1)[1].splitlines()

@@ -262,9 +262,31 @@ class IsoEmitter(IsoSpelling, Emitter):
         self.rel_tool: Optional[int] = 0
         # the tool words moved to where this control's words change the tool as the source's do
         self.tool_timing = ToolTiming(program.dialect, self.dialect, self.t_word_is_turret)
+        # this control's M6 stops the spindle (rules tool_change.stops_spindle: Haas, LinuxCNC)
+        # where the source's change does not: the direction in force is written again after it
+        self.respin = self.writes_m6_stop(program.dialect)
+        self.spindle_turning: Optional[str] = None       # "cw" / "ccw" where known to turn
+
+    def writes_m6_stop(self, source: Optional[str]) -> bool:
+        """Whether this control's tool change stops the spindle and the source's does not, on the
+        conversion's machine (nctrans.interp.run_checks.tool_change_rules)."""
+        if source == self.dialect or (self.program.meta or {}).get("flattened_from"):
+            return False        # (plain motion writes the direction again itself: lower/flatten)
+        from nctrans.dialects.emit import CONVERSION_MACHINE
+        from nctrans.interp.run_checks import tool_change_rules
+        from nctrans.rules import load_table
+        get = CONVERSION_MACHINE.get()
+        try:
+            machine = get() if get is not None else None
+            ours = tool_change_rules(machine, dict(load_table(self.table_name).options))[1]
+            theirs = tool_change_rules(machine, dict(load_table(source).options))[1] if source else True
+        except Exception:       # no table of that name (a test dialect) or a machine that fails
+            return False
+        return ours and not theirs
 
     def forget(self) -> None:
         super().forget()
+        self.spindle_turning = None
         self.distance_known = False
         self.spindle_tool = None
         self.turret_tool = None
@@ -979,6 +1001,14 @@ class IsoEmitter(IsoSpelling, Emitter):
                 lines.append(line)
             line.words.extend(w for _, w in words)
             line.used.update(keys)
+        if self.respin and self.spindle_turning is not None and any(
+                type(x) is n.ToolChange for x in body) and not any(
+                type(x) is n.ModeChange and x.group == "spindle" for x in body):
+            # this M6 stops the spindle, the source's change does not: it turns on as it was
+            self.lowered("the tool change stops the spindle here (M6 of ISO milling, as Haas and "
+                         "LinuxCNC do) and not in the source: its direction written again after it")
+            lines.append(_Line())
+            lines[-1].words.append(self.code_for("spindle", self.spindle_turning))
         # the chamfer / corner rounding words `,C` `,R` end their block (seed L3962-3967)
         return [sorted(ln.words, key=lambda w: w.startswith(",")) for ln in lines if ln.words]
 
@@ -996,6 +1026,8 @@ class IsoEmitter(IsoSpelling, Emitter):
         return key, code
 
     def w_ModeChange(self, s: n.ModeChange):
+        if s.group == "spindle":
+            self.spindle_turning = s.value if s.value in ("cw", "ccw") else None
         if s.group == "diameter" and self.table.code_for("diameter", s.value) is None:
             # ISO milling has no diameter mode: the X words are converted to radii instead
             self.diameter = s.value == "diameter"
