@@ -50,6 +50,10 @@ def test_the_register_in_force_goes_with_the_change():
     # ISO milling keeps H1 in force through the M6 until G43 H2: tool 2 with register 1, then 2
     text = nctrans.transpile(ISO_MILL, read="iso-m", write="iso-t").text
     assert [ln for ln in text.splitlines() if ln.startswith("T")] == ["T0101", "T0201", "T0202 G0 Z10."]
+    # no offset word in the source at all: each tool with its own register, as the first
+    plain = "G21 G90\nT1 M6\nG0 X10 Z5\nT2\nG1 Z-5 F100\nM6\nG1 Z-6\nM30\n"
+    text = nctrans.transpile(plain, read="iso-m", write="iso-t").text
+    assert [ln for ln in text.splitlines() if ln.startswith("T")] == ["T0101", "T0202"]
 
 
 SIN_MILL = "G17 G90 G71\nT1 M6\nD1\nG0 X0 Y0 Z10\nT2\nG1 Z-1 F100\nX10\nM6\nD1\nG0 Z10\nX20\nM30\n"

@@ -109,12 +109,14 @@ class TurningEmitter(iso.IsoEmitter):
     t_tool: "int | None" = None
     t_offset: "int | None" = None
     t_chosen: dict = {}
+    chosen_register: "int | None" = None    # the last register an offset word of the source chose
     block_offset: "int | None" = None
 
     def forget(self) -> None:
         super().forget()
         self.t_tool = self.t_offset = None
         self.t_chosen = {}
+        self.chosen_register = None
 
     def _own(self, k: "int | None", tool: "int | None") -> "int | None":
         """Register k as the T word writes it: a tool-relative D1 is tool `tool`'s own offset."""
@@ -138,10 +140,12 @@ class TurningEmitter(iso.IsoEmitter):
             new = int(t.value)
             if self.block_offset is not None:
                 self.t_offset = self._own(self.block_offset, new)
-            elif self.tool_relative or self.t_offset is None or self.t_tool is None:
+            elif self.tool_relative or self.chosen_register is None:
                 self.t_offset = new     # the new tool's own (Sinumerik/Fagor: its D1 comes in)
-            # else: an ISO mill's register in force stays in force through the change (T0201
-            # after H1: a later G43 H2 writes T0202)
+            else:
+                # an ISO mill's register (H/D) stays in force through the change (T0201 after
+                # H1: a later G43 H2 writes T0202)
+                self.t_offset = self.chosen_register
             self.t_tool = new
             self.t_chosen = {}
             return [("T", f"T{self.t_tool:02d}{self.t_offset:02d}")]
@@ -178,6 +182,7 @@ class TurningEmitter(iso.IsoEmitter):
                 raise NotConvertible(f"{kind} register {k} while the {other_kind} register {other} is in "
                                      "force: a lathe's T word has one register for both", f"D{k}")
             self.t_chosen[kind] = k
+        self.chosen_register = k
         if k == self.t_offset:
             return []                   # the T word in force already carries it
         self.t_offset = k
