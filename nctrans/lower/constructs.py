@@ -298,6 +298,9 @@ def _local(space: str, key, local_names: set[str]) -> bool:
         return isinstance(key, int) and 1 <= key <= 33
     if space == "name":
         return key in local_names
+    if space == "local":            # a call-frame parameter or local user variable (not a V.S. global)
+        from nctrans.lower.frame_locals import lasting
+        return not lasting(key)
     return False
 
 

@@ -47,6 +47,7 @@ from nctrans.ir import nodes as ir
 from nctrans.ir import walk
 from nctrans.cyclemap import mapping_table, peck_clearance
 from nctrans.lower import computed_g, macro_procs, modal_numbers, restart_loop
+from nctrans.lower import frame_locals
 from nctrans.lower.macro_procs import ends_with_restart as _ends_with_restart
 from nctrans.lower.macro_procs import reads_arguments as _reads_arguments
 from nctrans.plainrun import PlainRun, run_blocks
@@ -155,6 +156,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.jump_regions: dict[int, dict] = {}  # per unit: label -> what jumps to it may change
         self.vacancy: dict[int, int] = {}      # local -> PROC parameter position ($P_SUBPAR)
         self.vacancy_flags: dict[int, str] = {}  # local the PROC sets -> flag carrying its vacancy
+        self.frame_locals: dict[str, str] = {}     # the unit's call-frame local -> its DEF name
+        self.frame_plan: dict = {}                 # unit -> its frame_locals (lower.frame_locals)
         self.macro_file = None                 # an ISO macro file written as a PROC (run())
         # (file, line) -> why: constructs convert() asks to refuse at their place (NC412)
         self.in_place: dict = dict((program.meta or {}).get("refuse_in_place") or {})
@@ -242,6 +245,8 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
     def foreign_var(self, v: ir.Var, target: bool, idx: str) -> str:
         """ISO macro variables: a G65 macro's locals by name, system variables (#1000 and up) by
         meaning, the rest as R parameters."""
+        if v.space == "local" and not v.indices and str(v.key).upper() in self.frame_locals:
+            return self.frame_locals[str(v.key).upper()]
         if v.space != "num":
             raise NotExpressible(f"the variable {v.space}:{v.key}")
         if v.key in self.local_names and not v.indices:
@@ -1034,6 +1039,15 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 text += " " + self.word("P", c.repeat)
             out.words.append(("MCALL " if c.modal != "none" else "") + text)
             return
+        passed = self.frame_plan.get(c.name, {}).get(frame_locals.PARAMETERS)
+        if passed is not None:
+            # a new frame with its arguments: the PROC's parameters in number order (A = P0 ...)
+            by_key = {str(v.key).upper(): c.named_args[letter] for letter, v in c.bindings.items()
+                      if letter in c.named_args}
+            text = f"{name}(" + ", ".join(self.expr(by_key[k]) if k in by_key else ""
+                                          for k in passed) + ")"
+            out.words.append(("MCALL " if c.modal != "none" else "") + text)
+            return
         if c.bindings or (c.kind == "g65" and self._defined(c.name)):
             self.info("g65", "macro call arguments passed in R parameters (global: a nested call can "
                              "overwrite them)")
@@ -1494,6 +1508,10 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
 
     def run(self) -> str:
         self.macro_file = self.standalone_macro()
+        # a main program's call-frame locals (Fagor P0..P99, V.P.): DEF'd variables of its own
+        self.frame_plan = (frame_locals.plan(self.p)
+                           if self.p.dialect != DIALECT and self.macro_file is None else {})
+        self.frame_locals = self.frame_plan.get(None, {})
         self.head()
         body = self.p.body
         # a compact body (base.CompactBody) is written item by item, its runs a few blocks at a time
@@ -1536,6 +1554,9 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         if self.call_variables:
             self.lines.append(f"DEF INT {self.call_variables[0]}")
             self.lines.append(f"DEF STRING[32] {self.call_variables[1]}")
+        if self.frame_locals:
+            self.span = ir.Span(self.p.file, 1)
+            self.declare_frame_locals("the main program")
         if self.macro_file is not None:
             self.vacancy_flags_on_entry(self.macro_file.proc)
             self.argument_checks(self.macro_file)
@@ -1579,6 +1600,15 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         if proc.plain_locals:
             self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
         self.declare_vacancy_flags(proc)
+
+    def declare_frame_locals(self, unit: str) -> None:
+        """DEF REAL of the call-frame parameters and local user variables of a unit (Fagor P0..P99,
+        V.P.: nctrans.lower.frame_locals), which end with it as the frame's locals do."""
+        self.info("frame-locals", f"call-frame parameters and local user variables of {unit} written "
+                                  "as its own variables (DEF REAL): " + ", ".join(
+                                      f"{k} -> {v}" for k, v in list(self.frame_locals.items())[:4])
+                  + (" ..." if len(self.frame_locals) > 4 else ""))
+        self.lines.append("DEF REAL " + ", ".join(self.frame_locals.values()))
 
     def declare_vacancy_flags(self, proc: "macro_procs.MacroProc") -> None:
         """An argument the macro tests for vacancy after setting it (Renishaw O9810: IF[#26EQ#0]
@@ -1640,6 +1670,9 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             for prm in sub.params:
                 dims = "[" + ",".join(str(x) if x else "" for x in prm.dims) + "]" if prm.dims else ""
                 params.append(("VAR " if prm.by_ref else "") + prm.type + " " + prm.name + dims)
+            frame = dict(self.frame_plan.get(name, {}))
+            passed = frame.pop(frame_locals.PARAMETERS, [])
+            params += [f"REAL {frame[k]}" for k in passed]
             head = f"PROC {sname}" + (f"({', '.join(params)})" if params else "")
             if getattr(sub, "attrs", None):
                 head += " " + " ".join(sub.attrs)
@@ -1647,6 +1680,14 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 self.lines.append(head)
             if proc is not None and proc.plain_locals:
                 self.lines.append("DEF REAL " + ", ".join(f"LOC{k}" for k in proc.plain_locals))
+            self.frame_locals = {k: v for k, v in frame.items() if k not in passed}
+            if passed:
+                self.info("frame-params", "a subprogram every call of which opens a new frame with its "
+                                          "arguments (#PCALL A..Z = P0..P25) written as a PROC with "
+                                          "those parameters: P0 -> REAL P_0 ...")
+            if self.frame_locals:
+                self.declare_frame_locals(f"subprogram {name}")
+            self.frame_locals = frame
             if proc is not None:
                 self.declare_vacancy_flags(proc)
                 self.vacancy_flags_on_entry(proc)
@@ -1660,7 +1701,7 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
                 if len(comp) == 1:      # every call is made with compensation on / off
                     self.edges.iso.comp = next(iter(comp))
             self.unit(sub.body)
-            self.local_names, self.vacancy, self.vacancy_flags = {}, {}, {}
+            self.local_names, self.vacancy, self.vacancy_flags, self.frame_locals = {}, {}, {}, {}
 
 
 def _reads_as_sinumerik(text: str, moves_allowed: bool = True) -> bool:
