@@ -91,3 +91,30 @@ def test_pcall_leaving_out_an_argument_the_body_reads_is_not_a_proc():
             "#PCALL HOLE A60\nM30\n")
     conv = api.transpile(text, read="fagor", write="sinumerik")
     assert "PROC HOLE(REAL P_0, REAL P_1)" not in (conv.text or "")
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=25, deadline=None)
+@given(start=st.integers(0, 3), stop=st.integers(1, 5), step=st.integers(1, 2),
+       scale=st.integers(1, 9), depth=st.integers(-5, -1))
+def test_property_counting_programs_convert_with_structure(tmp_path_factory, start, stop, step, scale, depth):
+    # a counting loop over a local parameter, a user variable and a #PCALL'd subroutine with two
+    # arguments: the Sinumerik program keeps the loop (WHILE over P_1) and drives the same path
+    text = (f"%L HOLE\nG00 XP0 Y0 Z2\nG01 ZP1 F100\nG00 Z2\n#RET\n%PROG\nG0 X0 Y0 Z5\n"
+            f"V.P.DEPTH={depth}\nP1={start}\n$WHILE P1<={stop}\n"
+            f"#PCALL HOLE A[P1*{scale}] B[V.P.DEPTH]\nP1=P1+{step}\n$ENDWHILE\nM30\n")
+    tmp = tmp_path_factory.mktemp("prop")
+    src = tmp / "p.nc"
+    src.write_text(text)
+    conv = api.transpile(src, read="fagor", write="sinumerik")
+    assert "flattened" not in conv.text
+    out = tmp / "p.mpf"
+    out.write_text(conv.text)
+    # hand: one plunge per P1 = start, start+step, ... <= stop, at X = P1*scale to Z = depth
+    expect = [(p * scale, depth) for p in range(start, stop + 1, step)]
+    got = [(r.end["X"], r.end["Z"]) for r in api.toolpath(out) if r.kind == "linear"]
+    assert got == [(float(x), float(z)) for x, z in expect]
+    assert api.equiv(src, out, read_a="fagor").equivalent

@@ -6,7 +6,8 @@ main program (`DEF REAL P_1`): they end with it, as the frame's locals do. Only 
 reaches that frame: a subprogram that shares the caller's frame (Fagor LL / L / #CALL, seed: "the
 called subroutine shares the local parameters") or reads V.P. variables of its caller (V.P. is
 kept in called subroutines, spec fagor8065 22.57) cannot see a main program's DEF, so a program
-calling one keeps those locals unexpressed (refused or lowered as before). V.S. globals survive
+calling one outside the program keeps those locals unexpressed (refused or lowered as before);
+one inside it that names them leaves the whole program so. V.S. globals survive
 the program (they are not call-frame locals) and are never declared here.
 """
 from __future__ import annotations
@@ -161,8 +162,8 @@ def plan(program: n.Program) -> dict[Optional[str], dict[str, str]]:
     for key in sorted(main["keys"]):
         if lasting(key):
             continue
-        if key.startswith("V.P.") and calls:
-            continue                    # V.P. is seen by every subroutine it calls
+        if key.startswith("V.P.") and any(c.name not in units for c in calls):
+            continue                    # V.P. is seen by the subroutines it calls (not all seen here)
         if not key.startswith("V.") and shares:
             continue                    # P0..P99 shared with a subroutine that is not here
         mine[key] = identifier(key)
