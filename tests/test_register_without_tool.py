@@ -76,3 +76,27 @@ def test_flatten_keeps_the_warning():
     conv = nctrans.transpile(G41_NO_TOOL, read="iso-m", write="sinumerik", flatten=True)
     assert conv.text is not None
     assert [d for d in conv.diagnostics if d.rule == "NC125" and d.line == 3]
+
+
+SIN_NO_TOOL = "G17 G90 G71\nG0 X-20 Y-20 Z5\nD1\nG42 G1 X0 Y0 F100\nX30\nG40 G1 X-20 Y-20\nM30\n"
+
+
+def test_a_sinumerik_edge_with_no_tool_change_is_no_iso_register():
+    # the other way: Sinumerik D1 with no tool change is an edge of the held tool (NC123 in the
+    # source's analysis); ISO D1 is register 1 (tool 1's radius 5 on MILL). It was written as D1,
+    # exit 0, and cut 5 mm off the contour the source's analysis ran: now refused at its line
+    tp = nctrans.toolpath(SIN_NO_TOOL, "sinumerik", MILL)
+    list(tp)
+    assert [d.line for d in tp.diagnostics if d.rule == "NC123"] == [4]
+    for target in ("iso-m", "iso-t"):
+        conv = nctrans.transpile(SIN_NO_TOOL, read="sinumerik", write=target, machine=MILL)
+        assert conv.text is None, (target, conv.text)
+        assert [d for d in conv.diagnostics if d.rule == "NC402" and d.line in (3, 4)], target
+    # a Fagor D1 is a corrector of the active tool too: the same unknown, said the same (NC123)
+    conv = nctrans.transpile(SIN_NO_TOOL, read="sinumerik", write="fagor", machine=MILL)
+    assert "D1" in conv.text
+    assert nctrans.equiv(SIN_NO_TOOL, conv.text, read_a="sinumerik", read_b="fagor", machine=MILL)
+    # a flat offset number the machine file gives is the same D in both
+    conv = nctrans.transpile(SIN_NO_TOOL, read="sinumerik", write="iso-m", machine=FLAT)
+    assert conv.text is not None and "D1" in conv.text
+    assert nctrans.equiv(SIN_NO_TOOL, conv.text, read_a="sinumerik", read_b="iso-m", machine=FLAT)

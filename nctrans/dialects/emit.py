@@ -46,6 +46,17 @@ def conversion_machine(get: Callable):
         CONVERSION_MACHINE.reset(token)
 
 
+def flat_radius_number(k) -> bool:
+    """Whether the machine of the conversion running gives offset number k as a flat radius
+    (`radius_offsets`), which a D reads whatever tool is in the spindle (False outside one)."""
+    get = CONVERSION_MACHINE.get()
+    try:
+        machine = get() if get is not None else None
+    except Exception:           # a machine file that does not load: said where it is used
+        return False
+    return machine is not None and k in getattr(machine, "radius_offsets", {})
+
+
 # the target of the conversion running and the control profile it is written for (`convert
 # --profile` naming one of the target's `[options.profiles]`, None: the dialect's own default)
 TARGET_PROFILE: ContextVar[Optional[tuple]] = ContextVar("target_profile", default=None)

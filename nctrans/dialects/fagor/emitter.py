@@ -21,7 +21,7 @@ from typing import Any, Optional
 from nctrans import spilled
 from nctrans.dialects.base import EmitResult
 from nctrans.dialects.base import get as get_dialect
-from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, rewrites
+from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, flat_radius_number, rewrites
 from nctrans.dialects.tool_timing import ToolTiming
 from nctrans.ir import nodes as n
 from nctrans.plainrun import RUNS, run_blocks
@@ -570,7 +570,7 @@ class FagorEmitter(FagorSpelling, Emitter):
                 # a Fagor D1 is that tool's own corrector (nctrans.interp.comp_radius)
                 raise NotExpressible(f"radius register D1 while T{self.tool_active:g} is in the spindle: "
                                      f"a Fagor D1 is the corrector of T{self.tool_active:g}, not register 1")
-            if self.register_radius and k and self.tool_active is None and not _flat_radius(k):
+            if self.register_radius and k and self.tool_active is None and not flat_radius_number(k):
                 # no tool change before it: a Fagor D<k> is a corrector of the tool the machine
                 # holds from before (its analysis: NC123, radius 0), register k is not
                 raise NotExpressible(f"radius register D{k:g} with no tool change before it: a Fagor "
@@ -989,18 +989,6 @@ def _machine_kind(dialect: str) -> Optional[str]:
 
 def _table_option(dialect: str, key: str) -> Any:
     return rules_option(dialect, key)
-
-
-def _flat_radius(k: float) -> bool:
-    """Whether the conversion's machine file gives offset number k as a flat radius
-    (radius_offsets), which a D reads whatever tool is in the spindle."""
-    from nctrans.dialects.emit import CONVERSION_MACHINE
-    get = CONVERSION_MACHINE.get()
-    try:
-        machine = get() if get is not None else None
-    except Exception:           # a machine file that does not load: said where it is used
-        return False
-    return machine is not None and k in getattr(machine, "radius_offsets", {})
 
 
 def _num(e) -> Optional[float]:

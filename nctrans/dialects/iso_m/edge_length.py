@@ -101,6 +101,14 @@ class EdgeLengths:
         d = _const(self.edge)
         if d is None:
             return [("D", em.addr("D", self.edge))]
+        from nctrans.dialects.emit import flat_radius_number
+        if self.tool == 0 and d and not flat_radius_number(d):
+            # no tool change before it: the edge of the tool the machine holds (the source's
+            # analysis: NC123), which no ISO register names (register d is another radius)
+            em.refuse(f"the radius of cutting edge D{d} with no tool change before it: an edge of "
+                      "the tool the machine holds from before, which the program does not say and "
+                      "no ISO register names")
+            return []
         if d == 1:
             if self.tool is None:
                 em.refuse("the radius of edge D1 of a tool not known here")

@@ -59,6 +59,11 @@ class TurningEmitter(iso.IsoEmitter):
             # a Fagor D<k> (length and radius of register k) is the T word's register k
             self.pos = {}
             return self._select_register(_fagor_d(s), None)
+        if s.group == "cutter_comp" and s.value != "off" and self.t_tool is None \
+                and self.program.dialect != self.dialect:
+            raise NotConvertible("cutter compensation with no tool known before it: ISO turning takes "
+                                 "the nose radius from the offset register its T word names, and which "
+                                 "tool and offset are in force here is not in the program", "G41/G42")
         if s.group == "tool_length" and s.value in ("plus", "off"):
             self.lowered("tool length offset on/off: a lathe applies the offset the T word names")
             return []
