@@ -100,3 +100,12 @@ def test_a_sinumerik_edge_with_no_tool_change_is_no_iso_register():
     conv = nctrans.transpile(SIN_NO_TOOL, read="sinumerik", write="iso-m", machine=FLAT)
     assert conv.text is not None and "D1" in conv.text
     assert nctrans.equiv(SIN_NO_TOOL, conv.text, read_a="sinumerik", read_b="iso-m", machine=FLAT)
+
+
+def test_a_fagor_corrector_with_no_tool_change_is_no_iso_register():
+    # Fagor D2 with no tool change: corrector 2 of the held tool (NC123), not ISO register 2
+    # (radius 3 on MILL): it was written D2, exit 0 (found by a fuzz of random Fagor programs)
+    text = "G17 G90 G71\nG00 X-20 Y-20 Z5\nT3\nD2\nG42 G01 X0 Y0 F100\nX30\nG40 G01 X-20 Y-20\nM30\n"
+    conv = nctrans.transpile(text, read="fagor", write="iso-m", machine=MILL)
+    assert conv.text is None
+    assert [d for d in conv.diagnostics if d.rule == "NC402" and d.line in (4, 5) and "D2" in d.message]

@@ -35,7 +35,8 @@ from nctrans import alarm_numbers
 from nctrans.diagnostics import at_span
 from nctrans.interp import corner_elements
 from nctrans.interp.frames import PLANE_AXES
-from nctrans.dialects.emit import Emitter, NotExpressible, Spelling, flat_forms, format_number, rewrites
+from nctrans.dialects.emit import (Emitter, NotExpressible, Spelling, flat_forms, flat_radius_number,
+                                   format_number, rewrites)
 from nctrans.ir import nodes as n
 from nctrans.dialects.tool_timing import ToolTiming
 from nctrans.ir import walk
@@ -1310,6 +1311,13 @@ class IsoEmitter(IsoSpelling, Emitter):
                 raise NotConvertible(f"the radius of D1, the corrector of the active tool ({why}), which "
                                      "no ISO register names", "D1")
             return [("D", f"D{self.rel_tool}")]
+        if self.tool_relative and s.kind == "radius" and self.rel_tool == 0 \
+                and (_const_int(s.index) or 0) >= 2 and not flat_radius_number(_const_int(s.index)):
+            # no tool change before it: a corrector of the held tool (its analysis: NC123), not
+            # register k, which holds another radius
+            raise NotConvertible(f"the radius of D{_const_int(s.index)}, a corrector of the active "
+                                 "tool with no tool change before it: the tool the machine holds, "
+                                 "which no ISO register names", f"D{_const_int(s.index)}")
         letter = "H" if s.kind == "length" else "D"
         return [(letter, self.addr(letter, s.index))]
 
