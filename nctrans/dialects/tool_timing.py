@@ -34,6 +34,11 @@ def t_word_changes(dialect: Optional[str]) -> bool:
     return changes_on_t_word(machine, dialect)
 
 
+def _default_edge(dialect: Optional[str]) -> int:
+    from nctrans.rules import option
+    return int(option(dialect, "default_cutting_edge", 0) or 0) if dialect else 0
+
+
 class ToolTiming:
     """Per emitter: `source` and `target` dialect names; `target_turret`: the target's T word
     always changes the tool (ISO turning's T<tool><offset>)."""
@@ -50,6 +55,12 @@ class ToolTiming:
         self.loaded: Optional[float] = None     # the tool the last M6 loaded, if known
         self.notes: list[str] = []      # NC401 notes of the last block retimed
         self.warnings: list[str] = []   # NC124 of the last block retimed
+        self.src_tool = None            # the tool the source's T put in place (both change by T)
+        # the edge a change brings in the source where the target's change brings none (rules
+        # default_cutting_edge: Sinumerik D1; a Fagor T keeps the D number)
+        self.edge_on_change = (_default_edge(source) if not same and not _default_edge(target)
+                               and not target_turret else 0)
+        self.same = False               # ... and the last T named the tool already there
         self.t_alone = False            # a source T changed the tool in a block of its own ...
         self.cut_since = False          # ... and a move followed it before any M6
 
@@ -64,6 +75,7 @@ class ToolTiming:
         self.in_place = None
         self.loaded = None
         self.t_alone = self.cut_since = False
+        self.src_tool, self.same = None, False
 
     def apply(self, emitter, body: list) -> list:
         """The block's statements retimed for `emitter`, its refusal (NC402), notes (NC401) and
@@ -91,7 +103,7 @@ class ToolTiming:
         if not self.target_turret:
             body = self._turret_stays(body)
         if not self.active:
-            return body, None
+            return (self._m6_changes_nothing(body) if self.source_changes else body), None
         if self.target_changes:
             return self._hold_until_change(body)
         return self._change_at_t(body), None
@@ -171,6 +183,31 @@ class ToolTiming:
             self.loaded = tool
             out.append(s)
         return out, why
+
+    def _m6_changes_nothing(self, body: list) -> list:
+        """Both change the tool by T: an M6 after a T naming the tool already in place changes
+        nothing in the source (nor its edge), and is left out where the target's M6 would do
+        something (a Fagor M06 brings D1 of the tool). After a T that changed the tool it is kept
+        (the target's M6 then brings what the source's change did)."""
+        out: list = []
+        edge = self.edge_on_change and not any(type(x) in (n.OffsetSelect, n.ToolChange) for x in body)
+        for s in body:
+            t = type(s)
+            if t is n.ToolSelect:
+                k = s.tool.value if type(s.tool) is n.Num else None
+                self.same = k is not None and k == self.src_tool
+                self.src_tool = k
+                if edge and not self.same:
+                    # the source's change brings its default edge (Sinumerik D1); the target's T
+                    # keeps the D number in force (Fagor): said with the T
+                    out.extend((s, n.OffsetSelect("radius", n.Num(float(self.edge_on_change)))))
+                    continue
+            elif t is n.ToolChange and not s.turret:
+                if self.same:
+                    continue
+                self.same = True
+            out.append(s)
+        return out
 
     def _change_at_t(self, body: list) -> list:
         out: list = []

@@ -116,6 +116,7 @@ class TurningEmitter(iso.IsoEmitter):
     t_chosen: dict = {}
     chosen_register: "int | None" = None    # the last register an offset word of the source chose
     block_offset: "int | None" = None
+    block_changes: bool = False
 
     def forget(self) -> None:
         super().forget()
@@ -134,15 +135,24 @@ class TurningEmitter(iso.IsoEmitter):
         if self.block_offset is None:
             self.block_offset = next((_fagor_d(s) for s in body if type(s) is n.ModeChange
                                       and s.group == "tool_length" and _fagor_d(s) is not None), None)
+        # the source's M6 changes the tool even to the one in place (its edge D1 comes in again);
+        # a T of the tool in place that changes nothing (a turret that stays) keeps the edge
+        # (where the source's T changes the tool, its M6 never changes the one in place)
+        self.block_changes = not self.tool_timing.source_changes and any(
+            type(s) is n.ToolChange and not s.turret for s in body)
         try:
             return super().statements(body)
         finally:
             self.block_offset = None
+            self.block_changes = False
 
     def w_ToolSelect(self, s):
         t = s.tool
         if type(t) is n.Num and t.value == int(t.value) and 0 <= t.value < 100:
             new = int(t.value)
+            if self.block_offset is None and self.tool_relative and new == self.t_tool \
+                    and self.t_offset is not None and not self.block_changes:
+                return []               # the turret stays: the T word in force says it all
             if self.block_offset is not None:
                 self.t_offset = self._own(self.block_offset, new)
             elif self.tool_relative or self.chosen_register is None:
