@@ -13,7 +13,15 @@ the tool words of each block to where the target's words change the tool as the 
   elsewhere) is refused at its line (NC402: the construct is lowered to plain motion);
 - source changes by T, target preselects: a T alone is followed by a turret change (a tool
   already in place changes nothing, as in the source), and an M6 after it, which changes nothing
-  in the source (the tool selected is the tool in place), is not written.
+  in the source (the tool selected is the tool in place), is not written;
+- both change by T: an M6 after a T of the tool in place is left out (a Fagor M06 brings D1), and
+  a change that brings the source's default edge (Sinumerik D1) says it where the target's T
+  keeps the D number (Fagor);
+- a lathe's turret that stays (ISO turning T0102 after T0101) is no change on a target whose M6
+  would change the tool again.
+Said at the line: a repeated M6 of the loaded tool a T-changing target cannot make (NC401), an M6
+after a T that already changed the tool with moves between (NC124: the program reads as written
+for an M6 changer, the conversion's machine changes by T).
 """
 from __future__ import annotations
 
