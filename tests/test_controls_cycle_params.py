@@ -81,10 +81,12 @@ def test_cycle85_feeds_out_at_rff():
 
 
 def test_cycle86_lifts_off_by_rpa_rpo_rpap_and_restarts_in_sdir():
-    # SDIR 4, RPA -1, RPO 0.5, RPAP 0.2, POSS 90: G1 to -20, oriented stop, G0 by (-1, 0.5, 0.2)
-    # to (-1, 0.5, -19.8), G0 up to RTP 10, back over the hole (0, 0, 10), spindle M4
+    # SDIR 4, RPA -1, RPO 0.5, RPAP 0.2, POSS 90: the hole is bored in M4 (SDIR; the program runs
+    # M3), G1 to -20, oriented stop, G0 by (-1, 0.5, 0.2) to (-1, 0.5, -19.8), G0 up to RTP 10,
+    # back over the hole (0, 0, 10), spindle M4
     recs, _ = run("CYCLE86(10, 0, 2, -20, , 0, 4, -1, 0.5, 0.2, 90)")
-    assert steps(recs) == [("rapid", 0, 0, 2), ("linear", 0, 0, -20), ("dwell", 0.0), ("spindle", "orient"),
+    assert steps(recs) == [("spindle", "ccw"), ("rapid", 0, 0, 2), ("linear", 0, 0, -20), ("dwell", 0.0),
+                           ("spindle", "orient"),
                            ("rapid", -1, 0.5, -19.8), ("rapid", -1, 0.5, 10), ("rapid", 0, 0, 10),
                            ("spindle", "ccw")]
 

@@ -297,21 +297,25 @@ class CycleCallsMixin:
 
     def _boring_params(self, kind: str, p: dict) -> dict:
         """What Sinumerik's boring cycles do beyond the ISO cycle of their kind [GK, Siemens
-        cycles manual]: CYCLE85 feeds out at RFF; CYCLE86 lifts off by RPA/RPO/RPAP (increments in
-        the abscissa, ordinate and applicate) after the oriented stop and turns the spindle back
-        on in SDIR (3: M3, 4: M4); CYCLE87/CYCLE88 retract with G0 after NC start."""
+        cycles manual]: CYCLE85 dwells DTB at the depth and feeds out at RFF; CYCLE86 lifts off by
+        RPA/RPO/RPAP (increments in the abscissa, ordinate and applicate) after the oriented stop;
+        CYCLE87/CYCLE88 retract with G0 after NC start. CYCLE86/87/88 bore in SDIR (3: M3, 4: M4,
+        "the direction of rotation with which boring is performed") and turn the spindle on in it
+        again; SDIR 0 (omitted) takes the direction in force (NC128 for CYCLE86)."""
         st = self.st
         own: dict = {}
-        if kind == "bore_feed_out" and p.get("rff"):
-            own["feed_out"] = p["rff"] * st.feed_scale
+        if kind == "bore_feed_out":
+            own["dwell_feed_out"] = True
+            if p.get("rff"):
+                own["feed_out"] = p["rff"] * st.feed_scale
         elif kind == "fine_bore":
             a1, a2, ax = PLANE_AXES[st.plane]
             own["lift"] = {a: (p.get(k) or 0.0) * st.scale for a, k in ((a1, "rpa"), (a2, "rpo"), (ax, "rpap"))}
-            direction = {3: "cw", 4: "ccw"}.get(int(p.get("sdir") or 0))
-            if direction:
-                own["spindle_dir"] = direction
         elif kind == "bore_manual":
             own["manual_retract"] = True
+        direction = {3: "cw", 4: "ccw"}.get(int(p.get("sdir") or 0))
+        if direction and kind in ("fine_bore", "bore_manual"):
+            own["bore_dir"] = direction
         return own
 
     def _tap(self, s: n.CycleCall, p: dict, approach: float, bottom: float, retract: float):

@@ -68,7 +68,8 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
                  repeat: int = 1, step: Optional[dict[str, float]] = None,
                  liftoff: Optional[str] = None, position_at: str = "clear_level",
                  feed_out: Optional[float] = None, lift: Optional[dict[str, float]] = None,
-                 manual_retract: bool = False) -> list[Step]:
+                 manual_retract: bool = False, bore_dir: Optional[str] = None,
+                 dwell_feed_out: bool = False) -> list[Step]:
     """The steps of one cycle block: ("rapid"|"linear", point) | ("dwell", s) | ("spindle", dir) | ("stop", "stop").
 
     `retract` is the level the hole ends at: the initial level Zi under G98 (may be below R; the
@@ -87,7 +88,10 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
     asks for: `feed_out` (CYCLE85 RFF) is the feed of the move out of the hole; `lift` (CYCLE86
     RPA/RPO/RPAP) is the lift-off after the oriented stop, an increment in up to three axes, and
     the tool comes back over the hole at the clear level; `manual_retract` (CYCLE87/CYCLE88): after
-    the stop the control retracts with G0 to the clear level when NC start is pressed.
+    the stop the control retracts with G0 to the clear level when NC start is pressed;
+    `bore_dir` (CYCLE86/87/88 SDIR): the spindle direction the hole is bored in, switched to before
+    the feed in when the spindle turns otherwise, and the one it is turned on in again;
+    `dwell_feed_out` (CYCLE85): the dwell DTB at the depth before the feed out (ISO G85 has none).
     """
     ax = DRILL_AXIS[plane]
     a1, a2 = PLANE_AXES[plane]
@@ -111,6 +115,10 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
     def above(a: float, b: float) -> bool:
         return (a - b) * up > 0
 
+    if bore_dir in ("cw", "ccw"):
+        if bore_dir != spindle_dir:
+            steps.append(("spindle", bore_dir))
+        spindle_dir = bore_dir
     # Where the tool travels in the plane, and where each hole ends (LinuxCNC old_cc / clear_cc).
     if position_at == "current":
         base = cur.get(ax, approach)
@@ -174,8 +182,8 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
             steps.append(("spindle", spindle_dir if spindle_dir in ("cw", "ccw") else "cw"))
         else:
             to_level("linear", bottom)
-            if kind in ("drill_dwell", "bore_stop_rapid_out", "bore_dwell_feed_out",
-                        "bore_manual") and dwell_s is not None:
+            if (kind in ("drill_dwell", "bore_stop_rapid_out", "bore_dwell_feed_out", "bore_manual")
+                    or dwell_feed_out) and dwell_s is not None:
                 steps.append(("dwell", dwell_s))
             if kind == "bore_feed_out":
                 if feed_out:
