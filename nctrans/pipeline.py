@@ -253,7 +253,8 @@ def _display_path(path: Path) -> str:
 def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> Optional[Callable]:
     """The interpreter's subprogram resolver, searching the source's directory (the working
     directory for stdin). Called files are parsed in the caller's dialect; their own diagnostics
-    are reported when they are linted themselves, not again through every caller."""
+    are reported when they are linted themselves, not again through every caller; only that a
+    called file has syntax errors is said at the call (NC129), as the path leaves them out."""
     from nctrans.interp.resolver import Resolver
 
     def parse_file(path: Path) -> Optional[Program]:
@@ -267,9 +268,13 @@ def make_resolver(source_dir: Optional[str], dialect: Optional[str] = None) -> O
         if name is None:
             return None
         try:
-            return get_dialect(name).parse(src.text, src.file).program
+            res = get_dialect(name).parse(src.text, src.file)
         except PipelineError:
             return None
+        errors = [d for d in res.diagnostics if d.severity == "error"]
+        if errors:             # said once at the call (NC129): what did not parse never runs
+            res.program.meta["parse_errors"] = (len(errors), errors[0].format_text())
+        return res.program
 
     d = base.get(dialect) if dialect else None
     candidates = d.subprogram_files if d is not None else _any_dialect_files

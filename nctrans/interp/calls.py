@@ -122,6 +122,11 @@ class CallsMixin:
                     self.diag("NC103", "warning", f"cannot load subprogram {name}: {ex}")
                     prog = None
                 self._resolved[key] = prog
+                if prog is not None and prog.meta.get("parse_errors"):
+                    count, first = prog.meta["parse_errors"]
+                    self.diag("NC129", "warning", f"the file of {name}, {prog.file}, has {count} "
+                              f"syntax error{'s' if count > 1 else ''} (first: {first}): what did "
+                              "not parse is left out of the call's path; lint that file")
                 if prog is not None:
                     self._index_subprograms(prog)
                     if key not in self.sub_index:

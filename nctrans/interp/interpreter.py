@@ -240,6 +240,8 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         # F as programmed, in the feed unit in force (G700 inch/min; G70 keeps mm/min)
         values["feed"] = lambda: (st.feed or 0.0) / (st.feed_scale if st.feed_mode != "inverse_time" else 1.0)
         values["spindle_speed"] = lambda: st.spindle_speed or 0.0
+        values["spindle_direction"] = lambda: {"cw": 3.0, "ccw": 4.0}.get(st.spindle_dir, 5.0)
+        values["active_tool_radius"] = lambda: (_edge_radius(self) or 0.0) / st.scale
         for flag in ("block_search_active", "simulation_active", "dry_run_active"):
             values[flag] = lambda: 0.0          # a normal run from the start (vocabulary)
         for i in range(3):      # geometry axes of the plane: abscissa, ordinate, applicate
@@ -258,6 +260,12 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         if gg is not None:
             variable, reader = gg
             self.ev.indexed_system[variable.upper()] = reader
+
+
+def _edge_radius(interp) -> Optional[float]:
+    """The active tool's radius in mm as the milling cycle models take it (Sinumerik $P_TOOLR)."""
+    from nctrans.interp.milling_cycles import _tool_radius
+    return _tool_radius(interp)
 
 
 def interpret(program: n.Program, machine=None, *, diagnostics: list, resolver=None,

@@ -695,11 +695,12 @@ PLANNERS: dict[str, Callable] = {
 def _tool_radius(interp) -> Optional[float]:
     """The active tool's radius (mm), or None when no offset is active or the machine model
     does not know it. A Sinumerik D number is an edge of the active tool, so the tool table's
-    radius of the active tool comes first, then the offset register."""
+    radius of the active tool comes first, then the offset register. An explicit D0 selects no
+    offset: the control's cycle stops (alarm 61000), where it used to take the default edge D1."""
     st = interp.st
-    edge = st.radius_index or (interp.default_edge if st.tool else None)
+    edge = st.radius_index if st.radius_index is not None else (interp.default_edge if st.tool else None)
     if not edge:
-        return None                      # no D, and no tool to bring its default edge D1
+        return None                      # D0 (no offset), or no D and no tool to bring its default edge D1
     if interp.edges is not None and st.tool:     # the edge's data, written or from the tool table
         r = interp.edges.radius(int(st.tool), int(edge))
         return r if r > 0 else None

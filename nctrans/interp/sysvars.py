@@ -63,7 +63,8 @@ def register(interp, dialect: str) -> None:
 # meanings whose spellings a program may only read (the control's alarm on a write: NC228)
 READ_ONLY_MEANINGS = frozenset((
     "axis_position_work", "axis_position_machine", "active_tool", "active_tool_edge", "feed",
-    "spindle_speed", "plane_axis_1", "plane_axis_2", "plane_axis_3", "programmed_tool",
+    "spindle_speed", "spindle_direction", "active_tool_radius", "plane_axis_1", "plane_axis_2",
+    "plane_axis_3", "programmed_tool",
     "argument_programmed", "settable_frame_number"))
 
 

@@ -57,6 +57,8 @@ SYSTEM_VARIABLES = (
     "active_tool_edge",          # active tool offset (edge / D number)
     "feed",                      # programmed feed rate
     "spindle_speed",             # programmed spindle speed
+    "spindle_direction",         # direction of the spindle: 3 clockwise, 4 counterclockwise, 5 stopped
+    "active_tool_radius",        # radius of the active tool edge (with its wear; 0: none active)
     "plane_axis_1",              # geometry axes of the active plane, as axis names: abscissa,
     "plane_axis_2",              # ordinate,
     "plane_axis_3",              # applicate (the tool axis)
