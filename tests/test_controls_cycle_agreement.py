@@ -5,13 +5,17 @@ pattern's PROC beside it too. The Siemens cycle sources are not public in this p
 corpus holds no PROC CYCLE8x / HOLES / CYCLE801), so the PROCs below are written here in the
 Sinumerik language to do what the control's cycles do as the models understand it (the same
 [GK] sources); they exercise the interpreter on real cycle-style code (loops, IF, AX[..], $P_AXN,
-$P_F, SAVE) where the models are plain Python.
+$P_F, SAVE) where the models are plain Python. Beside the hand-picked programs, a hypothesis strategy
+draws parameter sets (levels, DP/DPR, CYCLE83's infeeds and modes, CYCLE84's lead and SDAC, single
+calls, MCALL at positions, MCALL with a hole pattern). The boring and milling cycles have files of
+their own (test_controls_cycle_agreement_boring.py, _milling.py).
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import pipeline
 
@@ -316,3 +320,114 @@ def test_modal_call_follows_moves_in_called_subprograms_not_in_itself(tmp_path):
     assert [(m[0], m[1]["X"], m[1]["Z"]) for m in got] == [
         ("rapid", 0, 5), ("rapid", 10, 5), ("linear", 10, 4), ("rapid", 10, 5),
         ("rapid", 20, 5), ("linear", 20, 4), ("rapid", 20, 5), ("rapid", 0, 5)]
+
+
+def _num(v) -> str:
+    return "" if v is None else f"{v:g}"
+
+
+@st.composite
+def drilling_calls(draw):
+    """A drilling cycle call with a random parameter set, alone, under MCALL at positions, or under
+    MCALL with a hole pattern: levels, DP or DPR, dwell, CYCLE83's infeeds and modes, CYCLE84's
+    lead, hand and SDAC."""
+    cycle = draw(st.sampled_from(["CYCLE81", "CYCLE82", "CYCLE83", "CYCLE84"]))
+    rfp = draw(st.integers(-5, 5))
+    sdis = draw(st.sampled_from([0, 1, 2]))
+    rtp = rfp + sdis + draw(st.sampled_from([0, 3, 15]))
+    depth = draw(st.integers(2, 40))
+    dp, dpr = (None, depth) if draw(st.booleans()) else (rfp - depth, None)
+    dtb = draw(st.sampled_from([None, 0.5]))
+    args = [rtp, rfp, sdis, dp, dpr]
+    spindle = "M3"
+    if cycle == "CYCLE82":
+        args += [draw(st.sampled_from([0, 0.5, 1]))]          # the PROC dwells DTB as given
+    elif cycle == "CYCLE83":
+        first = draw(st.sampled_from([None, 1, 5, 12]))
+        rel = draw(st.booleans())
+        args += [None if rel or first is None else rfp - first, first if rel else None,
+                 draw(st.sampled_from([0, 1, 3])), dtb, draw(st.sampled_from([None, 0.5])),
+                 draw(st.sampled_from([None, 0.5, 1])), draw(st.sampled_from([0, 1])), None, None,
+                 draw(st.sampled_from([None, 0.5]))]
+    elif cycle == "CYCLE84":
+        pit = draw(st.sampled_from([0.8, 1.25, -1, -1.5]))
+        spindle = "M3" if pit > 0 else "M4"
+        args += [dtb, draw(st.sampled_from([3, 4, 5])), None, pit, 0, 1000]
+    while args and args[-1] is None:
+        args.pop()
+    call = f"{cycle}({', '.join(_num(a) for a in args)})"
+    head = START.replace("M3", spindle)
+    how = draw(st.sampled_from(["single", "mcall", "pattern"]))
+    if how == "single":
+        return head + call + "\nM30\n", cycle, None
+    if how == "mcall":
+        pts = draw(st.lists(st.tuples(st.integers(-20, 20), st.integers(-20, 20)), min_size=1, max_size=3))
+        return head + f"MCALL {call}\n" + "".join(f"X{p} Y{q}\n" for p, q in pts) + "MCALL\nM30\n", cycle, None
+    pattern = draw(st.sampled_from(["HOLES1", "HOLES2", "CYCLE801"]))
+    a, b = draw(st.integers(-10, 10)), draw(st.integers(-10, 10))
+    ang = draw(st.sampled_from([0, 30, 90]))
+    num = draw(st.integers(1, 4))
+    pat = {"HOLES1": f"HOLES1({a}, {b}, {ang}, {draw(st.sampled_from([0, 5]))}, 8, {num})",
+           "HOLES2": f"HOLES2({a}, {b}, 20, {ang}, {draw(st.sampled_from([0, 45]))}, {num})",
+           "CYCLE801": f"CYCLE801({a}, {b}, {ang}, 10, 7, {num}, {draw(st.integers(1, 3))})"}[pattern]
+    return head + f"MCALL {call}\n{pat}\nMCALL\nM30\n", cycle, pattern
+
+
+def changes(recs):
+    """Records as the machine sees them: a move to where the tool is (a G0 to RFP+SDIS where the
+    previous hole ended), a dwell of 0 s and a spindle record that leaves the direction as it was
+    are no change and are left out."""
+    out, at, spindle = [], None, None
+    for m in recs:
+        if m[0] in ("rapid", "linear") and m[1] == at:
+            continue
+        if m[0] == "dwell" and not m[1]:
+            continue
+        if m[0] == "spindle":
+            if m[1] == spindle:
+                continue
+            spindle = m[1]
+        if m[0] in ("rapid", "linear"):
+            at = m[1]
+        out.append(m)
+    return out
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
+@given(drilling_calls())
+def test_drilling_models_agree_over_parameter_sets(tmp_path_factory, call):
+    text, cycle, pattern = call
+    runs = []
+    for files in ((), (cycle,), (cycle, pattern)):
+        d = tmp_path_factory.mktemp("d")
+        for f in files:
+            if f is not None:
+                (d / f"{f}.SPF").write_text(SOURCES[f])
+        recs, bad = records(d, text)
+        runs.append((changes(recs), bad))
+    (want, bad), *others = runs
+    assert bad == [] and len(want) > 3
+    for got, bad in others:
+        assert bad == [] and got == want
+
+
+def test_cycle83_fdep_omitted_is_a_first_depth_at_0_by_hand(tmp_path):
+    # found by the generated sets: FDEP left out (and no FDPR) is 0 to the cycle (seed L4722), an
+    # absolute first depth at Z0; the model took "no first depth" and drilled strokes of DAM from
+    # RFP. RFP 5, DAM 4, DP -10: strokes 5 (to 0), then 5-4 = 1 < DAM so 4 (to -4, -8), the rest to
+    # -10; VARI 0 backs off 1 mm with G1 between strokes
+    got, bad = records(tmp_path, START + "CYCLE83(10, 5, 2, -10, , , , 4, , , 1, 0)\nM30\n")
+    assert bad == []
+    assert [m[1]["Z"] for m in got if m[0] in ("rapid", "linear")][1:] == [7, 0, 1, -4, -3, -8, -7, -10, 10]
+
+
+def test_cycle84_turns_the_spindle_the_threads_way_by_hand(tmp_path):
+    # found by the generated sets: after the first hole's SDAC 4 the spindle turns M4; the second
+    # right-hand tap (PIT 1) was cut in M4. G331 turns it clockwise first: G0 to Z1, spindle cw, tap
+    # to -6 at 1 x 1000 mm/min, reversed (ccw) back to Z1, SDAC 4 (ccw), G0 to RTP 5
+    got, bad = records(tmp_path, START + "MCALL CYCLE84(5, 0, 1, -6, , , 4, , 1, 0, 1000)\nX10\nX20\nMCALL\nM30\n")
+    assert bad == []
+    second = changes(got)[changes(got).index(("rapid", {"X": 20.0, "Y": 0.0, "Z": 5.0}, None, None)):]
+    assert [(m[0], m[1]["Z"], m[2]) if m[0] in ("rapid", "linear") else m for m in second][1:] == [
+        ("rapid", 1.0, None), ("spindle", "cw"), ("linear", -6.0, 1000.0), ("spindle", "ccw"),
+        ("linear", 1.0, 1000.0), ("rapid", 5.0, None)]

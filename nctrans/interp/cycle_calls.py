@@ -370,7 +370,9 @@ class CycleCallsMixin:
         """CYCLE83 infeeds from FDEP/FDPR and DAM (cycles.deep_hole_steps)."""
         rfp = p.get("r_plane", 0.0)
         up = 1.0 if approach >= bottom else -1.0
-        first = p.get("first_peck")
+        # FDEP left out is 0, an absolute first depth at 0, as the cycle sees it (seed L4722); FDPR
+        # 0 is "not programmed", as DPR
+        first = p.get("first_peck", 0.0)
         if p.get("fdpr"):               # FDPR as DPR: 0 is "not programmed" (plane_cycle_levels)
             first = rfp - up * abs(p["fdpr"] * self.st.scale)
         vari = int(p.get("vari", 0) or 0)

@@ -283,7 +283,8 @@ def tap_steps(*, plane: str, approach: float, bottom: float, retract: float,
               dwell_s: Optional[float], forward: str, after: Optional[str],
               before: Optional[str] = None, speeds: Optional[tuple] = None) -> list[Step]:
     """Sinumerik CYCLE84/CYCLE840 at the current position [GK, Siemens cycles manual]: G0 to
-    RFP+SDIS, tap to the depth (G331: spindle-synchronised), dwell DTB, spindle reversed and tap
+    RFP+SDIS, tap to the depth (G331: spindle-synchronised, the spindle turned the thread's way
+    when it turns otherwise or stands, as after an earlier hole's SDAC 4), dwell DTB, spindle reversed and tap
     back (G332) to RFP+SDIS, spindle `after` (SDAC; else as before), G0 to RTP. The caller marks
     the two linear steps as synchronised (the record's pitch). `before`: the spindle's state at
     the call, which the control's G332 returns to before SDAC applies (nctrans.interp.rigid_tap);
@@ -301,6 +302,8 @@ def tap_steps(*, plane: str, approach: float, bottom: float, retract: float,
     steps: list[Step] = [("rapid", {ax: approach})]
     if tap_s is not None:
         steps += [("spindle", forward, tap_s), ("feed", tap_f)]
+    elif before is not None and before != forward:
+        steps.append(("spindle", forward))   # G331 turns the spindle the thread's way (rigid_tap)
     steps.append(("linear", {ax: bottom}))
     if dwell_s:
         steps.append(("dwell", dwell_s))
