@@ -1,6 +1,8 @@
-"""Sinumerik thread cutting CYCLE97 on a lathe: the built-in model (nctrans.interp.milling_cycles
+"""Sinumerik turning cycles CYCLE97 (thread cutting), CYCLE94 and CYCLE96 (undercuts): the built-in model (nctrans.interp.milling_cycles
 .thread_turn_steps) against cycle code run by nctrans (issue 8, "Done when"), move for move, with
-each thread cut's lead (pitch) and start angle (SF), over hand-picked and generated parameter sets.
+each thread cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over
+hand-picked and generated parameter sets. Written for DIAMOF (X a radius); the PROCs do not read
+DIAMON ($P_GG of its group is not modelled).
 
 The seeds do not document CYCLE97; tests/data/cycle-procs/CYCLE97.SPF is written in the Sinumerik
 language from what rules/cycles.toml ([[milling]] CYCLE97, [milling_param], [metric_coarse_pitch])
@@ -29,12 +31,13 @@ def records(where: Path, text: str):
     bad = [d.format_text() for d in ld.diagnostics if d.severity in ("error", "warning")]
     out, at = [], None
     for r in recs:
-        if r.kind in ("rapid", "linear"):
+        if r.kind in ("rapid", "linear", "arc"):
             end = (r.end["X"], r.end["Z"])
-            if at is not None and max(abs(p - q) for p, q in zip(end, at)) < 1e-7:
+            if r.kind != "arc" and at is not None and max(abs(p - q) for p, q in zip(end, at)) < 1e-7:
                 continue
             at = end
-            out.append((r.kind, end, r.feed, r.pitch, getattr(r, "thread_start", None) if r.pitch else None))
+            arc = ((r.center["X"], r.center["Z"]), r.direction) if r.kind == "arc" else None
+            out.append((r.kind, end, r.feed, r.pitch, getattr(r, "thread_start", None) if r.pitch else None, arc))
     return out, bad
 
 
@@ -106,3 +109,53 @@ def cycle97_calls(draw):
 @given(cycle97_calls())
 def test_cycle97_model_agrees_over_parameter_sets(tmp_path_factory, text):
     agree(tmp_path_factory.mktemp("t"), text)
+
+
+# -------------------------------------------------------------------------------------------------
+# CYCLE94 / CYCLE96 undercuts: one pass along the undercut's outline (nctrans.interp.undercuts);
+# the PROCs hold the DIN 509 / DIN 76 / ISO 261 rows as SET arrays and take FORM as a STRING
+
+def agree_undercut(tmp_path: Path, text: str, cycle: str):
+    runs = []
+    for how in ("builtin", "code"):
+        d = tmp_path / how
+        d.mkdir(exist_ok=True)
+        if how == "code":
+            for f in (cycle, "CYCUNDC"):
+                (d / f"{f}.SPF").write_text((PROCS / f"{f}.SPF").read_text())
+        runs.append(records(d, text))
+    (want, bad_builtin), (got, bad_code) = runs
+    assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
+    assert len(got) == len(want) and all(_close(g, w) for g, w in zip(got, want)), (got, want)
+    return want
+
+
+UNDERCUTS = {
+    "94-E-outside": ('CYCLE94(20, 60, "E", 3)', "CYCLE94"),
+    "94-F-outside-plus-z": ('CYCLE94(12, -10, "F", 4)', "CYCLE94"),
+    "94-F-inside-large": ('CYCLE94(45, 30, "F", 2)', "CYCLE94"),
+    "96-A": ('CYCLE96(20, -30, "A", 3)', "CYCLE96"),
+    "96-B-plus-z": ('CYCLE96(12, 5, "B", 4)', "CYCLE96"),
+    "96-C-inside": ('CYCLE96(30, -20, "C", 2)', "CYCLE96"),
+    "96-D-inside-plus-z": ('CYCLE96(8, 0, "D", 1)', "CYCLE96"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(UNDERCUTS))
+def test_undercut_models_agree_with_cycle_code(tmp_path, name):
+    call, cycle = UNDERCUTS[name]
+    want = agree_undercut(tmp_path, "G18 G90 T1 D1\nS500 M3 F0.2 G95\nG0 X40 Z80\n" + call + "\nM30\n", cycle)
+    assert sum(m[0] == "linear" for m in want) >= 4 and sum(m[0] == "arc" for m in want) == 1
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
+@given(st.sampled_from(["CYCLE94", "CYCLE96"]), st.integers(1, 4), st.integers(-40, 40),
+       st.sampled_from([1, 2.5, 6, 9, 16, 45, 80]), st.sampled_from([6, 8, 10, 16, 20, 24, 30, 36, 42, 48]),
+       st.sampled_from("EFABCD"))
+def test_undercut_models_agree_over_parameter_sets(tmp_path_factory, cycle, vari, spl, spd, diath, form):
+    if cycle == "CYCLE94":
+        call = f'CYCLE94({spd:g}, {spl}, "{"E" if form in "EAC" else "F"}", {vari})'
+    else:              # forms A/B outside (VARI 3, 4), C/D inside (1, 2)
+        call = f'CYCLE96({diath}, {spl}, "{("AB" if vari > 2 else "CD")[form in "FBD"]}", {vari})'
+    agree_undercut(tmp_path_factory.mktemp("u"), "G18 G90 T1 D1\nS500 M3 F100\nG0 X60 Z50\n" + call + "\nM30\n",
+                   cycle)
