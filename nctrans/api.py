@@ -721,6 +721,14 @@ def _equiv_machine(machine: MachineLike, da: Optional[str], db: Optional[str]) -
     return next((m for m in kinds.values() if m.kind == "lathe"), kinds[da])
 
 
+def _subprogram_file(opened: tuple[Any, Optional[str]]) -> bool:
+    """An opened equiv side is a subprogram file by its dialect's file types (convert.subprogram_file)."""
+    from nctrans.convert import subprogram_file
+    what = opened[0]
+    program = what if isinstance(what, Program) else getattr(what, "program", None)
+    return program is not None and subprogram_file(program)
+
+
 def _budget_spent(diags: list[Diagnostic]) -> bool:
     """The run was cut by the step budget (NC205 as an error: an endless loop)."""
     return any(d.rule == "NC205" and d.severity == "error" and "step budget" in d.message for d in diags)
@@ -746,7 +754,10 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
     ob = _open_run(b, read_b, dirs, "<b>", None)
     _equiv_profiles(oa, ob, profile, profile_b)
     ma = mb = _equiv_machine(machine, oa[1], ob[1])
-    restarts = RESTART_MAIN.set(True)       # M99 in a main program loops, as a LOOP does
+    # M99 in a main program loops, as a LOOP does; but where either side is a subprogram file (a
+    # Sinumerik .SPF), both are: the other side is its conversion, whose M99 is the return the
+    # file's M17/RET was, so each runs once, as its caller would run it
+    restarts = RESTART_MAIN.set(not (_subprogram_file(oa) or _subprogram_file(ob)))
     try:
         with _search_path(dirs):
             ta = _run_opened(oa, ma, dirs)

@@ -207,6 +207,9 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.out = spilled.output_lines()      # to a temporary file once many (spilled.OutputLines)
         self.targets: set = set()
         self.motion = "rapid"
+        # the mode a main program's first move runs in: the source control's power-on motion mode
+        # (Sinumerik G1: `X10 F100` is a feed move; set by prologue), else Fagor's own, G00
+        self.first_motion = "rapid"
         self.plane = "XY"
         self.pending_motion: Optional[str] = None     # arc_3point / arc_tangent: one-shot G09/G08
         self.radius_index: Any = None
@@ -321,6 +324,10 @@ class FagorEmitter(FagorSpelling, Emitter):
             self.span = n.Span(p.file, 1)
             self.lowered(f"power-on modes of {p.dialect} written out: {' '.join(words)}")
             self.out.append(" ".join(words))
+        from nctrans.convert import subprogram_file
+        motion = source.get("motion")
+        if motion and not (p.meta or {}).get("flattened_from") and not subprogram_file(p):
+            self.first_motion = motion      # a subprogram file's first move runs in its caller's
 
     def _reset(self) -> None:
         self.motion = None
@@ -806,9 +813,10 @@ class FagorEmitter(FagorSpelling, Emitter):
         elif s.via:
             raise NotExpressible("an intermediate point outside a three-point arc")
         if self.motion is None:
-            # the first move of a unit: its mode is the power-on default, written out
-            self.motion = "rapid"
-            word("GMOTION", self.code_for("motion", "rapid"))
+            # the first move of a unit: its mode is the power-on default (the source control's in
+            # a main program), written out
+            self.motion = "rapid" if self.in_sub else self.first_motion
+            word("GMOTION", self.code_for("motion", self.motion))
         if self.motion == "thread" and self.tap_cancelled:
             self.tap_cancelled = False
             word("GMOTION", self.code_for("motion", "tap_interp"))

@@ -575,6 +575,23 @@ class IsoEmitter(IsoSpelling, Emitter):
             self.lowered(f"power-on modes of {self.program.dialect} written out: {' '.join(codes)}")
             self.out.append(" ".join(codes))
 
+    def _power_on_motion(self) -> list:
+        """The motion code of a first move that relies on the source control's power-on motion
+        mode where this control's differs (a Sinumerik main program starts in G1, seed L24114;
+        an ISO one in G0): `X10 F100` there is a feed move, written `G1 X10. F100.`, not left to
+        run as a rapid here. A subprogram file's first move runs in its caller's mode: left."""
+        if self.motion_mode is not None:
+            return []
+        from nctrans.convert import subprogram_file
+        source = ((self.program.meta or {}).get("defaults") or {}).get("motion")
+        if (source is None or self.program.dialect == self.dialect or subprogram_file(self.program)
+                or (self.program.meta or {}).get("flattened_from")
+                or self.table.defaults().get("motion") == source):
+            return []
+        self.motion_mode = source
+        self.lowered(f"power-on motion mode of {self.program.dialect} written at its first move")
+        return [self._g("motion", source)]
+
     def _name_table(self) -> list[str]:
         """Comment lines naming where each variable of the source lives (ISO has numbers only):
         `(VAR LEN = #100)`, `(VAR ARR[3] = #510..#512)`, `(VAR R1 = #501)`, per unit."""
@@ -1168,7 +1185,7 @@ class IsoEmitter(IsoSpelling, Emitter):
             raise NotExpressible("polar motion words")
         if s.indirect:
             raise NotExpressible("axis words with a computed axis (AX[..]=)")
-        words = []
+        words = self._power_on_motion()
         if self.thread_mode and s.center:
             return self._thread(s, words) + self._thread_start()
         if self.thread_mode and s.target:

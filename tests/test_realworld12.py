@@ -1,0 +1,79 @@
+"""Constructs that real Sinumerik and ISO programs from outside the corpus showed wrong or silent
+(issue 8, wave 12), each reproduced by a hand-written minimal program with hand-computed values:
+
+- a Sinumerik main program starts in G1: `G54 Z10 F600` with no motion code is a feed move, so
+  its ISO and Fagor conversions (which start in G0) must say G1/G01 at that first move; a
+  subprogram file's first move runs in its caller's mode and is left as written;
+- `equiv` of a subprogram file and its conversion runs each once (the converted M99 is the
+  return the file's M17 was), where a main program's M99 loops;
+- NC240: a construct nctrans does not model, in a block the analysis never ran (a PROC file or
+  macro file linted on its own, a branch not taken), is said at its line.
+"""
+from __future__ import annotations
+
+import nctrans
+
+
+def _lines(conv) -> list[str]:
+    assert conv.text is not None, [d.message for d in conv.diagnostics if d.severity == "error"]
+    return [x for x in conv.text.splitlines()
+            if x and x != "%" and not x.startswith(("(converted", "%PROGRAM"))]
+
+
+def _kinds(text: str, dialect: str) -> list[str]:
+    return [r.kind for r in nctrans.toolpath(text, dialect)]
+
+
+def _codes(diags, code: str) -> list[int]:
+    return [d.line for d in diags if d.rule == code]
+
+
+# ------------------------------------------------------------- power-on motion mode (G1 vs G0)
+
+MAIN = "G54 Z10 F600\nZ5 F1\nM30\n"
+
+
+def test_sinumerik_main_program_first_move_is_a_feed_move():
+    # Sinumerik powers on in G1 (rules/sinumerik.toml: G1 default): Z0 -> Z10 at 600 mm/min,
+    # then Z10 -> Z5 at 1 mm/min; nothing rapid
+    assert _kinds(MAIN, "sinumerik") == ["linear", "linear", "stop"]
+
+
+def test_iso_conversion_writes_g1_at_the_first_move():
+    conv = nctrans.transpile(MAIN, read="sinumerik", write="iso-m")
+    assert _lines(conv) == ["G54 F600. G1 Z10.", "F1. Z5.", "M30"]
+    assert _kinds(conv.text, "iso-m") == ["linear", "linear", "stop"]     # was rapid, rapid
+    assert nctrans.equiv(MAIN, conv.text, read_a="sinumerik", read_b="iso-m")
+
+
+def test_fagor_conversion_writes_g01_at_the_first_move():
+    conv = nctrans.transpile(MAIN, read="sinumerik", write="fagor")
+    assert _lines(conv)[0] == "G54 G01 Z10 F600"                           # was G00
+    assert nctrans.equiv(MAIN, conv.text, read_a="sinumerik", read_b="fagor")
+
+
+def test_an_explicit_motion_code_is_not_doubled():
+    src = "G0 X5\nX10 F100\nM30\n"              # both moves rapid: G0 is modal
+    conv = nctrans.transpile(src, read="sinumerik", write="iso-m")
+    assert _lines(conv) == ["G0 X5.", "F100. X10.", "M30"]
+    assert _kinds(conv.text, "iso-m") == ["rapid", "rapid", "stop"]
+
+
+def test_a_subprogram_file_keeps_its_callers_motion_mode():
+    # an .SPF runs from its caller's modes: no motion code is invented at its first move
+    spf = "%_N_LIFT_SPF\nZ10 F600\nM17\n"
+    conv = nctrans.transpile(spf, read="sinumerik", write="iso-m")
+    assert not any(" G1 " in f" {x} " for x in _lines(conv)), _lines(conv)
+
+
+# ------------------------------------------------------------- equiv of a subprogram file
+
+def test_equiv_runs_a_subprogram_file_and_its_conversion_once():
+    spf = "%_N_LIFT_SPF\nG1 Z10 F600\nG4 F4\nM17\n"
+    conv = nctrans.transpile(spf, read="sinumerik", write="iso-m")
+    assert _lines(conv)[-1] == "M99"             # the return, as an ISO subprogram ends
+    # A: Z0 -> Z10 at 600, dwell 4 s, end; B the same once (a main program's M99 would loop
+    # until the step budget and B would never end where A does)
+    result = nctrans.equiv(spf, conv.text, read_a="sinumerik", read_b="iso-m")
+    assert result, result.difference
+    assert result.records == (3, 3)
