@@ -77,3 +77,37 @@ def test_equiv_runs_a_subprogram_file_and_its_conversion_once():
     result = nctrans.equiv(spf, conv.text, read_a="sinumerik", read_b="iso-m")
     assert result, result.difference
     assert result.records == (3, 3)
+
+
+# ------------------------------------------------------------- NC240: not modelled, not run
+
+PROC_FILE = "PROC OSC_ON\nOSP1[Z]=10 OSP2[Z]=50\nOS[Z]=1\nG1 Z5 F100\nM17\n"
+
+
+def test_proc_file_linted_alone_says_what_is_not_modelled():
+    diags = nctrans.lint(PROC_FILE, "sinumerik")
+    assert _codes(diags, "NC240") == [2, 3]     # oscillation points, oscillation on
+    assert _codes(diags, "NC220") == []         # the body does not run on its own
+    assert all(d.severity == "warning" for d in diags if d.rule == "NC240")
+
+
+def test_a_block_that_runs_is_nc220_not_nc240():
+    diags = nctrans.lint("G1 X10 F100\nOS[Z]=1\nM30\n", "sinumerik")
+    assert _codes(diags, "NC220") == [2]
+    assert _codes(diags, "NC240") == []
+
+
+def test_a_branch_not_taken_is_nc240():
+    # R1 = 0: the IF body never runs, its fixed-stop word is said at line 3
+    src = "R1=0\nIF R1==1\nFXS[Z]=1 FXST[Z]=20 Z-5\nENDIF\nG1 X10 F100\nM30\n"
+    diags = nctrans.lint(src, "sinumerik")
+    assert _codes(diags, "NC240") == [3]
+    assert _codes(diags, "NC220") == []
+
+
+def test_iso_subprogram_nothing_calls_is_said():
+    # a probing macro stored after an empty O-number (as Renishaw's listings are): O9100 runs only
+    # when called, and its G31 (skip move) at line 4 is not modelled
+    src = "%\nO0002()\nO9100 (PROBE)\nG31 X10. F100.\nM99\n%\n"
+    diags = nctrans.lint(src, "iso-m")
+    assert _codes(diags, "NC240") == [4]

@@ -14,6 +14,17 @@ from nctrans.interp.words import LENGTH_WORDS
 from nctrans.ir import nodes as n
 from nctrans.ir.vocabulary import UNMODELLED_LIMITS, UNMODELLED_MODES
 
+
+def reported_unmodelled(s: n.Passthrough, kind: str = "mill") -> bool:
+    """Whether running this construct reports it as not modelled (NC220): neither one the
+    interpreter models itself (a computed G, a corner element, a contour offset, a compensating
+    chuck, spindle positioning, SETMS) nor one known to have no effect on the path (or reported
+    as an error instead). linting.checks asks the same of blocks the run never reached (NC240)."""
+    return not (computed_g.is_computed_g(s) or corner_elements.kind_of(s)
+                or contour_offset.is_offset_word(s) or s.reason == rigid_tap.COMPENSATING_CHUCK
+                or spindle_position.is_positioning(s) or spindle_position.is_setms(s)
+                or unmodelled.no_motion_effect(s.reason, kind) or s.reason in unmodelled.REPORTED_AS_ERROR)
+
 _BY_T_WORD = n.ToolChange(turret=True)      # the change a T word makes where it changes the tool
 
 class StatementsMixin:
@@ -242,8 +253,7 @@ class StatementsMixin:
             return (spindle_position.position, spindle_position.compile_position(self, s))
         if spindle_position.is_setms(s):
             return (spindle_position.set_master, (self, s))
-        if unmodelled.no_motion_effect(s.reason, getattr(self.machine, "kind", "mill")) or \
-                s.reason in unmodelled.REPORTED_AS_ERROR:
+        if not reported_unmodelled(s, getattr(self.machine, "kind", "mill")):
             return (self._h_known, None)
         return (self._h_unmodelled, (s, unmodelled.takes_motion(s)))
 

@@ -8,6 +8,9 @@ text, including what never runs.
 - NC111: a read of a variable that nothing in the file sets (a DEF without a value that is never
   assigned; an ISO local #1-#33 in the main program or common #100-#199 never assigned).
 - NC112: blocks after the main program's end that no jump reaches.
+- NC240: a construct nctrans does not model in a block the run never reached (a PROC file's or a
+  macro file's body linted on its own, a subprogram nothing calls, a branch not taken): at run
+  time it would be NC220, so it is said here instead of passing silently (issue 8).
 - --target DIALECT: the NC4xx the conversion to DIALECT would report, from its emitter (nothing
   is written).
 Modal and motion logic (NC202-NC209) is checked by the interpreter as it runs.
@@ -42,6 +45,7 @@ def run(ld: pipeline.Loaded, machine, target: Optional[str] = None, runner=None)
     diags.extend(type_checks(program, ld.dialect))
     diags.extend(unset_reads(program))
     diags.extend(unreachable(program))
+    diags.extend(unmodelled_not_run(program, getattr(machine, "kind", "mill"), diags))
     if target is not None:
         diags.extend(portability(ld, machine, target))
     return diags
@@ -285,6 +289,31 @@ def unreachable(program: n.Program) -> list[Diagnostic]:
                             f"never runs: {count} block(s) after the program end at line "
                             f"{body[end].span.line}, and no jump reaches them", node.span)]
     return []
+
+
+# --------------------------------------------------------------------------- not run (NC240)
+
+def unmodelled_not_run(program: n.Program, kind: str, run: list[Diagnostic]) -> list[Diagnostic]:
+    """NC240 at each block holding a construct the interpreter would report as not modelled
+    (NC220) but which the run never reached: nothing else would say it is not modelled."""
+    from nctrans.interp.statements import reported_unmodelled
+    said = {(d.file, d.line) for d in run if d.rule == "NC220"}
+    out = []
+    for name, body in units(program):
+        why = (f"subprogram {name} is not called by this file's own run" if name is not None else
+               "the analysis does not reach this block (a macro or PROC file runs only when called, "
+               "a branch not taken, after the end)")
+        for b in blocks(body):
+            if b.span is None or (b.span.file, b.span.line) in said:
+                continue
+            found = [s for s in b.body if type(s) is n.Passthrough and reported_unmodelled(s, kind)]
+            if found:
+                s = found[0]
+                more = f" (+{len(found) - 1} more in this block)" if len(found) > 1 else ""
+                reason = f" ({s.reason})" if s.reason else ""
+                out.append(at_span("NC240", "warning", f"{s.text.strip()!r}{reason} is not modelled, "
+                                   f"and {why}: what it does is in no analysed toolpath{more}", b.span))
+    return out
 
 
 def _expanded(nodes: list) -> list:
