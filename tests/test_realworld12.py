@@ -111,3 +111,25 @@ def test_iso_subprogram_nothing_calls_is_said():
     src = "%\nO0002()\nO9100 (PROBE)\nG31 X10. F100.\nM99\n%\n"
     diags = nctrans.lint(src, "iso-m")
     assert _codes(diags, "NC240") == [4]
+
+
+# ------------------------------------------------------------- NC241: G04 P with a point
+
+def _dwells(text: str) -> list[float]:
+    return [r.dwell_s for r in nctrans.toolpath(text, "iso-m") if r.kind == "dwell"]
+
+
+def test_dwell_p_with_a_point_is_said_and_read_as_milliseconds():
+    # seed Table 3-8: P counts 0.001 s; P200. read so is 200 * 0.001 = 0.2 s, said at line 2
+    src = "G0 X0\nG04 P200.\nG04 P500\nM30\n"
+    assert _dwells(src) == [0.2, 0.5]
+    assert _codes(nctrans.lint(src, "iso-m"), "NC241") == [2]
+
+
+def test_haas_program_reads_dwell_p_with_a_point_as_seconds():
+    # header names HAAS: P200. is 200 s, P500 (no point) still 500 ms = 0.5 s; nothing to say
+    src = "%\nO9220 (HAAS WARM-UP)\nG04 P200.\nG04 P500\nM30\n%\n"
+    assert _dwells(src) == [200.0, 0.5]
+    assert _codes(nctrans.lint(src, "iso-m"), "NC241") == []
+    conv = nctrans.transpile(src, read="iso-m", write="sinumerik")
+    assert "G4 F200" in conv.text and "G4 F0.5" in conv.text, conv.text

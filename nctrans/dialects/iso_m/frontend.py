@@ -173,6 +173,9 @@ class Lowering:
         self.local_calls: set[int] = set()      # N numbers it calls (_local_subprograms)
         self.dwell_unit = float(opts.get("dwell_p_unit", 0.001))
         self.dwell_div = round(1 / self.dwell_unit) if self.dwell_unit else 1000
+        # G04 P with a decimal point counts seconds (the profile's dwell_p_point, Haas) [GK]
+        self.dwell_point_seconds = False
+        self.cur_line = 0
         defaults = self.table.defaults()
         self.motion = defaults.get("motion")
         self.cycle = None               # active canned-cycle kind (None = off)
@@ -340,7 +343,8 @@ class Lowering:
     def _own_dwell(self, b: _Blk) -> None:
         vals = b.vals
         if "P" in vals:
-            secs = self._ms(vals.pop("P"))
+            p = vals.pop("P")
+            secs = self._dwell_point(p) if type(p) is str and "." in p else self._ms(p)
         else:
             v = vals.pop("X", None)
             if v is None:
@@ -352,6 +356,21 @@ class Lowering:
             else:
                 secs = _ex(v)
         b.out.append((B_DWELL, Dwell(seconds=secs)))
+
+    def _dwell_point(self, p: str):
+        """G04 P written with a decimal point. The seed counts P in 0.001 s, 1 to 99999999
+        (L1805-1809): no decimal point. A Haas reads `G04 P2.` as 2 s and `G04 P2000` as 2000 ms
+        (Haas mill operator's manual, G04 [GK]; Renishaw's Haas macros dwell `P200.` for 200 s):
+        the profile's dwell_p_point = "seconds" reads it so; any other control is read by the
+        seed and said at the line (NC241), since either reading is 1000 times the other."""
+        if self.dwell_point_seconds:
+            return Num(float(p), p)
+        secs = self._ms(p)
+        self.diags.append(Diagnostic(
+            "NC241", "warning", f"G04 P{p}: P with a decimal point; the ISO seed counts P in 0.001 s "
+            f"(no point), so it is read as {float(p) / self.dwell_div:g} s, where a Haas reads "
+            f"{float(p):g} s (a program whose header names HAAS is read so)", self.file, self.cur_line))
+        return secs
 
     def _own_home(self, b: _Blk) -> None:
         ref = 1 if b.owner == "home" else 2
@@ -613,6 +632,7 @@ class Lowering:
 
     def lower(self, items: list, line: int) -> tuple[Optional[str], list, list, Optional[str]]:
         """Lower one block's word list. Returns (number, body, structure items, unknown G)."""
+        self.cur_line = line
         number = None
         gs: list = []
         macro: list = []
@@ -1113,8 +1133,9 @@ def _parse_lines(text: str, file: str, program: Program, diags: list, main: list
                 "NC407", "info", f"{block[:40]}: read as a program for the {meaning} (control "
                 f"profile {profile}): only that control accepts this block", file, line))
     if meta.get("profile"):
-        low.local_call_code = str((opts.get("profiles") or {}).get(meta["profile"], {})
-                                  .get("local_call", "")).upper()
+        chosen = (opts.get("profiles") or {}).get(meta["profile"], {})
+        low.local_call_code = str(chosen.get("local_call", "")).upper()
+        low.dwell_point_seconds = chosen.get("dwell_p_point") == "seconds"
     name = None
     subprograms: dict[str, Subprogram] = program.subprograms
     cur = main
