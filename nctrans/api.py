@@ -729,6 +729,27 @@ def _subprogram_file(opened: tuple[Any, Optional[str]]) -> bool:
     return program is not None and subprogram_file(program)
 
 
+# The modes a subprogram file runs in are its caller's: an equiv of it and its conversion starts
+# the other side in the same ones (one caller calls either), not in its own control's power-on
+# modes (Sinumerik G1 where ISO and Fagor power on in G0: `Z10 F600` is the same move from a
+# caller in G1, a feed move against a rapid from power-on)
+_CALLERS_MODES = ("motion", "plane", "feed_mode", "distance", "units", "cutter_comp")
+
+
+def _called_alike(sub: tuple[Any, Optional[str]], other: tuple[Any, Optional[str]]) -> None:
+    """Start `other` in the modes `sub` (a subprogram file) starts in."""
+    def meta(o: tuple[Any, Optional[str]]) -> Optional[dict[str, Any]]:
+        program = o[0] if isinstance(o[0], Program) else getattr(o[0], "program", None)
+        return program.meta if program is not None and isinstance(program.meta, dict) else None
+
+    m_sub, m_other = meta(sub), meta(other)
+    if m_sub is None or m_other is None:
+        return
+    mine, theirs = m_sub.get("defaults"), m_other.get("defaults")
+    if isinstance(mine, dict) and isinstance(theirs, dict):
+        m_other["defaults"] = {**theirs, **{k: mine[k] for k in _CALLERS_MODES if k in mine}}
+
+
 def _budget_spent(diags: list[Diagnostic]) -> bool:
     """The run was cut by the step budget (NC205 as an error: an endless loop)."""
     return any(d.rule == "NC205" and d.severity == "error" and "step budget" in d.message for d in diags)
@@ -757,7 +778,10 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
     # M99 in a main program loops, as a LOOP does; but where either side is a subprogram file (a
     # Sinumerik .SPF), both are: the other side is its conversion, whose M99 is the return the
     # file's M17/RET was, so each runs once, as its caller would run it
-    restarts = RESTART_MAIN.set(not (_subprogram_file(oa) or _subprogram_file(ob)))
+    called = [o for o in (oa, ob) if _subprogram_file(o)]
+    if called:
+        _called_alike(called[0], ob if called[0] is oa else oa)
+    restarts = RESTART_MAIN.set(not called)
     try:
         with _search_path(dirs):
             ta = _run_opened(oa, ma, dirs)

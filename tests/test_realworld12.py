@@ -79,6 +79,17 @@ def test_equiv_runs_a_subprogram_file_and_its_conversion_once():
     assert result.records == (3, 3)
 
 
+def test_equiv_starts_the_conversion_of_a_subprogram_file_in_the_same_callers_modes():
+    # `Z10 F600` with no motion code: from a caller in G1 both run Z0 -> Z10 at 600 mm/min; the ISO
+    # side alone would start in its power-on G0 (a rapid) and differ for no reason of its own
+    spf = "%_N_LIFT_SPF\nZ10 F600\nM17\n"
+    conv = nctrans.transpile(spf, read="sinumerik", write="iso-m")
+    assert _lines(conv) == ["F600. Z10.", "M99"]          # no G1 invented: the caller's mode
+    result = nctrans.equiv(spf, conv.text, read_a="sinumerik", read_b="iso-m")
+    assert result, result.difference
+    assert result.records == (2, 2)
+
+
 # ------------------------------------------------------------- NC240: not modelled, not run
 
 PROC_FILE = "PROC OSC_ON\nOSP1[Z]=10 OSP2[Z]=50\nOS[Z]=1\nG1 Z5 F100\nM17\n"
