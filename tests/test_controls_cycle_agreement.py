@@ -1,7 +1,7 @@
 """Built-in cycle models against cycle code run by nctrans (issue 8, "Done when"): for each modelled
-Sinumerik drilling cycle and hole pattern, a program runs three ways and must give the same records
-move for move: with the built-in models only; with the drilling cycle's PROC beside it; and with the
-pattern's PROC beside it too. The Siemens cycle sources are not public in this project (the shared
+Sinumerik drilling cycle (CYCLE81-84, CYCLE840) and hole pattern, a program runs three ways and must
+give the same records move for move: with the built-in models only; with the drilling cycle's PROC
+beside it; and with the pattern's PROC beside it too. The Siemens cycle sources are not public in this project (the shared
 corpus holds no PROC CYCLE8x / HOLES / CYCLE801), so the PROCs below are written here in the
 Sinumerik language to do what the control's cycles do as the models understand it (the same
 [GK] sources); they exercise the interpreter on real cycle-style code (loops, IF, AX[..], $P_AXN,
@@ -203,7 +203,57 @@ _OUT: G0 AX[_AX]=RTP
 RET
 """
 
-SOURCES = {"CYCLE84": CYCLE84, "CYCLE81": CYCLE81, "CYCLE82": CYCLE82, "CYCLE83": CYCLE83, "HOLES1": HOLES1,
+CYCLE840 = """PROC CYCLE840(REAL RTP, REAL RFP, REAL SDIS, REAL DP, REAL DPR, REAL DTB, INT SDR, INT SDAC, INT ENC, REAL MPIT, REAL PIT, INT _AXN, INT _PTAB, INT _TECHNO) SAVE
+; tapping with compensating chuck, with encoder (G33, G17): in at the lead PIT (or MPIT's metric coarse
+; pitch; the sign the hand), dwell DTB, spindle reversed, out to RFP+SDIS, spindle as SDAC (3 M3,
+; 4 M4, 5 M5; else the tapping direction again), G0 to RTP (RFP+SDIS when RTP is lower)
+DEF REAL _MT[10]=SET(3, 4, 5, 6, 8, 10, 12, 16, 20, 24)
+DEF REAL _MP[10]=SET(0.5, 0.7, 0.8, 1, 1.25, 1.5, 1.75, 2, 2.5, 3)
+DEF REAL _ZSD, _ZAP, _LEAD
+DEF INT _I, _FWD
+_ZAP=RFP+SDIS
+_ZSD=DP
+IF DPR<>0
+  _ZSD=RFP-DPR
+ENDIF
+_LEAD=ABS(PIT)
+_FWD=3
+IF (PIT<0) OR (MPIT<0)
+  _FWD=4
+ENDIF
+IF _LEAD==0
+  FOR _I=0 TO 9
+    IF _MT[_I]==ABS(MPIT)
+      _LEAD=_MP[_I]
+    ENDIF
+  ENDFOR
+ENDIF
+G0 Z=_ZAP
+G33 Z=_ZSD K=_LEAD
+IF DTB>0
+  G4 F=DTB
+ENDIF
+IF _FWD==3
+  M4
+ELSE
+  M3
+ENDIF
+G33 Z=_ZAP K=_LEAD
+IF (SDAC>=3) AND (SDAC<=5)
+  _FWD=SDAC
+ENDIF
+CASE _FWD OF 3 GOTOF _M3 4 GOTOF _M4 DEFAULT GOTOF _M5
+_M3: M3
+GOTOF _OUT
+_M4: M4
+GOTOF _OUT
+_M5: M5
+_OUT: G0 Z=MAXVAL(RTP, _ZAP)
+RET
+"""
+
+SOURCES = {"CYCLE840": CYCLE840, "CYCLE84": CYCLE84, "CYCLE81": CYCLE81, "CYCLE82": CYCLE82,
+           "CYCLE83": CYCLE83, "HOLES1": HOLES1,
            "HOLES2": HOLES2, "CYCLE801": CYCLE801}
 START = "G17 G90 G0 X0 Y0 Z50 F100 S1000 M3\n"
 
@@ -240,6 +290,13 @@ PROGRAMS = {
                      "MCALL\nM30\n", "CYCLE84", None),
     "84-holes1": (START + "MCALL CYCLE84(5, 0, 1, -6, , , 3, , 1, 0, 1000)\nHOLES1(5, 5, 0, 10, 8, 3)\n"
                   "MCALL\nM30\n", "CYCLE84", "HOLES1"),
+    # tapping with compensating chuck, with encoder: lead 1.25, dwell, SDAC 5; MPIT 8 (1.25) with
+    # DPR at positions; left hand (PIT -1) under M4 in a hole circle
+    "840-pit": (START + "CYCLE840(10, 0, 2, -15, , 0.5, 0, 5, 0, , 1.25)\nM30\n", "CYCLE840", None),
+    "840-mpit-positions": (START + "MCALL CYCLE840(5, 1, 1, , 7, , 0, 3, 0, 8)\nX10\nY10\nMCALL\nM30\n",
+                           "CYCLE840", None),
+    "840-left-holes2": (START.replace("M3", "M4") + "MCALL CYCLE840(5, 0, 1, -6, , , 0, 4, 0, , -1)\n"
+                        "HOLES2(0, 0, 20, 0, 0, 3)\nMCALL\nM30\n", "CYCLE840", "HOLES2"),
     "pattern-no-mcall": (START + "CYCLE801(0, 0, 0, 5, 5, 2, 2)\nHOLES1(0, 0, 90, 0, 4, 3)\nM30\n",
                          None, "CYCLE801"),
 }
@@ -331,7 +388,7 @@ def drilling_calls(draw):
     """A drilling cycle call with a random parameter set, alone, under MCALL at positions, or under
     MCALL with a hole pattern: levels, DP or DPR, dwell, CYCLE83's infeeds and modes, CYCLE84's
     lead, hand and SDAC."""
-    cycle = draw(st.sampled_from(["CYCLE81", "CYCLE82", "CYCLE83", "CYCLE84"]))
+    cycle = draw(st.sampled_from(["CYCLE81", "CYCLE82", "CYCLE83", "CYCLE84", "CYCLE840"]))
     rfp = draw(st.integers(-5, 5))
     sdis = draw(st.sampled_from([0, 1, 2]))
     rtp = rfp + sdis + draw(st.sampled_from([0, 3, 15]))
@@ -353,6 +410,12 @@ def drilling_calls(draw):
         pit = draw(st.sampled_from([0.8, 1.25, -1, -1.5]))
         spindle = "M3" if pit > 0 else "M4"
         args += [dtb, draw(st.sampled_from([3, 4, 5])), None, pit, 0, 1000]
+    elif cycle == "CYCLE840":           # the spindle turning the thread's way (the cycle does not turn it)
+        pit = draw(st.sampled_from([0.8, 1.25, -1]))
+        spindle = "M3" if pit > 0 else "M4"
+        metric = draw(st.booleans()) and pit > 0
+        args += [dtb, 0, draw(st.sampled_from([None, 3, 4] if pit > 0 else [4])), 0,
+                 draw(st.sampled_from([6, 10])) if metric else None, None if metric else pit]
     while args and args[-1] is None:
         args.pop()
     call = f"{cycle}({', '.join(_num(a) for a in args)})"

@@ -1,5 +1,6 @@
-"""Sinumerik turning cycles CYCLE97 (thread cutting), CYCLE94 and CYCLE96 (undercuts): the built-in model (nctrans.interp.milling_cycles
-.thread_turn_steps) against cycle code run by nctrans (issue 8, "Done when"), move for move, with
+"""Sinumerik turning cycles CYCLE97 (thread cutting), CYCLE94 and CYCLE96 (undercuts): the built-in
+models (nctrans.interp.milling_cycles.thread_turn_steps, nctrans.interp.undercuts) against cycle
+code run by nctrans (issue 8, "Done when"), move for move, with
 each thread cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over
 hand-picked and generated parameter sets. Written for DIAMOF (X a radius); the PROCs do not read
 DIAMON ($P_GG of its group is not modelled).
