@@ -1,4 +1,4 @@
-"""Sinumerik turning cycles CYCLE97 (thread cutting), CYCLE94 and CYCLE96 (undercuts): the built-in
+"""Sinumerik turning cycles CYCLE97/CYCLE98 (threads), CYCLE94 and CYCLE96 (undercuts): the built-in
 models (nctrans.interp.milling_cycles.thread_turn_steps, nctrans.interp.undercuts) against cycle
 code run by nctrans (issue 8, "Done when"), move for move, with
 each thread cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over
@@ -160,3 +160,54 @@ def test_undercut_models_agree_over_parameter_sets(tmp_path_factory, cycle, vari
         call = f'CYCLE96({diath}, {spl}, "{("AB" if vari > 2 else "CD")[form in "FBD"]}", {vari})'
     agree_undercut(tmp_path_factory.mktemp("u"), "G18 G90 T1 D1\nS500 M3 F100\nG0 X60 Z50\n" + call + "\nM30\n",
                    cycle)
+
+
+# -------------------------------------------------------------------------------------------------
+# CYCLE98 chained threads: CYCLE97's passes through up to three sections with their own leads
+
+def agree_chain(tmp_path: Path, text: str):
+    runs = []
+    for how in ("builtin", "code"):
+        d = tmp_path / how
+        d.mkdir(exist_ok=True)
+        if how == "code":
+            (d / "CYCLE98.SPF").write_text((PROCS / "CYCLE98.SPF").read_text())
+        runs.append(records(d, text))
+    (want, bad_builtin), (got, bad_code) = runs
+    assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
+    first = next((i for i, (g, w) in enumerate(zip(got, want)) if not _close(g, w)), None)
+    assert first is None and len(got) == len(want), (first, got[first or 0:][:3], want[first or 0:][:3])
+    return want
+
+
+CHAINS = {
+    "three-leads": "CYCLE98(0, 20, -10, 20, -20, 22, -30, 22, 3, 2, 1.2, 0.2, 0, 0, 2, 1, 1.5, 2, 2.5, 1, 1)",
+    "internal-flanks-two-starts": ("CYCLE98(0, 30, -8, 29, -16, 29, -24, 30, 2, 0, 0.9, 0, -29, 30, 3, 0, 1, 1, 1,"
+                                   " 4, 2, 0.5)"),
+    "towards-plus-z": "CYCLE98(-30, 16, -20, 16, -10, 18, 0, 18, 0, 2, 0.6, 0.1, 30, 0, 2, 1, 1, 1.25, 1.5, 3, 1)",
+}
+
+
+@pytest.mark.parametrize("name", sorted(CHAINS))
+def test_cycle98_model_agrees_with_cycle_code(tmp_path, name):
+    want = agree_chain(tmp_path, START.format(x=30) + CHAINS[name] + "\nM30\n")
+    assert sum(m[3] is not None for m in want) >= 3        # thread cuts carrying their lead
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck))
+@given(st.data())
+def test_cycle98_model_agrees_over_parameter_sets(tmp_path_factory, data):
+    draw = data.draw
+    sp = draw(st.sampled_from([1, -1]))
+    z = [draw(st.integers(-5, 5))]
+    for _ in range(3):
+        z.append(z[-1] - sp * draw(st.integers(4, 12)))
+    d0 = draw(st.sampled_from([16, 24, 30]))
+    dms = [d0 + draw(st.sampled_from([0, 0, 1, -1, 2])) for _ in range(4)]
+    args = [z[0], dms[0], z[1], dms[1], z[2], dms[2], z[3], dms[3], draw(st.sampled_from([0, 2, 4])),
+            draw(st.sampled_from([0, 1.5])), draw(st.sampled_from([0.6, 1.1])), draw(st.sampled_from([0, 0.1])),
+            draw(st.sampled_from([0, 30, -29])), draw(st.sampled_from([0, 90])), draw(st.integers(1, 4)),
+            draw(st.integers(0, 2))] + [draw(st.sampled_from([1, 1.5, 2])) for _ in range(3)] + \
+        [draw(st.sampled_from([1, 2, 3, 4])), draw(st.sampled_from([0, 1, 3])), draw(st.sampled_from([0, 0.5]))]
+    call = "CYCLE98(" + ", ".join(f"{a:g}" for a in args) + ")"
+    agree_chain(tmp_path_factory.mktemp("c"), START.format(x=draw(st.sampled_from([2, 30]))) + call + "\nM30\n")
