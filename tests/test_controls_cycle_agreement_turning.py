@@ -1,7 +1,6 @@
-"""Sinumerik turning cycles CYCLE97/CYCLE98 (threads), CYCLE94 and CYCLE96 (undercuts): the built-in
-models (nctrans.interp.milling_cycles.thread_turn_steps, nctrans.interp.undercuts) against cycle
-code run by nctrans (issue 8, "Done when"), move for move, with
-each thread cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over
+"""Sinumerik turning cycles CYCLE97/CYCLE98 (threads), CYCLE94/CYCLE96 (undercuts) and CYCLE93
+(grooving, sharp-cornered grooves): the built-in models (nctrans.interp.milling_cycles, .undercuts,
+.grooving) against cycle code run by nctrans (issue 8, "Done when"), move for move, with each thread cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over
 hand-picked and generated parameter sets. Written for DIAMOF (X a radius); the PROCs do not read
 DIAMON ($P_GG of its group is not modelled).
 
@@ -211,3 +210,75 @@ def test_cycle98_model_agrees_over_parameter_sets(tmp_path_factory, data):
         [draw(st.sampled_from([1, 2, 3, 4])), draw(st.sampled_from([0, 1, 3])), draw(st.sampled_from([0, 0.5]))]
     call = "CYCLE98(" + ", ".join(f"{a:g}" for a in args) + ")"
     agree_chain(tmp_path_factory.mktemp("c"), START.format(x=draw(st.sampled_from([2, 30]))) + call + "\nM30\n")
+
+
+# -------------------------------------------------------------------------------------------------
+# CYCLE93 grooving, sharp-cornered grooves (RCO/RCI 0) in a straight contour: the tool's width comes
+# from the machine model (a tool's `width`) for the built-in model, from R90 for the PROC (the
+# control's cycle reads it from the two edges' offsets, which nctrans' machine model does not hold)
+
+def agree_groove(tmp_path: Path, call: str, width: float, start: str = "G0 X40 Z20"):
+    from nctrans.machine import Machine, Tool
+    machine = Machine(name="t", tools=[Tool(number=1, width=width)])
+    text = f"R90={width:g}\nG18 G90 T1 D1\nS500 M3 F0.1 G95\n{start}\n{call}\nM30\n"
+    runs = []
+    for how in ("builtin", "code"):
+        d = tmp_path / how
+        d.mkdir(exist_ok=True)
+        if how == "code":
+            for f in ("CYCLE93", "CYCGRF"):
+                (d / f"{f}.SPF").write_text((PROCS / f"{f}.SPF").read_text())
+        path = d / "MAIN.MPF"
+        path.write_text(text)
+        ld = pipeline.load(str(path), "sinumerik")
+        recs = list(pipeline.toolpath_of(ld, machine))
+        bad = [x.format_text() for x in ld.diagnostics if x.severity in ("error", "warning")]
+        out, at = [], None
+        for r in recs:
+            if r.kind in ("rapid", "linear"):
+                end = (r.end["X"], r.end["Z"])
+                if at is not None and max(abs(p - q) for p, q in zip(end, at)) < 1e-7:
+                    continue
+                at = end
+                out.append((r.kind, end, r.feed))
+            elif r.kind in ("dwell", "arc"):
+                out.append((r.kind, r.dwell_s, None))
+        runs.append((out, bad))
+    (want, bad_builtin), (got, bad_code) = runs
+    assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
+    first = next((i for i, (g, w) in enumerate(zip(got, want)) if not _close(g, w)), None)
+    assert first is None and len(got) == len(want), (first, got[first or 0:][:3], want[first or 0:][:3])
+    return want
+
+
+GROOVES = {
+    "outside-left": ("CYCLE93(20, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0.2, 0.3, 1.5, 0.5, 1)", 3),
+    "face-right-flanks": ("CYCLE93(30, 0, 6, 3, 0, 10, 20, 0, 0, 0, 0, 0.1, 0.2, 1, 0, 6, 0.5)", 2.5),
+    "inside-right-one-infeed": ("CYCLE93(10, -20, 10, 2, 0, 5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 7)", 4),
+}
+
+
+@pytest.mark.parametrize("name", sorted(GROOVES))
+def test_cycle93_model_agrees_with_cycle_code(tmp_path, name):
+    call, width = GROOVES[name]
+    want = agree_groove(tmp_path, call, width, "G0 X5 Z20" if "inside" in name else "G0 X40 Z20")
+    assert sum(m[0] == "linear" for m in want) >= 4
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
+@given(st.data())
+def test_cycle93_model_agrees_over_parameter_sets(tmp_path_factory, data):
+    draw = data.draw
+    vari = draw(st.integers(1, 8)) + draw(st.sampled_from([0, 10]))
+    inside = vari % 10 in (3, 4, 7, 8)
+    tw = draw(st.sampled_from([2, 3, 4]))
+    widg = tw + draw(st.sampled_from([0.5, 1, 3, 7]))
+    fal2 = draw(st.sampled_from([0, 0.1, 0.2]))
+    if tw > widg - 2 * fal2 / math.cos(math.radians(20)):
+        fal2 = 0
+    args = [draw(st.sampled_from([15, 25])), draw(st.integers(-20, 5)), widg, draw(st.sampled_from([1, 2.5, 4])), 0,
+            draw(st.sampled_from([0, 0, 5, 20])), draw(st.sampled_from([0, 0, 10, 15])), 0, 0, 0, 0,
+            draw(st.sampled_from([0, 0.1, 0.3])), fal2, draw(st.sampled_from([0, 0.7, 1.5, 5])),
+            draw(st.sampled_from([0, 0.4])), vari, draw(st.sampled_from([0, 0.5, 2]))]
+    call = "CYCLE93(" + ", ".join(f"{a:g}" for a in args) + ")"
+    agree_groove(tmp_path_factory.mktemp("g"), call, tw, "G0 X2 Z30" if inside else "G0 X50 Z30")
