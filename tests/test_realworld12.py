@@ -144,3 +144,16 @@ def test_haas_program_reads_dwell_p_with_a_point_as_seconds():
     assert _codes(nctrans.lint(src, "iso-m"), "NC241") == []
     conv = nctrans.transpile(src, read="iso-m", write="sinumerik")
     assert "G4 F200" in conv.text and "G4 F0.5" in conv.text, conv.text
+
+
+# ------------------------------------------------------------- Fagor: a machine's own M function
+
+def test_fagor_keeps_a_machine_m_function_as_written():
+    # M27 (a clamp, a PLC output) is the machine builder's number on either control: kept as the
+    # ISO and Sinumerik emitters keep it (NC403), where it refused the whole conversion
+    src = "G1 X10 F100\nM27\nm12\nX20\nM30\n"
+    conv = nctrans.transpile(src, read="sinumerik", write="fagor")
+    assert _lines(conv) == ["G01 X10 F100", "M27", "M12", "X20", "M30"]
+    assert _codes(conv.diagnostics, "NC403") == [2, 3]
+    assert not [d for d in conv.diagnostics if d.severity == "error"]
+    assert nctrans.equiv(src, conv.text, read_a="sinumerik", read_b="fagor")

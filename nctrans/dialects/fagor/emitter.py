@@ -30,6 +30,12 @@ from nctrans.lower import macro_procs, restart_loop
 from nctrans.ir.vocabulary import NO_EFFECT_PREFIX
 from nctrans import alarm_numbers
 from nctrans.rules import load_table, option as rules_option
+from nctrans.diagnostics import at_span
+
+import re as _re
+
+# one M word with a plain number: a function of the machine builder's (NC403 when kept)
+_MACHINE_M = _re.compile(r"[Mm]\d{1,4}")
 
 __all__ = ["FagorSpelling", "FagorEmitter", "NotExpressible", "format_number", "format_expr", "emit_program"]
 
@@ -709,6 +715,14 @@ class FagorEmitter(FagorSpelling, Emitter):
             word("", s.text, alone=s.text.startswith("#"))
         elif s.dialect and s.reason.startswith(NO_EFFECT_PREFIX):
             word("", "; " + self.foreign_function_comment(s), alone=True)
+        elif self.program.dialect != DIALECT and _MACHINE_M.fullmatch(s.text.strip()):
+            # a machine's own M function (a clamp, a conveyor, a PLC output: M27, M95): its number
+            # is the machine builder's on either control, so it is kept as written, as the ISO and
+            # Sinumerik emitters keep it, and said (NC403); refused, it stopped the conversion
+            text = s.text.strip().upper()
+            self.diags.append(at_span("NC403", "warning", f"kept verbatim from {s.dialect or self.program.dialect}: {text} "
+                                      f"({s.reason}): the machine's own M function", self._where()))
+            word("M", text)
         else:
             raise NotExpressible(f"{s.text!r} ({s.reason or 'kept verbatim'} from {s.dialect or 'the source'})")
 
