@@ -157,3 +157,15 @@ def test_fagor_keeps_a_machine_m_function_as_written():
     assert _codes(conv.diagnostics, "NC403") == [2, 3]
     assert not [d for d in conv.diagnostics if d.severity == "error"]
     assert nctrans.equiv(src, conv.text, read_a="sinumerik", read_b="fagor")
+
+
+# ------------------------------------------------------------- NC202 in a subprogram file
+
+def test_feed_move_without_f_in_a_subprogram_file_is_the_callers_feed():
+    # an .SPF moves at the F its caller set: alone, the feed is unknown, not an error of the file
+    spf = "%_N_CONTOUR_SPF\nG2 X80 Y0 CR=80\nRET\n"
+    diags = [d for d in nctrans.lint(spf, "sinumerik") if d.rule == "NC202"]
+    assert [(d.line, d.severity) for d in diags] == [(2, "warning")]
+    # the same move in a main program is the program's own error
+    main = [d for d in nctrans.lint("G2 X80 Y0 CR=80\nM30\n", "sinumerik") if d.rule == "NC202"]
+    assert [(d.line, d.severity) for d in main] == [(1, "error")]

@@ -242,11 +242,22 @@ class MotionMixin:
         st = self.st
         if not st.feed and not self.feed_reported:
             self.feed_reported = True
-            self.diag("NC202", "error", "feed move with no feed rate programmed")
+            if self.stack or not self._runs_from_a_caller():
+                self.diag("NC202", "error", "feed move with no feed rate programmed")
+            else:                       # a subprogram file (.SPF) run alone: F is its caller's
+                self.diag("NC202", "warning", "feed move with no feed rate programmed in this "
+                          "subprogram file: it moves at the feed its caller set, which the analysis "
+                          "of the file alone does not know")
         if self.spindle_stopped and not self.spindle_reported:
             self.spindle_reported = True
             self.diag("NC209", "warning", "feed move while the spindle is stopped (M5, or a tool change that stops it): the tool "
                       "would rub or break; start the spindle (M3/M4) before cutting")
+
+    def _runs_from_a_caller(self) -> bool:
+        """The program run is a subprogram file by its dialect's file types (a Sinumerik .SPF):
+        its modes and feed are its caller's (convert.subprogram_file)."""
+        from nctrans.convert import subprogram_file
+        return subprogram_file(self.program)
 
     def _g33_move(self, vals, center) -> None:
         """G33: a feed synchronised with the spindle, `lead` mm per revolution: the feed is
