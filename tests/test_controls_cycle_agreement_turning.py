@@ -1,7 +1,8 @@
 """Sinumerik turning cycles CYCLE97/CYCLE98 (threads), CYCLE94/CYCLE96 (undercuts) and CYCLE93
 (grooving, sharp-cornered grooves): the built-in models (nctrans.interp.milling_cycles, .undercuts,
-.grooving) against cycle code run by nctrans (issue 8, "Done when"), move for move, with each thread cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over
-hand-picked and generated parameter sets. Written for DIAMOF (X a radius); the PROCs do not read
+.grooving) against cycle code run by nctrans (issue 8, "Done when"), move for move, with each thread
+cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over hand-picked and
+generated parameter sets. Written for DIAMOF (X a radius); the PROCs do not read
 DIAMON ($P_GG of its group is not modelled).
 
 The seeds do not document CYCLE97; tests/data/cycle-procs/CYCLE97.SPF is written in the Sinumerik
