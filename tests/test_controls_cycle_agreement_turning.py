@@ -22,6 +22,14 @@ from nctrans import pipeline
 
 PROCS = Path(__file__).parent / "data" / "cycle-procs"
 START = "G18 G90 T1 D1\nS500 M3\nG0 X{x} Z10\n"
+# the same under DIAMON: X programmed as a diameter; each PROC turns DIAMOF for itself and SAVE
+# restores DIAMON at its end (seed L4386), which the move after the call (X40: radius 20) shows
+START_DIAMON = "G18 G90 DIAMON T1 D1\nS500 M3\nG0 X{x2} Z10\n"
+AFTER = "G0 X40 Z30\n"
+
+
+def start(x: float, diamon: bool) -> str:
+    return START_DIAMON.format(x2=2 * x) if diamon else START.format(x=x)
 
 
 def records(where: Path, text: str):
@@ -75,9 +83,11 @@ CALLS = {
 }
 
 
+@pytest.mark.parametrize("diamon", [False, True])
 @pytest.mark.parametrize("name", sorted(CALLS))
-def test_cycle97_model_agrees_with_cycle_code(tmp_path, name):
-    want = agree(tmp_path, START.format(x=30) + CALLS[name] + "\nG0 X40\nM30\n")
+def test_cycle97_model_agrees_with_cycle_code(tmp_path, name, diamon):
+    want = agree(tmp_path, start(30, diamon) + CALLS[name] + "\n" + AFTER + "M30\n")
+    assert want[-1][1] == ((20.0, 30.0) if diamon else (40.0, 30.0))
     assert sum(m[3] is not None for m in want) >= 1
 
 
@@ -103,7 +113,7 @@ def cycle97_calls(draw):
     while args and args[-1] is None:
         args.pop()
     call = "CYCLE97(" + ", ".join("" if a is None else f"{a:g}" for a in args) + ")"
-    return START.format(x=draw(st.sampled_from([2, 30]))) + call + "\nM30\n"
+    return start(draw(st.sampled_from([2, 30])), draw(st.booleans())) + call + "\n" + AFTER + "M30\n"
 
 
 @settings(max_examples=50, deadline=None, suppress_health_check=list(HealthCheck))
@@ -142,24 +152,27 @@ UNDERCUTS = {
 }
 
 
+@pytest.mark.parametrize("diamon", [False, True])
 @pytest.mark.parametrize("name", sorted(UNDERCUTS))
-def test_undercut_models_agree_with_cycle_code(tmp_path, name):
+def test_undercut_models_agree_with_cycle_code(tmp_path, name, diamon):
     call, cycle = UNDERCUTS[name]
-    want = agree_undercut(tmp_path, "G18 G90 T1 D1\nS500 M3 F0.2 G95\nG0 X40 Z80\n" + call + "\nM30\n", cycle)
+    head = "G18 G90 DIAMON T1 D1\nS500 M3 F0.2 G95\nG0 X80 Z80\n" if diamon else \
+        "G18 G90 T1 D1\nS500 M3 F0.2 G95\nG0 X40 Z80\n"
+    want = agree_undercut(tmp_path, head + call + "\n" + AFTER + "M30\n", cycle)
     assert sum(m[0] == "linear" for m in want) >= 4 and sum(m[0] == "arc" for m in want) == 1
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
 @given(st.sampled_from(["CYCLE94", "CYCLE96"]), st.integers(1, 4), st.integers(-40, 40),
        st.sampled_from([1, 2.5, 6, 9, 16, 45, 80]), st.sampled_from([6, 8, 10, 16, 20, 24, 30, 36, 42, 48]),
-       st.sampled_from("EFABCD"))
-def test_undercut_models_agree_over_parameter_sets(tmp_path_factory, cycle, vari, spl, spd, diath, form):
+       st.sampled_from("EFABCD"), st.booleans())
+def test_undercut_models_agree_over_parameter_sets(tmp_path_factory, cycle, vari, spl, spd, diath, form, diamon):
     if cycle == "CYCLE94":
         call = f'CYCLE94({spd:g}, {spl}, "{"E" if form in "EAC" else "F"}", {vari})'
     else:              # forms A/B outside (VARI 3, 4), C/D inside (1, 2)
         call = f'CYCLE96({diath}, {spl}, "{("AB" if vari > 2 else "CD")[form in "FBD"]}", {vari})'
-    agree_undercut(tmp_path_factory.mktemp("u"), "G18 G90 T1 D1\nS500 M3 F100\nG0 X60 Z50\n" + call + "\nM30\n",
-                   cycle)
+    head = f"G18 G90 {'DIAMON ' if diamon else ''}T1 D1\nS500 M3 F100\nG0 X{120 if diamon else 60} Z50\n"
+    agree_undercut(tmp_path_factory.mktemp("u"), head + call + "\n" + AFTER + "M30\n", cycle)
 
 
 # -------------------------------------------------------------------------------------------------
@@ -190,7 +203,7 @@ CHAINS = {
 
 @pytest.mark.parametrize("name", sorted(CHAINS))
 def test_cycle98_model_agrees_with_cycle_code(tmp_path, name):
-    want = agree_chain(tmp_path, START.format(x=30) + CHAINS[name] + "\nM30\n")
+    want = agree_chain(tmp_path, start(30, True) + CHAINS[name] + "\n" + AFTER + "M30\n")
     assert sum(m[3] is not None for m in want) >= 3        # thread cuts carrying their lead
 
 
@@ -210,7 +223,8 @@ def test_cycle98_model_agrees_over_parameter_sets(tmp_path_factory, data):
             draw(st.integers(0, 2))] + [draw(st.sampled_from([1, 1.5, 2])) for _ in range(3)] + \
         [draw(st.sampled_from([1, 2, 3, 4])), draw(st.sampled_from([0, 1, 3])), draw(st.sampled_from([0, 0.5]))]
     call = "CYCLE98(" + ", ".join(f"{a:g}" for a in args) + ")"
-    agree_chain(tmp_path_factory.mktemp("c"), START.format(x=draw(st.sampled_from([2, 30]))) + call + "\nM30\n")
+    agree_chain(tmp_path_factory.mktemp("c"), start(draw(st.sampled_from([2, 30])), draw(st.booleans())) + call
+                + "\n" + AFTER + "M30\n")
 
 
 # -------------------------------------------------------------------------------------------------
@@ -218,10 +232,11 @@ def test_cycle98_model_agrees_over_parameter_sets(tmp_path_factory, data):
 # from the machine model (a tool's `width`) for the built-in model, from R90 for the PROC (the
 # control's cycle reads it from the two edges' offsets, which nctrans' machine model does not hold)
 
-def agree_groove(tmp_path: Path, call: str, width: float, start: str = "G0 X40 Z20"):
+def agree_groove(tmp_path: Path, call: str, width: float, position: str = "G0 X40 Z20", diamon: bool = False):
     from nctrans.machine import Machine, Tool
     machine = Machine(name="t", tools=[Tool(number=1, width=width)])
-    text = f"R90={width:g}\nG18 G90 T1 D1\nS500 M3 F0.1 G95\n{start}\n{call}\nM30\n"
+    text = (f"R90={width:g}\nG18 G90 {'DIAMON ' if diamon else ''}T1 D1\nS500 M3 F0.1 G95\n{position}\n{call}\n"
+            + AFTER + "M30\n")
     runs = []
     for how in ("builtin", "code"):
         d = tmp_path / how
@@ -259,10 +274,15 @@ GROOVES = {
 }
 
 
+@pytest.mark.parametrize("diamon", [False, True])
 @pytest.mark.parametrize("name", sorted(GROOVES))
-def test_cycle93_model_agrees_with_cycle_code(tmp_path, name):
+def test_cycle93_model_agrees_with_cycle_code(tmp_path, name, diamon):
     call, width = GROOVES[name]
-    want = agree_groove(tmp_path, call, width, "G0 X5 Z20" if "inside" in name else "G0 X40 Z20")
+    if diamon:                     # SPD is a diameter under DIAMON: the same groove
+        head, spd, rest = call.partition("(")[0], call.split("(")[1].split(",")[0], call.split(",", 1)[1]
+        call = f"{head}({2 * float(spd):g},{rest}"
+    x = 5 if "inside" in name else 40
+    want = agree_groove(tmp_path, call, width, f"G0 X{2 * x if diamon else x} Z20", diamon)
     assert sum(m[0] == "linear" for m in want) >= 4
 
 
@@ -277,9 +297,25 @@ def test_cycle93_model_agrees_over_parameter_sets(tmp_path_factory, data):
     fal2 = draw(st.sampled_from([0, 0.1, 0.2]))
     if tw > widg - 2 * fal2 / math.cos(math.radians(20)):
         fal2 = 0
-    args = [draw(st.sampled_from([15, 25])), draw(st.integers(-20, 5)), widg, draw(st.sampled_from([1, 2.5, 4])), 0,
+    diamon = draw(st.booleans())            # SPD a diameter under DIAMON: the same radius 15 or 25
+    args = [draw(st.sampled_from([15, 25])) * (2 if diamon else 1), draw(st.integers(-20, 5)), widg, draw(st.sampled_from([1, 2.5, 4])), 0,
             draw(st.sampled_from([0, 0, 5, 20])), draw(st.sampled_from([0, 0, 10, 15])), 0, 0, 0, 0,
             draw(st.sampled_from([0, 0.1, 0.3])), fal2, draw(st.sampled_from([0, 0.7, 1.5, 5])),
             draw(st.sampled_from([0, 0.4])), vari, draw(st.sampled_from([0, 0.5, 2]))]
     call = "CYCLE93(" + ", ".join(f"{a:g}" for a in args) + ")"
-    agree_groove(tmp_path_factory.mktemp("g"), call, tw, "G0 X2 Z30" if inside else "G0 X50 Z30")
+    agree_groove(tmp_path_factory.mktemp("g"), call, tw, f"G0 X{(2 if inside else 50) * (2 if diamon else 1)} Z30",
+                 diamon)
+
+
+def test_save_restores_diamon_and_p_gg_29_reads_it(tmp_path):
+    # found by the DIAMON runs: a PROC with SAVE that turns DIAMOF left the caller in DIAMOF (the
+    # diameter state was not among what SAVE restores), so every X after a cycle's own code was
+    # read as a radius, twice the intended size. Seed L4386: SAVE restores the modal G functions;
+    # DIAMON/DIAMOF are G group 29 (L24279-24281), whose index $P_GG[29] reads 2 under DIAMON.
+    # X40 (diameter) = radius 20; inside: R2 = 2, DIAMOF, X5 = radius 5; back: X22 = radius 11
+    (tmp_path / "SUBD.SPF").write_text("PROC SUBD(REAL AA) SAVE\nR2=$P_GG[29]\nDIAMOF\nG0 X=AA\nRET\n")
+    path = tmp_path / "MAIN.MPF"
+    path.write_text("G18 G90 DIAMON G0 X40 Z0\nSUBD(5)\nG0 X=R2*10+2\nM30\n")
+    ld = pipeline.load(str(path), "sinumerik")
+    xs = [r.end["X"] for r in pipeline.toolpath_of(ld) if r.kind == "rapid"]
+    assert [d for d in ld.diagnostics if d.severity != "info"] == [] and xs == [20.0, 5.0, 11.0]

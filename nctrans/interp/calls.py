@@ -22,8 +22,10 @@ SHARED_SCOPE_CALLS = frozenset(("m98", "m97", "shared"))   # m97: Haas local sub
 # Modal groups a SAVE subprogram does not restore: not G codes (spindle, coolant, tool length),
 # or state whose restoring mid-path would need its own approach (cutter compensation, cycles).
 NOT_SAVED_GROUPS = frozenset(("spindle", "coolant", "tool_length", "cutter_comp", "cycle"))
+# the state a SAVE subprogram's return restores besides the groups themselves: every attribute the
+# saved G groups set (group 29 DIAMON/DIAMOF too, seed L4386 "the modal G functions", L24279-24281)
 SAVED_ATTRS = ("motion", "plane", "incremental", "arc_absolute", "scale", "feed_scale", "feed_mode",
-               "work_offset", "cycle_retract", "polar")
+               "work_offset", "cycle_retract", "polar", "diameter")
 
 
 class CallsMixin:
