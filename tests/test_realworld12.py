@@ -169,3 +169,22 @@ def test_feed_move_without_f_in_a_subprogram_file_is_the_callers_feed():
     # the same move in a main program is the program's own error
     main = [d for d in nctrans.lint("G2 X80 Y0 CR=80\nM30\n", "sinumerik") if d.rule == "NC202"]
     assert [(d.line, d.severity) for d in main] == [(1, "error")]
+
+
+# ------------------------------------------------------------- NC237: an ISO system number write
+
+def test_write_to_an_unmodelled_iso_system_number_is_said():
+    # #12029: a Haas NGC output (Renishaw's air blast), a Fanuc's tool memory: nothing models it;
+    # the two writes at lines 2 and 3 were silent, the program linted clean
+    src = "G0 X0\n#12029=1\n#12029=0\nM30\n"
+    diags = nctrans.lint(src, "iso-m")
+    assert _codes(diags, "NC237") == [2, 3]
+    assert all(d.severity == "warning" for d in diags if d.rule == "NC237")
+
+
+def test_common_variables_and_haas_macro_variables_are_not_system_writes():
+    # #100/#500 are common variables; under a HAAS header #10110 is one too (profile haas)
+    assert _codes(nctrans.lint("#100=1\n#500=2\nG0 X#100\nM30\n", "iso-m"), "NC237") == []
+    haas = "%\nO1 (HAAS VF2)\n#10110=-.125\nG1 Z#10110 F10.\nM30\n%\n"
+    assert _codes(nctrans.lint(haas, "iso-m"), "NC237") == []
+    assert [r.end["Z"] for r in nctrans.toolpath(haas, "iso-m") if r.kind == "linear"] == [-0.125]

@@ -357,6 +357,12 @@ class Evaluator:
         self.on_unmodelled_read: Optional[Callable[[str], None]] = None
         # number ranges (first, last) a write refuses / a write leaves unknown (sysvars registers)
         self.read_only_numbers: tuple[tuple[int, int], ...] = ()
+        # numbered variables from this number on are the control's system variables (ISO #1000..):
+        # a write nothing models is said (NC237) unless the number is a plain common variable of
+        # the program's control (a profile's common_variables, Haas #10000-#10999) or one the
+        # rules table maps (common_numbers); None: none
+        self.system_numbers_from: Optional[int] = None
+        self.common_numbers: tuple[tuple[int, int], ...] = ()
         self.running_numbers: tuple[tuple[int, int], ...] = ()
         self.unknown_used = False     # set when UNKNOWN was read; the interpreter reports it
 
@@ -766,6 +772,13 @@ class Evaluator:
             self.num_globals.pop(k, None)       # a timer: set, it runs on; reads stay unknown
         else:
             self.num_globals[k] = value
+            if self.system_numbers_from is not None and k >= self.system_numbers_from and \
+                    not any(a <= k <= b for a, b in self.common_numbers):
+                # kept for later reads; what the control does with it (an output, an offset of
+                # the tool memory, a setting) is not modelled
+                raise EvalError("NC237", f"write to system variable #{k} is not modelled: what it "
+                                "changes on the control (an output, an offset, a setting) is not in "
+                                "the analysed toolpath", "warning")
 
     def _lookup_name(self, name: str):
         if name in self.scope.names:

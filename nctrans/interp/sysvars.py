@@ -40,6 +40,17 @@ def register(interp, dialect: str) -> None:
     interp.ev.write_policy = write_policy(dialect)
     interp.ev.read_only_numbers = _ranges(dialect, "read_only_numbers")
     interp.ev.running_numbers = _ranges(dialect, "running_numbers")
+    from nctrans.rules import option
+    first = option(dialect, "system_numbers_from", None)
+    interp.ev.system_numbers_from = int(first) if first is not None else None
+    meta = getattr(getattr(interp, "program", None), "meta", None) or {}
+    chosen = (option(dialect, "profiles", {}) or {}).get(meta.get("profile") or "", {})
+    # a profile's common variables, and the numbers the table maps (a parts counter #3901 is the
+    # program's to set): a write to them is no unmodelled system write
+    listed = [(int(e["first"]), int(e.get("last", e["first"]))) for e in entries(dialect)
+              if isinstance(e, dict) and "first" in e]
+    interp.ev.common_numbers = tuple((int(a), int(b)) for a, b in chosen.get("common_variables", ())) \
+        + tuple(listed)
     _register_indexed(interp, dialect)
     setters = interp.ev.system_setters
     # (kind, offset number) -> wear written; shared with G10 L11/L13 (offsets._h_data)
