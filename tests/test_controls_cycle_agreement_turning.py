@@ -1,5 +1,5 @@
 """Sinumerik turning cycles CYCLE97/CYCLE98 (threads), CYCLE94/CYCLE96 (undercuts) and CYCLE93
-(grooving, sharp-cornered grooves): the built-in models (nctrans.interp.milling_cycles, .undercuts,
+(grooving, sharp base corners): the built-in models (nctrans.interp.milling_cycles, .undercuts,
 .grooving) against cycle code run by nctrans (issue 8, "Done when"), move for move, with each thread
 cut's lead (pitch) and start angle (SF), arcs with their centre and direction, over hand-picked and
 generated parameter sets. Written for DIAMOF (X a radius); the PROCs do not read
@@ -228,7 +228,8 @@ def test_cycle98_model_agrees_over_parameter_sets(tmp_path_factory, data):
 
 
 # -------------------------------------------------------------------------------------------------
-# CYCLE93 grooving, sharp-cornered grooves (RCO/RCI 0) in a straight contour: the tool's width comes
+# CYCLE93 grooving in a straight contour, outer corners RCO rounded or chamfered by the PROC's own
+# RND/CHF/CHR blocks (the interpreter's corner elements), base corners RCI 0: the tool's width comes
 # from the machine model (a tool's `width`) for the built-in model, from R90 for the PROC (the
 # control's cycle reads it from the two edges' offsets, which nctrans' machine model does not hold)
 
@@ -242,7 +243,7 @@ def agree_groove(tmp_path: Path, call: str, width: float, position: str = "G0 X4
         d = tmp_path / how
         d.mkdir(exist_ok=True)
         if how == "code":
-            for f in ("CYCLE93", "CYCGRF"):
+            for f in ("CYCLE93", "CYCGRF", "CYCGRC", "CYCGRE"):
                 (d / f"{f}.SPF").write_text((PROCS / f"{f}.SPF").read_text())
         path = d / "MAIN.MPF"
         path.write_text(text)
@@ -263,7 +264,7 @@ def agree_groove(tmp_path: Path, call: str, width: float, position: str = "G0 X4
     (want, bad_builtin), (got, bad_code) = runs
     assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
     first = next((i for i, (g, w) in enumerate(zip(got, want)) if not _close(g, w)), None)
-    assert first is None and len(got) == len(want), (first, got[first or 0:][:3], want[first or 0:][:3])
+    assert first is None and len(got) == len(want), (call, first, got[first or 0:][:3], want[first or 0:][:3])
     return want
 
 
@@ -271,6 +272,8 @@ GROOVES = {
     "outside-left": ("CYCLE93(20, -10, 8, 4, 0, 0, 0, 0, 0, 0, 0, 0.2, 0.3, 1.5, 0.5, 1)", 3),
     "face-right-flanks": ("CYCLE93(30, 0, 6, 3, 0, 10, 20, 0, 0, 0, 0, 0.1, 0.2, 1, 0, 6, 0.5)", 2.5),
     "inside-right-one-infeed": ("CYCLE93(10, -20, 10, 2, 0, 5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 7)", 4),
+    "outside-rounded-and-chamfered": ("CYCLE93(20, -10, 8, 4, 0, 15, 0, 0.5, -0.4, 0, 0, 0.2, 0.3, 1.5, 0, 5)", 3),
+    "face-chamfer-legs": ("CYCLE93(30, 0, 6, 3, 0, 0, 10, -0.3, 0.6, 0, 0, 0.1, 0.2, 1, 0, 12)", 2.5),
 }
 
 
@@ -298,8 +301,10 @@ def test_cycle93_model_agrees_over_parameter_sets(tmp_path_factory, data):
     if tw > widg - 2 * fal2 / math.cos(math.radians(20)):
         fal2 = 0
     diamon = draw(st.booleans())            # SPD a diameter under DIAMON: the same radius 15 or 25
-    args = [draw(st.sampled_from([15, 25])) * (2 if diamon else 1), draw(st.integers(-20, 5)), widg, draw(st.sampled_from([1, 2.5, 4])), 0,
-            draw(st.sampled_from([0, 0, 5, 20])), draw(st.sampled_from([0, 0, 10, 15])), 0, 0, 0, 0,
+    args = [draw(st.sampled_from([15, 25])) * (2 if diamon else 1), draw(st.integers(-20, 5)), widg,
+            draw(st.sampled_from([1, 2.5, 4])), 0, draw(st.sampled_from([0, 0, 5, 20])),
+            draw(st.sampled_from([0, 0, 10, 15])), draw(st.sampled_from([0, 0.3, -0.2])),
+            draw(st.sampled_from([0, 0.5, -0.4])), 0, 0,
             draw(st.sampled_from([0, 0.1, 0.3])), fal2, draw(st.sampled_from([0, 0.7, 1.5, 5])),
             draw(st.sampled_from([0, 0.4])), vari, draw(st.sampled_from([0, 0.5, 2]))]
     call = "CYCLE93(" + ", ".join(f"{a:g}" for a in args) + ")"
