@@ -494,3 +494,20 @@ def test_cycle84_turns_the_spindle_the_threads_way_by_hand(tmp_path):
     assert [(m[0], m[1]["Z"], m[2]) if m[0] in ("rapid", "linear") else m for m in second][1:] == [
         ("rapid", 1.0, None), ("spindle", "cw"), ("linear", -6.0, 1000.0), ("spindle", "ccw"),
         ("linear", 1.0, 1000.0), ("rapid", 5.0, None)]
+
+
+def test_parameters_the_models_do_not_read_are_said_at_the_line(tmp_path):
+    # CYCLE84 _VARI 1 (tapping in strokes of _DAM 3 with chip breaking [GK]) and CYCLE83 _MDEP 2 are
+    # not in the models: NC239 once per call statement (the MCALL's holes are one call); _VARI 0
+    # and _MDEP left out are quiet. With the cycle's PROC beside the program nothing is said
+    path = tmp_path / "MAIN.MPF"
+    path.write_text(START + "MCALL CYCLE84(10, 0, 2, -15, , , 3, , 1.25, 0, 1000, , , , , 1, 3, 1)\nX10\nX20\n"
+                    "MCALL\nCYCLE84(10, 0, 2, -15, , , 3, , 1.25, 0, 1000, , , , , 0)\n"
+                    "CYCLE83(10, 0, 2, -30, , -10, , 4, , , 1, 0, , 2)\nCYCLE83(10, 0, 2, -30, , -10, , 4)\nM30\n")
+    ld = pipeline.load(str(path), "sinumerik")
+    list(pipeline.toolpath_of(ld))
+    assert [(d.line, d.severity) for d in ld.diagnostics if d.rule == "NC239"] == [(2, "warning"), (7, "warning")]
+    (tmp_path / "CYCLE84.SPF").write_text(CYCLE84)
+    ld = pipeline.load(str(path), "sinumerik")
+    list(pipeline.toolpath_of(ld))
+    assert [d.line for d in ld.diagnostics if d.rule == "NC239"] == [7]

@@ -149,6 +149,7 @@ class CycleCallsMixin:
             return self._cycle_code(s)
         self._omitted_retract_plane(s)
         self._omitted_from_state(s)
+        self._unmodelled_params(s)
         if s.kind in ("holes_line", "holes_circle", "holes_grid"):
             return self._hole_pattern(s)
         if s.kind == "swivel_plane":
@@ -199,6 +200,19 @@ class CycleCallsMixin:
                       f"omitted or 0: the control's cycle sees 0 (seed L4722) and stops or uses a default "
                       f"of its own; the analysis takes {'; '.join(taken)}. The path is the same, its feed, "
                       "time or spindle may not be the machine's; give the value")
+
+    def _unmodelled_params(self, s: n.CycleCall) -> None:
+        """A parameter the built-in model does not read, given a value at which the control's
+        cycle moves otherwise (rules/cycles.toml [unmodelled_param]): said at the line (NC239),
+        once per call statement; the path is the model's without it."""
+        table = cycle_table()
+        for name, entry in table.unmodelled_param.get((s.name or "").upper(), {}).items():
+            e = s.params.get(table.neutral(name))
+            v = None if e is None else self._value(self.ev.compile(e), f"{s.name} {name}")
+            if v is not None and entry.get("when") == "nonzero" and v != 0:
+                self.diag("NC239", "warning", f"{s.name.upper()} with {name} {v:g}: {entry['meaning']} is not "
+                          f"modelled [GK]; the analysed path is {entry['modelled']}, which the control's "
+                          "cycle does not run. Give its PROC beside the program to run it")
 
     def _cycle_code(self, s: n.CycleCall):
         """A cycle whose own code is in the program or beside it (CYCLE81.SPF on the search
