@@ -40,10 +40,15 @@ CYCLE83 = """PROC CYCLE83(REAL RTP, REAL RFP, REAL SDIS, REAL DP, REAL DPR, REAL
 ; deep-hole drilling downwards: first depth FDEP (absolute) or FDPR (relative), strokes less DAM
 ; down to DAM; VARI=1 back to RFP+SDIS and down again to the anticipation distance above the last
 ; depth, VARI=0 back by _VRT (1 mm)
-DEF REAL _ZSD, _Z, _STROKE, _LAST, _F, _ANT, _BACK, _TOT, _FAC, _D
+DEF REAL _ZSD, _Z, _STROKE, _LAST, _F, _ANT, _BACK, _TOT, _FAC, _D, _MM
 DEF INT _I
 DEF AXIS _AX
 _AX=$P_AXN3
+; the cycle's own distances are in mm: 1 mm in program units (G70/G700, $P_GG[13] 1 or 3: inch)
+_MM=1
+IF ($P_GG[13]==1) OR ($P_GG[13]==3)
+  _MM=1/25.4
+ENDIF
 _F=$P_F
 _ZSD=DP
 IF DPR<>0
@@ -62,11 +67,11 @@ IF _STROKE<=0
     _STROKE=_TOT
   ENDIF
 ENDIF
-_ANT=0.6
-IF _TOT>30
-  _ANT=MINVAL(_TOT/50, 7)
+_ANT=0.6*_MM
+IF _TOT>30*_MM
+  _ANT=MINVAL(_TOT/50, 7*_MM)
 ENDIF
-_BACK=1
+_BACK=_MM
 IF _VRT<>0
   _BACK=ABS(_VRT)
 ENDIF
@@ -227,6 +232,9 @@ IF _LEAD==0
       _LEAD=_MP[_I]
     ENDIF
   ENDFOR
+  IF ($P_GG[13]==1) OR ($P_GG[13]==3)
+    _LEAD=_LEAD/25.4             ; a metric thread's pitch is mm: K in inch
+  ENDIF
 ENDIF
 G0 Z=_ZAP
 G33 Z=_ZSD K=_LEAD
@@ -319,9 +327,12 @@ def records(where: Path, text: str):
     return out, bad
 
 
+@pytest.mark.parametrize("units", ["", "G70", "G700"])
 @pytest.mark.parametrize("name", sorted(PROGRAMS))
-def test_builtin_models_agree_with_cycle_code(tmp_path, name):
+def test_builtin_models_agree_with_cycle_code(tmp_path, name, units):
+    # G70: lengths in inch, feeds mm/min; G700: feeds inch/min too
     text, cycle, pattern = PROGRAMS[name]
+    text = text.replace("G17 G90", f"G17 G90 {units}") if units else text
     runs = {}
     for how, files in (("builtin", ()), ("cycle", (cycle,)), ("cycle+pattern", (cycle, pattern))):
         d = tmp_path / how
@@ -511,3 +522,14 @@ def test_parameters_the_models_do_not_read_are_said_at_the_line(tmp_path):
     ld = pipeline.load(str(path), "sinumerik")
     list(pipeline.toolpath_of(ld))
     assert [d.line for d in ld.diagnostics if d.rule == "NC239"] == [7]
+
+
+@pytest.mark.parametrize("units", ["G70", "G700"])
+def test_cycle84_feed_in_inch_by_hand(tmp_path, units):
+    # found running the programs in inch: under G70 (lengths inch, feeds mm/min) the model divided
+    # lead x S by 25.4 as if feeds were inch too. PIT 0.05 inch = 1.27 mm; SST 400: in at
+    # 1.27 x 400 = 508 mm/min, SST1 200: out at 254 mm/min, in both unit modes
+    got, bad = records(tmp_path, f"G17 G90 {units} G0 X0 Y0 Z2 F100 S1000 M3\n"
+                                 "CYCLE84(1, 0, 0.1, -0.6, , , 3, , 0.05, 0, 400, 200)\nM30\n")
+    assert bad == [] and [(m[1]["Z"], m[2], m[3]) for m in got if m[0] == "linear"] == [
+        (-15.24, 508.0, 1.27), (2.54, 254.0, 1.27)]

@@ -351,7 +351,9 @@ class CycleCallsMixin:
             self.diag("NC206", "error", f"{s.name or 'tapping cycle'} with no spindle speed")
             return kind, None
         p["pitch"] = lead
-        p["feed"] = lead * st.spindle_speed / st.scale
+        # lead (mm) x S in mm/min, in the program's feed unit as _expand reads p["feed"]: under G70
+        # lengths are inch but feeds stay mm/min (feed_scale 1), so it is not lead / scale
+        p["feed"] = lead * st.spindle_speed / st.feed_scale
         after = {3: "cw", 4: "ccw", 5: "off"}.get(int(p.get("sdac", 0) or 0))
         before = None
         speeds = None
@@ -376,8 +378,8 @@ class CycleCallsMixin:
         if tap == now and back == now:
             return None
 
-        def feed(speed: float) -> float:      # as p["feed"] and _expand scale it
-            return lead * speed / st.scale * st.feed_scale
+        def feed(speed: float) -> float:      # a ("feed", F) step is mm/min as it stands: lead (mm) x S
+            return lead * speed
         return ((None, None) if tap == now else (tap, feed(tap))), (back, feed(back)), now
 
     def _deep_hole(self, p: dict, approach: float, bottom: float, retract: float):
