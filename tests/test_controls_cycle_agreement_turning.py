@@ -28,8 +28,14 @@ START_DIAMON = "G18 G90 DIAMON T1 D1\nS500 M3\nG0 X{x2} Z10\n"
 AFTER = "G0 X40 Z30\n"
 
 
-def start(x: float, diamon: bool) -> str:
-    return START_DIAMON.format(x2=2 * x) if diamon else START.format(x=x)
+def start(x: float, diamon: bool, units: str = "") -> str:
+    """The program's head; `units` G70 or G700 (inch lengths; the PROCs turn their own mm distances,
+    the 1 mm clearances and the DIN and ISO tables, into inch, as the models read them in mm)."""
+    text = START_DIAMON.format(x2=2 * x) if diamon else START.format(x=x)
+    return text.replace("G18 G90", f"G18 G90 {units}") if units else text
+
+
+MODES = [("", False), ("", True), ("G70", False), ("G700", True)]
 
 
 def records(where: Path, text: str):
@@ -83,11 +89,13 @@ CALLS = {
 }
 
 
-@pytest.mark.parametrize("diamon", [False, True])
+@pytest.mark.parametrize("units, diamon", MODES)
 @pytest.mark.parametrize("name", sorted(CALLS))
-def test_cycle97_model_agrees_with_cycle_code(tmp_path, name, diamon):
-    want = agree(tmp_path, start(30, diamon) + CALLS[name] + "\n" + AFTER + "M30\n")
-    assert want[-1][1] == ((20.0, 30.0) if diamon else (40.0, 30.0))
+def test_cycle97_model_agrees_with_cycle_code(tmp_path, name, units, diamon):
+    want = agree(tmp_path, start(30, diamon, units) + CALLS[name] + "\n" + AFTER + "M30\n")
+    # the move after the call, X40 Z30: a diameter under DIAMON (radius 20), in inch x 25.4
+    inch = 25.4 if units else 1.0
+    assert want[-1][1] == pytest.approx((20.0 * inch if diamon else 40.0 * inch, 30.0 * inch))
     assert sum(m[3] is not None for m in want) >= 1
 
 
@@ -152,12 +160,14 @@ UNDERCUTS = {
 }
 
 
-@pytest.mark.parametrize("diamon", [False, True])
+@pytest.mark.parametrize("units, diamon", MODES)
 @pytest.mark.parametrize("name", sorted(UNDERCUTS))
-def test_undercut_models_agree_with_cycle_code(tmp_path, name, diamon):
+def test_undercut_models_agree_with_cycle_code(tmp_path, name, units, diamon):
     call, cycle = UNDERCUTS[name]
-    head = "G18 G90 DIAMON T1 D1\nS500 M3 F0.2 G95\nG0 X80 Z80\n" if diamon else \
-        "G18 G90 T1 D1\nS500 M3 F0.2 G95\nG0 X40 Z80\n"
+    if units and cycle == "CYCLE96":
+        pytest.skip("DIATH in inch names no metric thread exactly (M20 is 0.7874.. inch)")
+    head = f"G18 G90 {units} DIAMON T1 D1\nS500 M3 F0.2 G95\nG0 X80 Z80\n" if diamon else \
+        f"G18 G90 {units} T1 D1\nS500 M3 F0.2 G95\nG0 X40 Z80\n"
     want = agree_undercut(tmp_path, head + call + "\n" + AFTER + "M30\n", cycle)
     assert sum(m[0] == "linear" for m in want) >= 4 and sum(m[0] == "arc" for m in want) == 1
 
@@ -201,9 +211,10 @@ CHAINS = {
 }
 
 
+@pytest.mark.parametrize("units, diamon", MODES)
 @pytest.mark.parametrize("name", sorted(CHAINS))
-def test_cycle98_model_agrees_with_cycle_code(tmp_path, name):
-    want = agree_chain(tmp_path, start(30, True) + CHAINS[name] + "\n" + AFTER + "M30\n")
+def test_cycle98_model_agrees_with_cycle_code(tmp_path, name, units, diamon):
+    want = agree_chain(tmp_path, start(30, diamon, units) + CHAINS[name] + "\n" + AFTER + "M30\n")
     assert sum(m[3] is not None for m in want) >= 3        # thread cuts carrying their lead
 
 
@@ -233,11 +244,12 @@ def test_cycle98_model_agrees_over_parameter_sets(tmp_path_factory, data):
 # from the machine model (a tool's `width`) for the built-in model, from R90 for the PROC (the
 # control's cycle reads it from the two edges' offsets, which nctrans' machine model does not hold)
 
-def agree_groove(tmp_path: Path, call: str, width: float, position: str = "G0 X40 Z20", diamon: bool = False):
+def agree_groove(tmp_path: Path, call: str, width: float, position: str = "G0 X40 Z20", diamon: bool = False,
+                 units: str = ""):
     from nctrans.machine import Machine, Tool
     machine = Machine(name="t", tools=[Tool(number=1, width=width)])
-    text = (f"R90={width:g}\nG18 G90 {'DIAMON ' if diamon else ''}T1 D1\nS500 M3 F0.1 G95\n{position}\n{call}\n"
-            + AFTER + "M30\n")
+    text = (f"R90={width:g}\nG18 G90 {units} {'DIAMON ' if diamon else ''}T1 D1\nS500 M3 F0.1 G95\n{position}\n"
+            f"{call}\n" + AFTER + "M30\n")
     runs = []
     for how in ("builtin", "code"):
         d = tmp_path / how
@@ -277,15 +289,15 @@ GROOVES = {
 }
 
 
-@pytest.mark.parametrize("diamon", [False, True])
+@pytest.mark.parametrize("units, diamon", MODES)
 @pytest.mark.parametrize("name", sorted(GROOVES))
-def test_cycle93_model_agrees_with_cycle_code(tmp_path, name, diamon):
+def test_cycle93_model_agrees_with_cycle_code(tmp_path, name, units, diamon):
     call, width = GROOVES[name]
     if diamon:                     # SPD is a diameter under DIAMON: the same groove
         head, spd, rest = call.partition("(")[0], call.split("(")[1].split(",")[0], call.split(",", 1)[1]
         call = f"{head}({2 * float(spd):g},{rest}"
     x = 5 if "inside" in name else 40
-    want = agree_groove(tmp_path, call, width, f"G0 X{2 * x if diamon else x} Z20", diamon)
+    want = agree_groove(tmp_path, call, width, f"G0 X{2 * x if diamon else x} Z20", diamon, units)
     assert sum(m[0] == "linear" for m in want) >= 4
 
 
