@@ -188,3 +188,12 @@ def test_common_variables_and_haas_macro_variables_are_not_system_writes():
     haas = "%\nO1 (HAAS VF2)\n#10110=-.125\nG1 Z#10110 F10.\nM30\n%\n"
     assert _codes(nctrans.lint(haas, "iso-m"), "NC237") == []
     assert [r.end["Z"] for r in nctrans.toolpath(haas, "iso-m") if r.kind == "linear"] == [-0.125]
+
+
+def test_fagor_conversion_of_a_subprogram_file_keeps_its_callers_motion_mode():
+    # the .SPF's first move runs in its caller's mode: no G00 invented (it made `Z10 F600` a rapid)
+    spf = "%_N_LIFT_SPF\nZ10 F600\nM17\n"
+    conv = nctrans.transpile(spf, read="sinumerik", write="fagor")
+    assert _lines(conv) == ["%LIFT", "Z10 F600", "M30"]          # was `G00 Z10 F600`
+    result = nctrans.equiv(spf, conv.text, read_a="sinumerik", read_b="fagor")
+    assert result, result.difference

@@ -214,8 +214,9 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.targets: set = set()
         self.motion = "rapid"
         # the mode a main program's first move runs in: the source control's power-on motion mode
-        # (Sinumerik G1: `X10 F100` is a feed move; set by prologue), else Fagor's own, G00
-        self.first_motion = "rapid"
+        # (Sinumerik G1: `X10 F100` is a feed move; set by prologue), else Fagor's own, G00; None:
+        # a subprogram file's, whose first move runs in its caller's mode (nothing written)
+        self.first_motion: Optional[str] = "rapid"
         self.plane = "XY"
         self.pending_motion: Optional[str] = None     # arc_3point / arc_tangent: one-shot G09/G08
         self.radius_index: Any = None
@@ -332,8 +333,12 @@ class FagorEmitter(FagorSpelling, Emitter):
             self.out.append(" ".join(words))
         from nctrans.convert import subprogram_file
         motion = source.get("motion")
-        if motion and not (p.meta or {}).get("flattened_from") and not subprogram_file(p):
-            self.first_motion = motion      # a subprogram file's first move runs in its caller's
+        if (p.meta or {}).get("flattened_from"):
+            pass
+        elif subprogram_file(p):
+            self.first_motion = None        # a subprogram file's first move runs in its caller's
+        elif motion:
+            self.first_motion = motion
 
     def _reset(self) -> None:
         self.motion = None
@@ -826,7 +831,9 @@ class FagorEmitter(FagorSpelling, Emitter):
             word("G", self.code_for("arc_once", "tangent"))
         elif s.via:
             raise NotExpressible("an intermediate point outside a three-point arc")
-        if self.motion is None:
+        if self.motion is None and not self.in_sub and self.first_motion is None:
+            self.motion = "caller"          # a subprogram file's first move: its caller's mode, as written
+        elif self.motion is None:
             # the first move of a unit: its mode is the power-on default (the source control's in
             # a main program), written out
             self.motion = "rapid" if self.in_sub else self.first_motion
