@@ -65,8 +65,11 @@ def loaded_tool_radius(it) -> Optional[float]:
 def check_entry(it) -> None:
     """Before the first move of a G41/G42 episode: NC123 and radius 0 where the radius is the
     unknown tool's. `it`: the Interpreter (st, machine, comp_radius, default_edge, diag)."""
+    folding = getattr(it, "hook", None) is not None
+    if folding and it.st.tool is not None:
+        folded_at_zero(it)
     if not it.offsets_of_tool:
-        if getattr(it, "hook", None) is not None and it.st.tool is None:
+        if folding and it.st.tool is None:
             register_unknown(it)
         return
     if it.st.tool is not None:
@@ -111,3 +114,41 @@ def register_unknown(it) -> None:
             f"entry {d}, no tool {d}): plain motion would fold a radius of 0 into the coordinates, "
             "and the control's register holds whatever radius was set there. Give the register in "
             "the machine file (--machine)", it.comp_on_span)
+
+
+def radius_given(it, d: int) -> bool:
+    """Whether the machine model (its file, or a write of the program: G10, $TC_DP6) holds a
+    radius for offset number `d` of the active tool, as radius_of / ToolEdges read it."""
+    m = it.machine
+    if d in getattr(m, "radius_offsets", {}):
+        return True
+    t = int(it.st.tool or 0)
+    edges = getattr(it, "edges", None)
+    if edges is not None and "radius" in edges.data.get((t, d), {}):
+        return True
+    if (edges is not None or it.offsets_of_tool) and d == 1 and t and m.tool(t) is not None:
+        return True
+    return m.tool(int(d)) is not None
+
+
+def folded_at_zero(it) -> None:
+    """NC409 in a run written as plain motion (a lowering, --flatten) with the tool known: the
+    register or edge in force gives no radius in the machine model (the built-in machines give
+    none), so the tool-centre path written is the programmed contour, right only for a tool of
+    radius 0. Said once per offset number per run, at the first G41/G42 that uses it; the
+    conversion goes ahead (corpus lathe programs under G42 convert without --machine)."""
+    d = it.st.radius_index if it.st.radius_index is not None else it.default_edge
+    if not d or radius_given(it, int(d)):
+        return
+    seen = it.__dict__.setdefault("_folded_at_zero", set())
+    if d in seen:
+        return
+    seen.add(d)
+    code = "G41" if it.st.comp_side == "left" else "G42"
+    which = f"edge D{d} of tool {it.st.tool}" if (getattr(it, "edges", None) is not None
+                                                   or it.offsets_of_tool) else f"offset register {d}"
+    it.diag("NC409", "warning",
+            f"{code} with {which}: the machine model gives no radius for it, so the compensation "
+            "was folded into the coordinates with radius 0; the path written is right only for a "
+            "tool of radius 0. Convert with --machine giving the tool's radius (radius_offsets "
+            f"{d}, or its [[tools]] entry) for the real path", it.comp_on_span)
