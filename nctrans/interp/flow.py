@@ -209,11 +209,13 @@ class FlowMixin:
         if s.kind == "restart" and self.stack:
             # M99 at the end of a file's main body that was called as a subprogram: a return
             return ("return", None)
-        if s.kind == "restart" and not self.stack and RESTART_MAIN.get() and self._main is not None:
+        alone = getattr(self, "_macro_alone", False)     # a macro file run alone: M99 returns
+        if s.kind == "restart" and not self.stack and RESTART_MAIN.get() and self._main is not None \
+                and not alone:
             return ("restart",)
         self._comp_flush()
         self._record("stop", stop_kind="end")
-        if s.kind == "restart" and not self.stack:
+        if s.kind == "restart" and not self.stack and not alone:
             self.diag("NC205", "warning", f"analysis truncated at line {self.span.line}: the "
                       "program restarts (return in a main program); one pass analysed")
         raise _Stop
@@ -260,6 +262,8 @@ class FlowMixin:
                 body = []
             main = self.unit_for(id(prog), prog.name or "main", body, prog.file, [])
         self._main = main if stream is None else None      # a streamed body cannot restart
+        from nctrans.interp.macro_alone import note_if_alone
+        self._macro_alone = stream is None and note_if_alone(self)
         unit, code = main, main.code
         pc = sidx = 0
         steps = 0
