@@ -116,6 +116,8 @@ class CycleCallsMixin:
                 if k in ("rapid", "linear"):
                     pt = dict(self.pos)
                     pt.update(s[1])
+                    if k == "linear" and self.spindle_stopped and not self.spindle_reported:
+                        self._cycle_cuts_standing(kind)
                     mark = len(self.out)
                     self._move(k, pt)
                     if pitch is not None and k == "linear":
@@ -129,7 +131,10 @@ class CycleCallsMixin:
                     st.set("spindle", s[1])
                     if len(s) > 2:
                         st.spindle_speed = s[2]
-                    self.spindle_stopped = s[1] in ("off", "orient")
+                    stops = s[1] in ("off", "orient")
+                    if stops and not self.spindle_stopped:
+                        self.spindle_reported = False   # a fresh stop by the cycle (SDAC 5): NC209 again
+                    self.spindle_stopped = stops
                     self._record("spindle", spindle_dir=s[1], spindle=st.spindle_speed)
                 elif k == "stop":
                     self._record("stop", stop_kind="stop")
@@ -141,6 +146,24 @@ class CycleCallsMixin:
             pos[ax] = max(retract, approach) if approach >= bottom else min(retract, approach)
             self.pos = pos
             self.mpos = self._to_machine(pos)
+
+    def _cycle_cuts_standing(self, kind: str) -> None:
+        """NC209 at the cycle's line (the call, or the MCALL/modal position that runs it): a cycle
+        model's feed move would cut with the spindle the program (M5, a tool change that stops
+        it) or an earlier hole's cycle (CYCLE840 SDAC 5) left standing. The cycle moves bypass
+        the feed-move check (motion._need_feed); a cycle that turns the spindle itself first
+        (CYCLE84: G331, rigid_tap) never gets here. Once until the spindle is programmed again,
+        by the program or by a cycle (CYCLE840 turns it back at the depth and SDAC 5 stops it anew)."""
+        self.spindle_reported = True
+        if kind in ("tap", "tap_left"):
+            self.diag("NC209", "warning", "tapping with the spindle stopped (M5, a tool change "
+                      "that stops it, or an earlier hole's SDAC 5 under MCALL): this tapping cycle "
+                      "feeds the tap in without turning the spindle first, so the tap breaks; start "
+                      "the spindle (M3/M4) before the cycle, or end the earlier tap with SDAC 3/4")
+        else:
+            self.diag("NC209", "warning", "cycle feed move while the spindle is stopped (M5, or a "
+                      "tool change that stops it): the tool would rub or break; start the spindle "
+                      "(M3/M4) before the cycle")
 
     def _h_cycle_call(self, s: n.CycleCall):
         if s.kind in TURNING_KINDS:
