@@ -750,6 +750,19 @@ def _called_alike(sub: tuple[Any, Optional[str]], other: tuple[Any, Optional[str
         m_other["defaults"] = {**theirs, **{k: mine[k] for k in _CALLERS_MODES if k in mine}}
 
 
+def _endless_budget(*opened: tuple[Any, Optional[str]]) -> Optional[int]:
+    """The smaller step budget of limits.MAX_ENDLESS_STEPS where a side's main program ends by
+    starting again (M99): that side never ends, and neither does a side equivalent to it, so
+    each would run to MAX_STEPS (minutes) to compare what the first thousand passes show."""
+    from nctrans.lower.restart_loop import restart_block
+    for o in opened:
+        program = o[0] if isinstance(o[0], Program) else getattr(o[0], "program", None)
+        if program is not None and restart_block(program.body) is not None:
+            return min(limits.setting("MAX_STEPS", limits.MAX_STEPS),
+                       limits.setting("MAX_ENDLESS_STEPS", limits.MAX_ENDLESS_STEPS))
+    return None
+
+
 def _budget_spent(diags: list[Diagnostic]) -> bool:
     """The run was cut by the step budget (NC205 as an error: an endless loop)."""
     return any(d.rule == "NC205" and d.severity == "error" and "step budget" in d.message for d in diags)
@@ -782,6 +795,7 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
     if called:
         _called_alike(called[0], ob if called[0] is oa else oa)
     restarts = RESTART_MAIN.set(not called)
+    budget = limits.STEP_BUDGET.set(_endless_budget(oa, ob) if not called else None)
     try:
         with _search_path(dirs):
             ta = _run_opened(oa, ma, dirs)
@@ -797,6 +811,7 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
                 tb.close()
     finally:
         RESTART_MAIN.reset(restarts)
+        limits.STEP_BUDGET.reset(budget)
     diags = list(once_each(ta.diagnostics + tb.diagnostics))    # a file both sides read: once
     if diff is not None and diff.at_end and _budget_spent(ta.diagnostics) and _budget_spent(tb.diagnostics):
         # both endless (a LOOP, M99 restarting a main program), both cut by the step budget at

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
+from contextvars import ContextVar
 from typing import Optional
 
 # Largest input read (bytes): 512 MiB holds ~20 M CAM blocks. The text is held in memory once
@@ -39,6 +40,11 @@ MAX_STRING = 200
 # Repeated execution (loop iterations, jumps back, calls) of one run before NC205 stops it;
 # straight-line blocks run the first time are free. NCTRANS_MAX_STEPS overrides it.
 MAX_STEPS = 2_000_000
+# Repeated execution `equiv` follows where a side restarts its main program for ever (ISO M99):
+# both sides are endless, and comparing thousands of passes says what millions would, in seconds
+# (a 39-line Haas program ending in M99 took 4 min 40 s at MAX_STEPS). NCTRANS_MAX_ENDLESS_STEPS
+# overrides it; MAX_STEPS stays the cap when it is lower.
+MAX_ENDLESS_STEPS = 100_000
 # Blocks of plain motion a conversion holds in memory when it is not streamed: one construct the
 # target lacks, lowered on its own (an endless loop around it would otherwise grow until the step
 # budget: gigabytes), or a whole program lowered as the last resort. Beyond it the construct is
@@ -78,9 +84,19 @@ def setting(name: str, default: int) -> int:
     return default if value is None else value
 
 
+# The step budget of the runs started in this context (equiv of endless programs); None: MAX_STEPS.
+STEP_BUDGET: ContextVar[Optional[int]] = ContextVar("STEP_BUDGET", default=None)
+
+
+def step_budget() -> int:
+    """Repeated steps a run may take: the context's budget, else MAX_STEPS (or its setting)."""
+    budget = STEP_BUDGET.get()
+    return setting("MAX_STEPS", MAX_STEPS) if budget is None else budget
+
+
 # The limits the environment may set (NCTRANS_<NAME>).
-SETTINGS = ("MAX_INPUT_BYTES", "MAX_BLOCK_CHARS", "MAX_STEPS", "MAX_LOWERED_BLOCKS", "MAX_UNROLLED",
-            "MAX_PLOTTED_MOVES", "MAX_DIAGNOSTICS")
+SETTINGS = ("MAX_INPUT_BYTES", "MAX_BLOCK_CHARS", "MAX_STEPS", "MAX_ENDLESS_STEPS", "MAX_LOWERED_BLOCKS",
+            "MAX_UNROLLED", "MAX_PLOTTED_MOVES", "MAX_DIAGNOSTICS")
 
 
 

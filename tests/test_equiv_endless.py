@@ -51,3 +51,24 @@ def test_a_call_event_past_the_end_of_the_other_toolpath_is_a_difference_at_its_
     # a call missing in the middle is not at the end
     d = compare([move, call, R(0, "a", 3, "rapid", p, q)], [move, R(0, "b", 3, "rapid", p, q)])
     assert d is not None and not d.at_end
+
+
+def test_an_endless_side_runs_to_the_smaller_endless_budget(monkeypatch):
+    # M99 restarts the ISO main program for ever: equiv stops both sides at MAX_ENDLESS_STEPS, not
+    # at MAX_STEPS (a 39-line Haas program took minutes there); 300 steps < the fixture's 400
+    monkeypatch.setenv("NCTRANS_MAX_ENDLESS_STEPS", "300")
+    same = api.equiv(ISO, LOOP, read_a="iso-m", read_b="sinumerik")
+    assert same and same.endless, same.message
+    assert any("step budget of 300 " in d.message for d in same.diagnostics)
+    assert not any("step budget of 400 " in d.message for d in same.diagnostics)
+
+
+def test_a_finite_loop_keeps_the_full_step_budget(monkeypatch):
+    # no restart on either side: a 350-pass WHILE runs to its end although 350 > the endless budget
+    monkeypatch.setenv("NCTRANS_MAX_STEPS", "5000")    # 350 passes of ~3 steps fit
+    monkeypatch.setenv("NCTRANS_MAX_ENDLESS_STEPS", "50")
+    loop = "G71 G17 G90 G94\nR1=0\nWHILE R1<350\nR1=R1+1\nG1 X=R1 F100\nENDWHILE\nM30\n"
+    same = api.equiv(loop, loop, read_a="sinumerik", read_b="sinumerik")
+    assert same and not same.endless, same.message
+    assert not any(d.rule == "NC205" for d in same.diagnostics)
+    assert same.records[0] > 350                 # every pass ran: X1 .. X350 and the stop

@@ -93,7 +93,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
                  max_steps: Optional[int] = None, flatten_hook=None, preload=(), fast_sink=None):
         if max_steps is None:
             from nctrans import limits
-            max_steps = limits.setting("MAX_STEPS", limits.MAX_STEPS)
+            max_steps = limits.step_budget()
         if machine is None:
             from nctrans.machine import default_mill
             machine = default_mill()
