@@ -57,12 +57,20 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
     ("DEF STRING[200] TXT\nDEF INT I\nTXT=\"AB\"\nFOR I=1 TO 40\nTXT=TXT<<TXT\nENDFOR\nG0 X1\nM30\n", 5),
     # an undeclared growth: concatenation into an R parameter-free string expression in a loop
     ("DEF STRING[10] TXT\nDEF INT I\nFOR I=1 TO 10000\nTXT=TXT<<\"ABCDEFGHIJ\"\nENDFOR\nM30\n", 4),
-    ("DEF STRING[5] TXT\nTXT=\"ABCDEFGH\"\nM30\n", 2),
 ])
 def test_string_growth_is_capped_with_nc109(tmp_path, program, line):
     f = write(tmp_path, "s.mpf", program)
     rc, out, _ = run("lint", f.name, cwd=tmp_path)
     assert rc == 1 and located(out, "NC109", "s.mpf", line)
+
+
+def test_a_literal_too_long_is_said_once(tmp_path):
+    """A literal too long for its STRING[5]: NC110 at its line, and not also the run's NC109 for
+    the same assignment (it was both)."""
+    f = write(tmp_path, "s.mpf", "DEF STRING[5] TXT\nTXT=\"ABCDEFGH\"\nM30\n")
+    rc, out, _ = run("lint", f.name, cwd=tmp_path)
+    assert rc == 1 and located(out, "NC110", "s.mpf", 2)
+    assert "NC109" not in out and out.count("s.mpf:2:") == 1 and "cut to 5 characters" in out
 
 
 def test_declared_length_cuts_the_string(tmp_path):

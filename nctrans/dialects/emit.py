@@ -322,6 +322,23 @@ class Emitter(Spelling):
         text = f"lowered for {self.lowered_for}: {what}" if self.lowered_for else what
         self.diags.append(at_span("NC401", "info", text, self._where()))
 
+    def lowered_once_per_program(self, what: str) -> None:
+        """NC401 once per distinct `what` in the program, at its first line; the later lines are
+        counted in that note ("(and 2999 more lines)"): a lowering at every tool change of a
+        3000-change program was 3000 notes saying one thing."""
+        folded = self.__dict__.setdefault("_folded_notes", {})
+        line = self._where().line
+        seen = folded.get(what)
+        if seen is None:
+            text = f"lowered for {self.lowered_for}: {what}" if self.lowered_for else what
+            d = at_span("NC401", "info", text, self._where())
+            folded[what] = [d, text, line, 0]
+            self.diags.append(d)
+        elif line != seen[2]:
+            seen[2] = line
+            seen[3] += 1
+            seen[0].message = f"{seen[1]} (and {seen[3]} more line{'s' if seen[3] > 1 else ''})"
+
     def foreign_function_comment(self, s: n.Passthrough) -> str:
         """NC413: a function of the source control with no effect on the path and no counterpart
         here (ISO POPEN/DPRNT, Haas G103): the text of the comment that stands in its place, never

@@ -255,8 +255,8 @@ class FagorEmitter(FagorSpelling, Emitter):
         self.comp_on = False
 
     def lowered(self, what: str, once: Any = None) -> None:
-        """Each lowering once per source line."""
-        super().lowered(what, once=(what, self.span.line if self.span else 0))
+        """Each lowering once per program, at its first line, the later lines counted."""
+        self.lowered_once_per_program(what)
 
     # ---------------------------------------------------------------- program
     def run(self) -> str:
