@@ -138,9 +138,10 @@ def test_cycle84_taps_at_sst_and_retracts_at_sst1():
     # (600 x 1.5 = 900 mm/min both ways)
     recs, diags = run("CYCLE84(10, 0, 2, -18, , 0, 3, , 1.5, 0, 600, 0)")
     assert [(r.feed, r.spindle) for r in recs if r.kind == "linear"] == [(900, 600), (900, 600)]
-    # reversed for G332, back to the state before the call (G332), then SDAC 3
+    # reversed for G332, back to the state before the call (G332); SDAC 3 is that state again:
+    # no second record
     assert [(r.spindle_dir, r.spindle) for r in recs if r.kind == "spindle"] == [
-        ("ccw", 600), ("cw", 600), ("cw", 600)]
+        ("ccw", 600), ("cw", 600)]
     assert not diags
     # SST omitted: the tap runs at the speed in force, said at the line (NC128)
     recs, diags = run("CYCLE84(10, 0, 2, -18, , 0, 3, , 1.5)")

@@ -105,13 +105,13 @@ def test_positioning_is_data(dialect, mode):
 def test_cycle84_taps_synchronised_with_reversal():
     # MPIT=8 -> M8 coarse pitch 1.25 mm; S500: feed 1.25*500 = 625 mm/min. G0 Z2, tap to -15,
     # dwell 0.5, spindle reversed (ccw), tap back to Z2, the G332 returns it to cw (as before the
-    # call), SDAC=3 -> cw, G0 Z10.
+    # call), SDAC=3 -> cw, which it already is (one record), G0 Z10.
     text = "G17 G90 G0 X0 Y0 Z50 F100 S500 M3\nCYCLE84(10, 0, 2, -15, , 0.5, 3, 8)\nM30\n"
     recs, _ = run(text, "sinumerik")
     mine = [r for r in recs if r.line == 2]
     assert [(r.kind, r.end["Z"] if r.end else r.spindle_dir or r.dwell_s) for r in mine] == [
         ("rapid", 2.0), ("linear", -15.0), ("dwell", 0.5), ("spindle", "ccw"), ("linear", 2.0),
-        ("spindle", "cw"), ("spindle", "cw"), ("rapid", 10.0)]
+        ("spindle", "cw"), ("rapid", 10.0)]
     taps = [r for r in mine if r.kind == "linear"]
     assert [(r.feed, r.pitch) for r in taps] == [(625.0, 1.25), (625.0, 1.25)]
     assert all(r.pitch is None for r in recs if r.kind == "rapid")

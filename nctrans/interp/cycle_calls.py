@@ -18,6 +18,9 @@ from nctrans.interp.milling_cycles import run_milling_cycle
 from nctrans.ir import nodes as n
 from nctrans.ir.walk import constant
 
+# refusals of a cycle call at its line: it moved nothing (NC206 a required value missing, NC224 a
+# variant not modelled, NC225 a call the control would refuse)
+CALL_REFUSED = frozenset(("NC206", "NC224", "NC225"))
 CYCLE_LENGTH_KEYS = frozenset(("bottom", "r_plane", "retract_plane", "safety", "peck", "shift",
                                "depth_rel", "first_peck", "decrement", "min_peck", "relief"))
 
@@ -110,9 +113,17 @@ class CycleCallsMixin:
                     feed / st.spindle_speed if st.spindle_speed else None)
         saved = st.feed
         st.feed = feed
+        turned = None       # (direction, speed) of a spindle step just recorded, nothing since
         try:
             for s in steps:
                 k = s[0]
+                if k == "spindle":
+                    now = (s[1], s[2] if len(s) > 2 else st.spindle_speed)
+                    if now == turned:
+                        continue    # CYCLE84: G332's return to cw, then SDAC cw at the same speed
+                    turned = now
+                else:
+                    turned = None
                 if k in ("rapid", "linear"):
                     pt = dict(self.pos)
                     pt.update(s[1])
@@ -171,8 +182,20 @@ class CycleCallsMixin:
         if s.name and s.kind != "swivel_plane" and self._find_unit(s.name) is not None:
             return self._cycle_code(s)
         self._omitted_retract_plane(s)
-        self._omitted_from_state(s)
+        filled = self._omitted_from_state(s)
         self._unmodelled_params(s)
+        if filled is None:
+            return self._dispatch_cycle_call(s)
+        # NC128 after the call has run: a call refused at its line (NC206 no depth, NC224/NC225
+        # not modelled) moved nothing, so what the analysis took for its omitted values is moot
+        span, mark = self.span, len(self.diags)
+        line = span.line if span is not None else 0
+        result = self._dispatch_cycle_call(s)
+        if not any(d.rule in CALL_REFUSED and d.line == line for d in self.diags[mark:]):
+            self.diag("NC128", "warning", filled, span)
+        return result
+
+    def _dispatch_cycle_call(self, s: n.CycleCall):
         if s.kind in ("holes_line", "holes_circle", "holes_grid"):
             return self._hole_pattern(s)
         if s.kind == "swivel_plane":
@@ -204,14 +227,14 @@ class CycleCallsMixin:
                   f"where that is higher) as the control does, not to the height it started from "
                   f"({axis}{self.pos.get(axis, 0.0):g}); give RTP")
 
-    def _omitted_from_state(self, s: n.CycleCall) -> None:
+    def _omitted_from_state(self, s: n.CycleCall) -> Optional[str]:
         """Parameters a built-in model takes from the program's state when the call leaves them
         out or gives 0, where the control's cycle sees 0 (rules/cycles.toml [omitted_from_state]):
-        said at the line (NC128), once per call statement."""
+        the NC128 message said at the line (once per call statement), or None."""
         table = cycle_table()
         fills = table.omitted_from_state.get((s.name or "").upper())
         if not fills:
-            return
+            return None
         taken = []
         for name, instead in fills.items():
             e = s.params.get(table.neutral(name))
@@ -219,10 +242,11 @@ class CycleCallsMixin:
             if e is None or (c is not None and c == 0):
                 taken.append(f"{name} as {instead}")
         if taken:
-            self.diag("NC128", "warning", f"{s.name.upper()} with {', '.join(n_.split(' as ')[0] for n_ in taken)} "
+            return (f"{s.name.upper()} with {', '.join(n_.split(' as ')[0] for n_ in taken)} "
                       f"omitted or 0: the control's cycle sees 0 (seed L4722) and stops or uses a default "
                       f"of its own; the analysis takes {'; '.join(taken)}. The path is the same, its feed, "
-                      "time or spindle may not be the machine's; give the value")
+                    "time or spindle may not be the machine's; give the value")
+        return None
 
     def _unmodelled_params(self, s: n.CycleCall) -> None:
         """A parameter the built-in model does not read, given a value at which the control's
