@@ -109,7 +109,10 @@ def test_internal_thread_undercut_forms_c_and_d_by_hand():
     # face to the hole X8.646835, off by 1 to X7.646835; G0 back.
     r1 = (20 - 1.082532 * 2.5) / 2
     got, diags, recs = _run('CYCLE96(20, -30, "C", 2)')
-    assert [d for d in diags if d.severity != "info"] == []
+    # started at X40 Z5 (radius 20), outside the core hole: the G0 to (7.646835, -16) crosses the
+    # hole's radius 8.646835 at Z = 5 - 21 x (20 - 8.646835) / (20 - 7.646835) = -14.30003
+    assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC418", 4)]
+    assert "at Z-14.3," in next(d.message for d in diags if d.rule == "NC418")
     assert got == _approx([("rapid", r1 - 1, -16), ("linear", r1, -17), ("linear", 10.25, -17 - 2.776763),
                            ("linear", 10.25, -28.8), ("arc", 9.05, -30), ("linear", r1, -30),
                            ("linear", r1 - 1, -30), ("rapid", r1 - 1, -16)])
@@ -246,3 +249,16 @@ def test_undercuts_never_cut_outside_the_outline_and_end_where_they_start(diamet
         here = end
     assert here == pytest.approx(local(steps[0][1]))      # ends where it started
     assert deepest == pytest.approx(cut.depth)             # reaches the undercut's base
+
+
+def test_an_approach_from_inside_the_bore_is_not_warned():
+    # positioned inside the core hole first (radius 5 < 8.646835, at Z5): the G0 to the clearance
+    # point stays inside the hole: no NC418; the same call from X40 Z5 is NC418 (above)
+    text = _text('G0 X10\nCYCLE96(20, -30, "C", 2)')
+    diags = api.lint(text, "sinumerik", _lathe())
+    assert not [d for d in diags if d.rule == "NC418"]
+
+
+def test_an_external_undercut_started_outside_is_not_warned():
+    got, diags, _ = _run('CYCLE96(24, -30, "A", 3)')
+    assert not [d for d in diags if d.rule == "NC418"]

@@ -240,8 +240,31 @@ def run_undercut(interp, cyc, s) -> None:
         interp.diag(err.rule, err.severity, f"{s.name} {err.message}; the call is skipped and moves "
                     "nothing in the analysed toolpath")
         return
+    _diagonal_approach(interp, s, steps)
     for step in steps:
         if step[0] == "arc":
             interp._emit_turning([("arc", step[1], step[2], step[3])])
         else:
             interp._emit_turning([(step[0], step[1], None, None)])
+
+
+def _diagonal_approach(interp, s, steps: list[Step]) -> None:
+    """NC418 where the cycle's first G0, straight from wherever the tool is to the clearance
+    point, crosses the radius of the surface it undercuts: the tool started on the part's side of
+    that surface (an internal undercut started outside the bore, an external one inside the
+    diameter). How the control's cycle approaches is not documented in the seeds; the model runs
+    the G0 in both axes at once (as the turning cycles' start points), so say it where that line
+    would pass through the part, with where it crosses."""
+    (_, (xc, zc)), (_, (surface, _z1)) = steps[0][:2], steps[1][:2]
+    x0, z0 = interp.pos.get("X", 0.0), interp.pos.get("Z", 0.0)
+    if (x0 - surface) * (xc - surface) >= -EPS or abs(x0 - surface) <= 1e-6:
+        return                                  # the start is on the free side of the surface
+    z = z0 + (zc - z0) * (x0 - surface) / (x0 - xc)
+    inside = xc < surface
+    interp.diag("NC418", "warning",
+                f"{s.name} approaches its clearance point (radius {xc:.6g}, Z{zc:.6g}) with one G0 "
+                f"in X and Z from radius {x0:.6g}, Z{z0:.6g}: that line crosses the "
+                f"{'bore' if inside else 'diameter'} it undercuts (radius {surface:.6g}, diameter "
+                f"{2 * surface:.6g}) at Z{z:.6g}, through the part wherever the part is there. "
+                f"How the control approaches is not documented here; position the tool "
+                f"{'inside the bore' if inside else 'outside the diameter'} before the call")
