@@ -360,12 +360,13 @@ def test_cycle83_vari0_strokes_by_hand(tmp_path):
 
 def test_cycle84_by_hand(tmp_path):
     # RFP 0 + SDIS 2 = Z2 by G0; tap to -15 at 1.25 x 1000 = 1250 mm/min carrying the pitch; dwell
-    # 0.5 s; spindle reversed, back to Z2; the G332 returns it to M3; SDAC 3: M3; G0 to RTP 10
+    # 0.5 s; spindle reversed, back to Z2; the G332 returns it to M3 (SDAC 3: M3 again, no
+    # change, no second record); G0 to RTP 10
     got, bad = records(tmp_path, PROGRAMS["84-pit"][0])
     assert bad == []
     assert [(m[0], m[1]["Z"], m[2], m[3]) if m[0] in ("rapid", "linear") else m for m in got][2:] == [
         ("rapid", 2.0, None, None), ("linear", -15.0, 1250.0, 1.25), ("dwell", 0.5),
-        ("spindle", "ccw"), ("linear", 2.0, 1250.0, 1.25), ("spindle", "cw"), ("spindle", "cw"),
+        ("spindle", "ccw"), ("linear", 2.0, 1250.0, 1.25), ("spindle", "cw"),
         ("rapid", 10.0, None, None)]
 
 

@@ -25,11 +25,11 @@ def diags(text: str) -> list[tuple]:
 
 def test_right_hand_tap_and_retract():
     # K1.5 at S500: 750 mm/min both ways; G332 reverses the spindle and, retracted, it turns as
-    # before the G331 again (cw); the M3 after it is recorded too
+    # before the G331 again (cw); the M3 after it changes nothing and records nothing
     text = "G17 G90 G0 X10 Y20 Z5\nS500 M3\nG331 Z-20 K1.5\nG332 Z5 K1.5\nM3\nG0 Z50\nM30\n"
     assert events(text) == [("rapid", 5.0, None, None), ("spindle", "cw"),
                             ("linear", -20.0, 750.0, 1.5), ("spindle", "ccw"),
-                            ("linear", 5.0, 750.0, 1.5), ("spindle", "cw"), ("spindle", "cw"),
+                            ("linear", 5.0, 750.0, 1.5), ("spindle", "cw"),
                             ("rapid", 50.0, None, None)]
     assert diags(text) == []
 

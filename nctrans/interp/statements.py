@@ -90,13 +90,17 @@ class StatementsMixin:
                 # side switch while active: finish with the next move, restart after
                 self.comp_exit = True
         elif g == "spindle":
+            # M3/M4 with the spindle already turning that way changes nothing: no second record
+            # (CYCLE84's code turns it back to M3 after G332 did: one cw record, as the model)
+            same = v in ("cw", "ccw") and v == st.spindle_dir and not self.spindle_stopped
             st.set(g, v)
             self.spindle_stopped = v == "off"
             # M19 positions at SD 43240 M19_SPOS, 0 degrees by default (spindle_position.py)
             self.spindle_angle = 0.0 if v == "orient" else None
             self.spindle_reported = False
             rigid_tap.spindle_programmed(self)
-            self._record("spindle", spindle_dir=v, spindle=st.spindle_speed)
+            if not same:
+                self._record("spindle", spindle_dir=v, spindle=st.spindle_speed)
         elif g == "coolant":
             st.set(g, v)
             self._record("coolant", coolant=v)
