@@ -44,3 +44,14 @@ def test_equiv_of_a_macro_file_with_itself_ends_at_m99():
     assert result.equivalent, result.message
     # one pass: the G1 Z-5 and the stop at M99 (it restarted until the step budget: 285715 records)
     assert "(2 and 2 toolpath records)" in result.message
+
+
+def test_a_feed_from_an_argument_is_no_error_alone():
+    # F#9: vacant when the file runs alone, the caller's G65 F.. otherwise: NC202 is the warning a
+    # subprogram file gets (it moves at its caller's feed), not an error failing lint
+    macro = "O9006\nG1 Z-#26 F#9\nM99\n"
+    diags = [(d.rule, d.line, d.severity) for d in api.lint(macro, "iso-m")]
+    assert ("NC202", 2, "warning") in diags and ("NC202", 2, "error") not in diags
+    # a main program with no F is still the error
+    assert ("NC202", 2, "error") in [(d.rule, d.line, d.severity)
+                                     for d in api.lint("O1000\nG1 Z-5.\nM30\n", "iso-m")]

@@ -254,10 +254,11 @@ class MotionMixin:
                       "would rub or break; start the spindle (M3/M4) before cutting")
 
     def _runs_from_a_caller(self) -> bool:
-        """The program run is a subprogram file by its dialect's file types (a Sinumerik .SPF):
-        its modes and feed are its caller's (convert.subprogram_file)."""
+        """The program run is a subprogram file by its dialect's file types (a Sinumerik .SPF)
+        or an ISO macro file run alone (interp/macro_alone: its F may be a G65 argument): its
+        modes and feed are its caller's (convert.subprogram_file)."""
         from nctrans.convert import subprogram_file
-        return subprogram_file(self.program)
+        return subprogram_file(self.program) or bool(getattr(self, "_macro_alone", False))
 
     def _g33_move(self, vals, center) -> None:
         """G33: a feed synchronised with the spindle, `lead` mm per revolution: the feed is
