@@ -19,6 +19,8 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import pipeline
 
+from cycle_agreement import num as written
+
 from test_controls_cycle_code import CYCLE81
 
 CYCLE82 = """PROC CYCLE82(REAL RTP, REAL RFP, REAL SDIS, REAL DP, REAL DPR, REAL DTB) SAVE
@@ -391,10 +393,6 @@ def test_modal_call_follows_moves_in_called_subprograms_not_in_itself(tmp_path):
         ("rapid", 20, 5), ("linear", 20, 4), ("rapid", 20, 5), ("rapid", 0, 5)]
 
 
-def _num(v) -> str:
-    return "" if v is None else f"{v:g}"
-
-
 @st.composite
 def drilling_calls(draw):
     """A drilling cycle call with a random parameter set, alone, under MCALL at positions, or under
@@ -430,7 +428,7 @@ def drilling_calls(draw):
                  draw(st.sampled_from([6, 10])) if metric else None, None if metric else pit]
     while args and args[-1] is None:
         args.pop()
-    call = f"{cycle}({', '.join(_num(a) for a in args)})"
+    call = f"{cycle}({', '.join(written(a) for a in args)})"
     head = START.replace("M3", spindle)
     how = draw(st.sampled_from(["single", "mcall", "pattern"]))
     if how == "single":

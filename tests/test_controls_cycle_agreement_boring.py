@@ -25,6 +25,8 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import pipeline
 
+from cycle_agreement import num as written
+
 # The levels every boring cycle starts from: the drilling direction is from RTP towards RFP (RTP
 # below RFP bores upwards) [GK: "the direction in which the safety clearance is active is determined
 # by the cycle"]; DPR wins over DP; the clear level is RTP, or RFP+SDIS when RTP is not beyond it.
@@ -210,10 +212,6 @@ def test_boring_models_agree_with_cycle_code(tmp_path, name):
     assert len(agree(tmp_path, text, cycle)) > 4
 
 
-def _num(v) -> str:
-    return "" if v is None else f"{v:g}"
-
-
 @st.composite
 def boring_calls(draw):
     """A boring cycle call with a random parameter set: plane, levels (RTP above or below RFP+SDIS),
@@ -244,7 +242,7 @@ def boring_calls(draw):
         args += [dtb]
     while args and args[-1] is None:
         args.pop()
-    call = f"{cycle}({', '.join(_num(a) for a in args)})"
+    call = f"{cycle}({', '.join(written(a) for a in args)})"
     head = f"{plane} G90 G0 {start} F120 S800 {spindle}\n"
     if draw(st.booleans()):
         a1, a2 = {"G17": ("X", "Y"), "G18": ("Z", "X"), "G19": ("Y", "Z")}[plane]

@@ -13,7 +13,6 @@ G functions only, seed L4386) as the models do.
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import pytest
@@ -21,7 +20,9 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import pipeline
 
-PROCS = Path(__file__).parent / "data" / "cycle-procs"
+import cycle_agreement
+from cycle_agreement import num as written, procs
+
 START = "$TC_DP6[1,1]={r}\nG17 G90 T1 D1 M6\nS2000 {m} F500\nG0 X50 Y50 Z20\n"
 
 
@@ -50,30 +51,9 @@ def records(where: Path, text: str):
     return out, bad
 
 
-def _close(a, b, tol: float = 1e-6) -> bool:
-    if isinstance(a, float) or isinstance(b, float):
-        return a is not None and b is not None and math.isclose(a, b, abs_tol=tol)
-    if isinstance(a, tuple) and isinstance(b, tuple):
-        return len(a) == len(b) and all(_close(x, y, tol) for x, y in zip(a, b))
-    return a == b
-
-
 def agree(tmp_path: Path, text: str, cycle: str, tol: float = 1e-6):
     """The program with the built-in model, then with the cycle's PROC (and the helpers) beside it."""
-    runs = []
-    for how in ("builtin", "code"):
-        d = tmp_path / how
-        d.mkdir(exist_ok=True)
-        if how == "code":
-            for f in PROCS.glob("*.SPF"):
-                (d / f.name).write_text(f.read_text())
-        runs.append(records(d, text))
-    (want, bad_builtin), (got, bad_code) = runs
-    assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
-    first = next((i for i, (g, w) in enumerate(zip(got, want)) if not _close(g, w, tol)), None)
-    assert first is None and len(got) == len(want), (first, got[first or 0:][:3], want[first or 0:][:3],
-                                                     len(got), len(want))
-    return want
+    return cycle_agreement.agree(tmp_path, text, procs(), records, tol)
 
 
 def program(call: str, r: float = 3.0, spindle: str = "M3") -> str:
@@ -129,10 +109,6 @@ def test_milling_models_agree_in_inch(tmp_path, name, units):
 # or an MCALL at two positions.
 
 PLANES = {"G17": ("X", "Y", "Z"), "G18": ("Z", "X", "Y"), "G19": ("Y", "Z", "X")}
-
-
-def _num(v) -> str:
-    return "" if v is None else f"{v:g}"
 
 
 def _opt(draw, values):
@@ -200,7 +176,7 @@ def milling_calls(draw, cycle: str):
                 _opt(draw, [1, 2]) + 10 * draw(st.integers(1, 4)), _opt(draw, [None, 0, 2])]
     while args and args[-1] is None:
         args.pop()
-    call = f"{cycle}({', '.join(_num(a) for a in args)})"
+    call = f"{cycle}({', '.join(written(a) for a in args)})"
     plane = "G17" if cycle == "CYCLE90" else _opt(draw, sorted(PLANES))
     a1, a2, ax = PLANES[plane]
     head = (f"$TC_DP6[1,1]={r}\n{plane} G90 T1 D1 M6\nS2000 {_opt(draw, ['M3', 'M4'])} F500\n"

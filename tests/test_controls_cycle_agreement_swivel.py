@@ -9,7 +9,6 @@ kinematics is not in its model) is said of the built-in run only and is not a di
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import pytest
@@ -17,7 +16,9 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import pipeline
 
-PROCS = Path(__file__).parent / "data" / "cycle-procs"
+import cycle_agreement
+from cycle_agreement import procs
+
 AFTER = "G0 X10 Y0 Z5\nG1 X20 Y5 Z0 F100\nG2 X30 Y5 I5 J0\nG0 Z40\n"
 
 
@@ -33,26 +34,8 @@ def records(where: Path, text: str):
     return out, bad
 
 
-def _close(a, b) -> bool:
-    if isinstance(a, float) or isinstance(b, float):
-        return a is not None and b is not None and math.isclose(a, b, abs_tol=1e-6)
-    if isinstance(a, tuple) and isinstance(b, tuple):
-        return len(a) == len(b) and all(_close(x, y) for x, y in zip(a, b))
-    return a == b
-
-
 def agree(tmp_path: Path, text: str):
-    runs = []
-    for how in ("builtin", "code"):
-        d = tmp_path / how
-        d.mkdir(exist_ok=True)
-        if how == "code":
-            (d / "CYCLE800.SPF").write_text((PROCS / "CYCLE800.SPF").read_text())
-        runs.append(records(d, text))
-    (want, bad_builtin), (got, bad_code) = runs
-    assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
-    assert len(got) == len(want) and all(_close(g, w) for g, w in zip(got, want)), (got, want)
-    return want
+    return cycle_agreement.agree(tmp_path, text, procs("CYCLE800"), records)
 
 
 CALLS = {

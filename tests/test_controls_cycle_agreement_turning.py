@@ -21,7 +21,9 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from nctrans import pipeline
 
-PROCS = Path(__file__).parent / "data" / "cycle-procs"
+import cycle_agreement
+from cycle_agreement import assert_same, both_runs, close, procs
+
 START = "G18 G90 T1 D1\nS500 M3\nG0 X{x} Z10\n"
 # the same under DIAMON: X programmed as a diameter; each PROC turns DIAMOF for itself and SAVE
 # restores DIAMON at its end (seed L4386), which the move after the call (X40: radius 20) shows
@@ -57,28 +59,8 @@ def records(where: Path, text: str):
     return out, bad
 
 
-def _close(a, b) -> bool:
-    if isinstance(a, float) or isinstance(b, float):
-        return a is not None and b is not None and math.isclose(a, b, abs_tol=1e-6)
-    if isinstance(a, tuple) and isinstance(b, tuple):
-        return len(a) == len(b) and all(_close(x, y) for x, y in zip(a, b))
-    return a == b
-
-
 def agree(tmp_path: Path, text: str):
-    runs = []
-    for how in ("builtin", "code"):
-        d = tmp_path / how
-        d.mkdir(exist_ok=True)
-        if how == "code":
-            (d / "CYCLE97.SPF").write_text((PROCS / "CYCLE97.SPF").read_text())
-        runs.append(records(d, text))
-    (want, bad_builtin), (got, bad_code) = runs
-    assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
-    first = next((i for i, (g, w) in enumerate(zip(got, want)) if not _close(g, w)), None)
-    assert first is None and len(got) == len(want), (first, got[first or 0:][:3], want[first or 0:][:3],
-                                                     len(got), len(want))
-    return want
+    return cycle_agreement.agree(tmp_path, text, procs("CYCLE97"), records)
 
 
 CALLS = {
@@ -136,15 +118,7 @@ def test_cycle97_model_agrees_over_parameter_sets(tmp_path_factory, text):
 # the PROCs hold the DIN 509 / DIN 76 / ISO 261 rows as SET arrays and take FORM as a STRING
 
 def agree_undercut(tmp_path: Path, text: str, cycle: str):
-    runs = []
-    for how in ("builtin", "code"):
-        d = tmp_path / how
-        d.mkdir(exist_ok=True)
-        if how == "code":
-            for f in (cycle, "CYCUNDC"):
-                (d / f"{f}.SPF").write_text((PROCS / f"{f}.SPF").read_text())
-        runs.append(records(d, text))
-    (want, bad_builtin), (got, bad_code) = runs
+    (want, bad_builtin), (got, bad_code) = both_runs(tmp_path, text, procs(cycle, "CYCUNDC"), records)
     # a G0 to the clearance point from the part's side of the surface undercut (an inside undercut
     # started outside the bore, an outside one inside the diameter) runs through the part: the
     # model says where (NC418); the PROC runs the same G0, which nctrans cannot tell from any G0 a
@@ -163,7 +137,7 @@ def agree_undercut(tmp_path: Path, text: str, cycle: str):
         crosses = start > surface if inside else start < surface
     assert bool(crossing) == crosses, (text, crossing)
     assert [b for b in bad_builtin if b not in crossing] == [] and bad_code == [], (bad_builtin, bad_code)
-    assert len(got) == len(want) and all(_close(g, w) for g, w in zip(got, want)), (got, want)
+    assert len(got) == len(want) and all(close(g, w) for g, w in zip(got, want)), (got, want)
     return want
 
 
@@ -207,18 +181,7 @@ def test_undercut_models_agree_over_parameter_sets(tmp_path_factory, cycle, vari
 # CYCLE98 chained threads: CYCLE97's passes through up to three sections with their own leads
 
 def agree_chain(tmp_path: Path, text: str):
-    runs = []
-    for how in ("builtin", "code"):
-        d = tmp_path / how
-        d.mkdir(exist_ok=True)
-        if how == "code":
-            (d / "CYCLE98.SPF").write_text((PROCS / "CYCLE98.SPF").read_text())
-        runs.append(records(d, text))
-    (want, bad_builtin), (got, bad_code) = runs
-    assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
-    first = next((i for i, (g, w) in enumerate(zip(got, want)) if not _close(g, w)), None)
-    assert first is None and len(got) == len(want), (first, got[first or 0:][:3], want[first or 0:][:3])
-    return want
+    return cycle_agreement.agree(tmp_path, text, procs("CYCLE98"), records)
 
 
 CHAINS = {
@@ -273,8 +236,8 @@ def agree_groove(tmp_path: Path, call: str, width: float, position: str = "G0 X4
         d = tmp_path / how
         d.mkdir(exist_ok=True)
         if how == "code":
-            for f in ("CYCLE93", "CYCGRF", "CYCGRC", "CYCGRE"):
-                (d / f"{f}.SPF").write_text((PROCS / f"{f}.SPF").read_text())
+            for name, body in procs("CYCLE93", "CYCGRF", "CYCGRC", "CYCGRE").items():
+                (d / name).write_text(body)
         path = d / "MAIN.MPF"
         path.write_text(text)
         ld = pipeline.load(str(path), "sinumerik")
@@ -293,8 +256,7 @@ def agree_groove(tmp_path: Path, call: str, width: float, position: str = "G0 X4
         runs.append((out, bad))
     (want, bad_builtin), (got, bad_code) = runs
     assert bad_builtin == [] and bad_code == [], (bad_builtin, bad_code)
-    first = next((i for i, (g, w) in enumerate(zip(got, want)) if not _close(g, w)), None)
-    assert first is None and len(got) == len(want), (call, first, got[first or 0:][:3], want[first or 0:][:3])
+    assert_same(got, want, 1e-6, call)
     return want
 
 
