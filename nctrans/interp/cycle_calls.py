@@ -9,8 +9,8 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from nctrans.interp.compiled import BLOCK, Unit
-from nctrans.interp.cycles import (coarse_pitch, cycle_table, deep_hole_steps, expand_cycle,
-                                   hole_pattern, plane_cycle_levels, swivel_plan, tap_steps)
+from nctrans.interp.cycles import (coarse_pitch, cycle_problems, cycle_table, deep_hole_steps,
+                                   expand_cycle, hole_pattern, plane_cycle_levels, swivel_plan, tap_steps)
 from nctrans.interp.evaluate import UNKNOWN
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.lathe import TURNING_KINDS
@@ -77,7 +77,23 @@ class CycleCallsMixin:
         step = None
         if st.incremental:
             step = {a: v for a, v, m in plane_vals if m != "abs"}
+        self._questionable_cycle(st.cycle, zr, zb, p, repeat)
         self._expand(st.cycle, hole, zr, zb, retract, p, int(round(repeat)), step)
+
+    def _questionable_cycle(self, kind: str, approach: float, bottom: float, p: dict, repeat) -> None:
+        """NC132 at the line: values a control rejects or reads in its own way (an R plane beyond
+        the bottom, G83 with no peck depth Q, G76 with no shift Q, G89 with no dwell P, a tap
+        against the spindle's direction). The seed does not say what the control does with them
+        and LinuxCNC stops with an error; nctrans runs its own reading, so it is said, never
+        silent. A stopped spindle is NC209's, at the first feed move."""
+        problems = cycle_problems(kind, approach=approach, bottom=bottom, peck=self.cycle_params.get("peck"),
+                                  dwell_s=p.get("dwell"), shift=p.get("shift"),
+                                  spindle_dir=self.st.spindle_dir, repeat=int(round(repeat)))
+        if self.spindle_stopped:
+            problems = [x for x in problems if not x.startswith("spindle")]
+        if problems:
+            self.diag("NC132", "warning", f"canned cycle {kind}: {'; '.join(problems)} (a control may "
+                      "alarm here; the analysed motion is nctrans' reading of these values)")
 
     def _position_at(self) -> str:
         mode = self.__dict__.get("_cycle_positioning")
