@@ -86,7 +86,7 @@ class CycleCallsMixin:
         against the spindle's direction). The seed does not say what the control does with them
         and LinuxCNC stops with an error; nctrans runs its own reading, so it is said, never
         silent. A stopped spindle is NC209's, at the first feed move."""
-        problems = cycle_problems(kind, approach=approach, bottom=bottom, peck=self.cycle_params.get("peck"),
+        problems = cycle_problems(kind, approach=approach, bottom=bottom, peck=p.get("peck"),
                                   dwell_s=p.get("dwell"), shift=p.get("shift"),
                                   spindle_dir=self.st.spindle_dir, repeat=int(round(repeat)))
         if self.spindle_stopped:
@@ -143,8 +143,8 @@ class CycleCallsMixin:
                 if k in ("rapid", "linear"):
                     pt = dict(self.pos)
                     pt.update(s[1])
-                    if k == "linear" and self.spindle_stopped and not self.spindle_reported:
-                        self._cycle_cuts_standing(kind)
+                    if k == "linear":
+                        self._spindle_standing(self._standing_cut(kind))
                     mark = len(self.out)
                     self._move(k, pt)
                     if pitch is not None and k == "linear":
@@ -174,23 +174,20 @@ class CycleCallsMixin:
             self.pos = pos
             self.mpos = self._to_machine(pos)
 
-    def _cycle_cuts_standing(self, kind: str) -> None:
-        """NC209 at the cycle's line (the call, or the MCALL/modal position that runs it): a cycle
-        model's feed move would cut with the spindle the program (M5, a tool change that stops
-        it) or an earlier hole's cycle (CYCLE840 SDAC 5) left standing. The cycle moves bypass
-        the feed-move check (motion._need_feed); a cycle that turns the spindle itself first
-        (CYCLE84: G331, rigid_tap) never gets here. Once until the spindle is programmed again,
-        by the program or by a cycle (CYCLE840 turns it back at the depth and SDAC 5 stops it anew)."""
-        self.spindle_reported = True
+    @staticmethod
+    def _standing_cut(kind: str) -> str:
+        """NC209's text for a cycle model's feed move with the spindle the program (M5, a tool
+        change that stops it) or an earlier hole's cycle (CYCLE840 SDAC 5) left standing, said at
+        the cycle's line (the call, or the MCALL/modal position). A cycle that turns the spindle
+        itself first (CYCLE84: G331, rigid_tap) never gets here; CYCLE840 turns it back at the
+        depth and SDAC 5 stops it anew, so each such position is said."""
         if kind in ("tap", "tap_left"):
-            self.diag("NC209", "warning", "tapping with the spindle stopped (M5, a tool change "
-                      "that stops it, or an earlier hole's SDAC 5 under MCALL): this tapping cycle "
-                      "feeds the tap in without turning the spindle first, so the tap breaks; start "
-                      "the spindle (M3/M4) before the cycle, or end the earlier tap with SDAC 3/4")
-        else:
-            self.diag("NC209", "warning", "cycle feed move while the spindle is stopped (M5, or a "
-                      "tool change that stops it): the tool would rub or break; start the spindle "
-                      "(M3/M4) before the cycle")
+            return ("tapping with the spindle stopped (M5, a tool change that stops it, or an "
+                    "earlier hole's SDAC 5 under MCALL): this tapping cycle feeds the tap in without "
+                    "turning the spindle first, so the tap breaks; start the spindle (M3/M4) before "
+                    "the cycle, or end the earlier tap with SDAC 3/4")
+        return ("cycle feed move while the spindle is stopped (M5, or a tool change that stops it): "
+                "the tool would rub or break; start the spindle (M3/M4) before the cycle")
 
     def _h_cycle_call(self, s: n.CycleCall):
         if s.kind in TURNING_KINDS:

@@ -248,10 +248,15 @@ class MotionMixin:
                 self.diag("NC202", "warning", "feed move with no feed rate programmed in this "
                           "subprogram file: it moves at the feed its caller set, which the analysis "
                           "of the file alone does not know")
+        self._spindle_standing("feed move while the spindle is stopped (M5, or a tool change that "
+                               "stops it): the tool would rub or break; start the spindle (M3/M4) before cutting")
+
+    def _spindle_standing(self, message: str) -> None:
+        """NC209 at the line, once until the spindle is programmed again: a feed move (or a cycle's
+        feed, interp/cycle_calls) with the spindle standing."""
         if self.spindle_stopped and not self.spindle_reported:
             self.spindle_reported = True
-            self.diag("NC209", "warning", "feed move while the spindle is stopped (M5, or a tool change that stops it): the tool "
-                      "would rub or break; start the spindle (M3/M4) before cutting")
+            self.diag("NC209", "warning", message)
 
     def _runs_from_a_caller(self) -> bool:
         """The program run is a subprogram file by its dialect's file types (a Sinumerik .SPF)
