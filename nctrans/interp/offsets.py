@@ -240,7 +240,18 @@ class OffsetsMixin:
         self.off.set_g92({})
         self._resync()
 
+    def _frame_axes_resolved(self, s: n.FrameOp) -> n.FrameOp:
+        """The frame op with its AX[expr]=value words under the axes their expressions name when
+        the block runs (Sinumerik `TRANS AX[AXVAR]=10`): the same op written with that axis."""
+        values = dict(s.values)
+        for axis, value in s.indirect:
+            name = self._indirect_axis(self.ev.compile(axis)())
+            values[name] = value
+        return n.FrameOp(s.op, values, s.center, s.angle, s.additive, s.clear, s.local)
+
     def _h_frame(self, s: n.FrameOp):
+        if s.indirect:
+            s = self._frame_axes_resolved(s)
         st = self.st
         if st.polar and polar_input.guard(self, [(a,) for a in list(s.values) + list(s.center or ())],
                                           "a frame or local offset with plane axis words"):

@@ -243,6 +243,8 @@ class FrameOp:
     values: per-axis values (translation, scale factor, mirror flag, or rotation angle per axis).
     center: pivot for ISO G68/G51/G51.1 (program coordinates); angle: rotation in the active plane.
     local: ISO G52 local coordinate system (a translation that stacks under G68/G51).
+    indirect: values whose axis is computed when the block runs (Sinumerik `TRANS AX[AXVAR]=10`,
+    seed L1422): [(axis expression, value)]; the axis is known only to the run.
     """
     op: str
     values: dict[str, Expr] = field(default_factory=dict)
@@ -251,6 +253,7 @@ class FrameOp:
     additive: bool = False
     clear: bool = False
     local: bool = False
+    indirect: Optional[list[tuple[Expr, Expr]]] = None
 
 
 @node

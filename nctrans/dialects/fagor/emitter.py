@@ -922,6 +922,8 @@ class FagorEmitter(FagorSpelling, Emitter):
             word("", f"L {callee}", alone=True)
 
     def frame(self, s: n.FrameOp, word) -> None:
+        if s.indirect:
+            raise NotExpressible("a frame value with a computed axis (AX[..]=)")
         scale, rotation = self.code_for("frame", "scale"), self.code_for("frame", "rotation")
         mirror_off, shift = self.code_for("frame", "mirror_off"), self.code_for("incremental_offset")
         if s.op in ("scale", "mirror") and s.additive and not s.clear:

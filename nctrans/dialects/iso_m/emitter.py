@@ -1410,6 +1410,8 @@ class IsoEmitter(IsoSpelling, Emitter):
                                                                for k, v in total.items()]
 
     def w_FrameOp(self, s: n.FrameOp):
+        if s.indirect:
+            raise NotExpressible("a frame value with a computed axis (AX[..]=)")
         if s.additive:
             if s.op == "trans" and not s.clear:
                 return self._additive_trans(s)

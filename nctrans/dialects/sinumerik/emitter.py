@@ -849,6 +849,12 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
             body = f"{op} " + " ".join(f"{k}0" for k in f.values)
         else:
             body = f"{op} " + " ".join(self.word(k, v) for k, v in f.values.items())
+        if f.indirect:
+            if f.op == "mirror":
+                body = body.rstrip() + " " + " ".join(f"AX[{self.expr(a)}]=0" for a, _ in f.indirect)
+            else:
+                body = body.rstrip() + " " + " ".join(f"AX[{self.expr(a)}]={self.expr(v)}"
+                                                      for a, v in f.indirect)
         for line in pre + [body.strip()] + post:
             out.alone(line)
 

@@ -597,16 +597,20 @@ class Lowerer:
         additive = op.endswith("_add")
         base = op.replace("_add", "")
         values = {k: v.value for k, v in w.target.items()}
-        if not values and w.rpl is None:
+        # AX[axis]=value is the axis word written indirectly (seed L1422): in a frame instruction
+        # it is one of the frame's values (TRANS AX[AXVAR]=10 shifts that axis), never a motion
+        indirect = [(axis, av.value) for axis, av in w.indirect] or None
+        w.indirect = []
+        if not values and w.rpl is None and not indirect:
             if additive:
                 return
             w.out.append(ir.FrameOp("all", clear=True))
             return
         if base == "rot" and w.rpl is not None:
-            w.out.append(ir.FrameOp("rot", values, angle=w.rpl, additive=additive))
+            w.out.append(ir.FrameOp("rot", values, angle=w.rpl, additive=additive, indirect=indirect))
             w.rpl = None
         else:
-            w.out.append(ir.FrameOp(base, values, additive=additive))
+            w.out.append(ir.FrameOp(base, values, additive=additive, indirect=indirect))
         w.target.clear()
 
     def statements(self, stmts: list, line: Line) -> list:
