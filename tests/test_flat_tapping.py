@@ -42,12 +42,19 @@ def test_a_thread_that_is_no_tap_stays_a_g33_move_with_its_lead_as_f():
     assert api.equiv(text, conv.text, read_a="iso-m", read_b="iso-m")
 
 
-def test_g98_tap_returning_above_its_start_is_not_a_g99_cycle():
-    # G98: the tap feeds out to the initial level Z20, not to where it began (Z5): no G84 form
+def test_g98_tap_of_the_seed_is_a_g99_cycle_then_a_rapid_and_linuxcncs_is_not():
     text = "G17 G90 G94 G54\nS500 M3\nG0 X10 Y10 Z20\nG98 G84 Z-10 R5 F750\nG80\nM30\n"
+    # iso-m (the seed, L3179): G98 taps out to R (Z5), stops the spindle, rapids to Z20: the tap
+    # is the G99 form, the rapid after it a move of its own; the spindle stays stopped
     conv = _flat(text, "iso-m")
-    assert "G84" not in conv.text and "G33 Z-10. F1.5" in conv.text.splitlines()
+    lines = conv.text.splitlines()
+    assert "F750. G99 G84 R5. X10. Y10. Z-10." in lines
+    assert lines[lines.index("F750. G99 G84 R5. X10. Y10. Z-10.") + 2] == "G0 Z20."
     assert api.equiv(text, conv.text, read_a="iso-m", read_b="iso-m")
+    # LinuxCNC's G98 tap feeds out to the initial level Z20, not to where it began (Z5): that is
+    # no G33.1 (which returns to where it began), so it stays G33 moves (LinuxCNC's lead word K)
+    conv = _flat(text, "iso-m", "linuxcnc")
+    assert "G33 Z-10. K1.5" in conv.text.splitlines() and "G84" not in conv.text
 
 
 CYCLE84 = "G17 G90 G0 X10 Y10 Z20 S500 M3\nCYCLE84(10, 0, 2, -10, , , 3, , 1.5)\nG0 X30\nM30\n"

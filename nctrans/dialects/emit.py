@@ -91,6 +91,8 @@ def flat_forms(dialect: Optional[str] = None) -> dict:
         forms.update(((option(dialect, "profiles") or {}).get(profile) or {}).get("flat_motion") or {})
     if forms:
         forms["dialect"] = dialect
+        from nctrans.interp.cycles import cycle_table
+        forms["tap_end"] = cycle_table().tap_end(dialect, profile)   # how its G84 ends a hole
     return forms
 
 

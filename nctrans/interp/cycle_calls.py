@@ -102,9 +102,25 @@ class CycleCallsMixin:
                 self.program.dialect, self.program.meta.get("profile"))
         return mode
 
+    def _tap_end(self) -> str:
+        mode = self.__dict__.get("_cycle_tap_end")
+        if mode is None:
+            mode = self._cycle_tap_end = cycle_table().tap_end(
+                self.program.dialect, self.program.meta.get("profile"))
+        return mode
+
     def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None,
                 steps=None, own: Optional[dict] = None) -> None:
         st = self.st
+        seed_tap = steps is None and kind in ("tap", "tap_left") and self._tap_end() == "stopped"
+        if seed_tap:
+            # the spindle an earlier hole's tap stopped is turned by this one (rules [tapping]);
+            # one the program stopped (M5, a tool change) is not: NC209 at the feed in, and at
+            # each later hole while no M3/M4 is programmed (the control's alarm is per call)
+            turns = bool(self.spindle_stopped_by_tap and self.spindle_stopped)
+            programmed = turns or not self.spindle_stopped
+            own = {**(own or {}), "tap_end": "stopped",
+                   "tap_turns": True if turns else (False if programmed else None)}
         feed = p.get("feed")
         feed = feed * st.feed_scale if feed is not None else (st.feed or 0.0)
         if not feed:
@@ -144,7 +160,14 @@ class CycleCallsMixin:
                     pt = dict(self.pos)
                     pt.update(s[1])
                     if k == "linear":
-                        self._spindle_standing(self._standing_cut(kind))
+                        said = self._standing_cut(kind)
+                        if seed_tap and self.spindle_stopped and not self.spindle_reported:
+                            alarm = cycle_table().tapping_alarm.get(self.program.dialect)
+                            said = ("tapping with no spindle direction in force (M5, or a tool change "
+                                    "that stops the spindle): the tap is fed in with the spindle "
+                                    "standing and breaks; program M3/M4 before the cycle"
+                                    + (f"; {alarm}" if alarm else ""))
+                        self._spindle_standing(said)
                     mark = len(self.out)
                     self._move(k, pt)
                     if pitch is not None and k == "linear":
@@ -167,6 +190,8 @@ class CycleCallsMixin:
                     self._record("stop", stop_kind="stop")
         finally:
             st.feed = saved
+        if seed_tap:
+            self.spindle_stopped_by_tap = self.spindle_stopped and programmed
         if kind == "bore_manual":        # the operator retracted by hand (see cycles.py)
             ax = PLANE_AXES[st.plane][2]
             pos = dict(self.pos)

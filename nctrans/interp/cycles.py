@@ -19,8 +19,10 @@ canonical calls exactly (checked by tests/test_cycles.py against rs274). Where t
   not deeper than the bottom (LinuxCNC: `depth > bottom`), then one feed to the bottom.
 - G84 / G74 (tap, tap_left): LinuxCNC feeds out all the way to the clear level (Zi under G98) with
   the spindle reversed, dwelling P only once at the bottom after reversing: stop, reverse, dwell,
-  feed out, stop, forward. §5.3 feeds out to R only, dwells at both ends and rapids to Zi.
-  The dwell is always emitted (P defaults to 0 in LinuxCNC).
+  feed out, stop, forward. §5.3 feeds out to R only, dwells at both ends and rapids to Zi, and the
+  seed's text ends with the spindle stopped: a dialect whose rules say so (rules/cycles.toml
+  [tapping] "stopped": iso-m) runs that instead (`tap_end`). The dwell is always emitted (P
+  defaults to 0 in LinuxCNC).
 - G85 (bore_feed_out): identical to §5.3 (feed to R, rapid to the clear level even under G99).
 - G86 (bore_stop_rapid_out): LinuxCNC dwells P at the bottom before stopping the spindle (P is
   required there); §5.3 has no dwell.
@@ -69,7 +71,8 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
                  liftoff: Optional[str] = None, position_at: str = "clear_level",
                  feed_out: Optional[float] = None, lift: Optional[dict[str, float]] = None,
                  manual_retract: bool = False, bore_dir: Optional[str] = None,
-                 dwell_feed_out: bool = False) -> list[Step]:
+                 dwell_feed_out: bool = False, tap_end: str = "forward",
+                 tap_turns: Optional[bool] = False) -> list[Step]:
     """The steps of one cycle block: ("rapid"|"linear", point) | ("dwell", s) | ("spindle", dir) | ("stop", "stop").
 
     `retract` is the level the hole ends at: the initial level Zi under G98 (may be below R; the
@@ -92,6 +95,12 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
     `bore_dir` (CYCLE86/87/88 SDIR): the spindle direction the hole is bored in, switched to before
     the feed in when the spindle turns otherwise, and the one it is turned on in again;
     `dwell_feed_out` (CYCLE85): the dwell DTB at the depth before the feed out (ISO G85 has none).
+    `tap_end` (G84/G74, rules/cycles.toml [tapping]): "forward" is LinuxCNC's tap (above);
+    "stopped" the Siemens ISO seed's rigid tap (L3179, L3269): out to R only, dwell P there too,
+    the spindle left stopped, G0 to the clear level. `tap_turns`: True, each hole's tap turns the
+    spindle the thread's way first (an earlier tap stopped it); False, each hole after the first
+    (the program's M3/M4 turns it for the first); None, none (no M03/M04 in force: the program
+    stopped it, and each hole is fed with it standing, as the control's alarm is per call).
     """
     ax = DRILL_AXIS[plane]
     a1, a2 = PLANE_AXES[plane]
@@ -160,6 +169,17 @@ def expand_cycle(kind: str, *, plane: str, position: dict[str, float], hole: dic
                 count += 1
             to_level("linear", bottom)
             to_level("rapid", clear)
+        elif kind in ("tap", "tap_left") and tap_end == "stopped":
+            fwd, rev = ("cw", "ccw") if kind == "tap" else ("ccw", "cw")
+            if tap_turns:
+                steps.append(("spindle", fwd))     # rigid mode: the tap turns the spindle (L3155)
+            to_level("linear", bottom)
+            steps += [("spindle", "off"), ("dwell", dwell_s or 0.0), ("spindle", rev)]
+            to_level("linear", approach)
+            steps += [("dwell", dwell_s or 0.0), ("spindle", "off")]
+            if clear != approach:
+                to_level("rapid", clear)
+            tap_turns = None if tap_turns is None else True
         elif kind in ("tap", "tap_left"):
             fwd, rev = ("cw", "ccw") if kind == "tap" else ("ccw", "cw")
             to_level("linear", bottom)
@@ -520,6 +540,8 @@ class CycleTable:
     swivel_mode: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "axis"}))
     swivel_retract: SwivelModes = field(default_factory=lambda: SwivelModes(modes={"0": "none"}))
     positioning: dict[str, Literal["clear_level", "current"]] = field(default_factory=dict)
+    tapping: dict[str, Literal["forward", "stopped"]] = field(default_factory=dict)
+    tapping_alarm: dict[str, str] = field(default_factory=dict)
     unmodelled: list[UnmodelledCycle] = field(default_factory=list)
     metric_coarse_pitch: dict[str, float] = field(default_factory=dict)
     milling: list[MillingCycle] = field(default_factory=list)
@@ -542,6 +564,8 @@ class CycleTable:
                    swivel_mode=SwivelModes(**d["swivel_mode"]),
                    swivel_retract=SwivelModes(**d["swivel_retract"]),
                    positioning=dict(d.get("positioning", {})),
+                   tapping=dict(d.get("tapping", {})),
+                   tapping_alarm=dict(d.get("tapping_alarm", {})),
                    unmodelled=[UnmodelledCycle(**u) for u in d.get("unmodelled", [])],
                    metric_coarse_pitch=dict(d.get("metric_coarse_pitch", {})),
                    milling=[MillingCycle(**m) for m in d.get("milling", [])],
@@ -562,6 +586,16 @@ class CycleTable:
             if own in ("clear_level", "current"):
                 return own
         return self.positioning.get(dialect, self.positioning.get("default", "clear_level"))
+
+    def tap_end(self, dialect: str, profile: Optional[str] = None) -> str:
+        """How an ISO G84/G74 of `dialect` ends each hole ([tapping]; see expand_cycle): "forward"
+        (LinuxCNC) or "stopped" (the Siemens ISO seed); a profile may override it (`cycle_tapping`)."""
+        if profile:
+            from nctrans.rules import option
+            own = ((option(dialect, "profiles") or {}).get(profile) or {}).get("cycle_tapping")
+            if own in ("forward", "stopped"):
+                return own
+        return self.tapping.get(dialect, self.tapping.get("default", "forward"))
 
     def neutral(self, name: str) -> str:
         """The neutral key of a Siemens parameter name, or its lowercase spelling if it has none."""

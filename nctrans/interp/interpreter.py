@@ -150,6 +150,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         # flagged. Moves then take the Python path, which reports the first feed move once.
         self.spindle_stopped = False
         self.spindle_reported = False
+        self.spindle_stopped_by_tap = False  # the last stop was an ISO tap's own (rules [tapping])
         self.spindle_angle = None         # where SPOS/M19 left the spindle (spindle_position.py)
         self.master_spindle = 1           # SETMS(n) (spindle_position.py); None: not known
         self.thread_start = 0.0           # SD 42000 THREAD_START_ANGLE (thread_starts.py)

@@ -172,6 +172,7 @@ class RunChecks:
             # the change leaves the spindle stopped: NC209 reports a cut before it starts again
             self.spindle_stopped = True
             self.spindle_reported = False
+            self.spindle_stopped_by_tap = False
 
 
 def _table_options(dialect) -> Optional[dict]:

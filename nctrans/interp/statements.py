@@ -95,6 +95,7 @@ class StatementsMixin:
             same = v in ("cw", "ccw") and v == st.spindle_dir and not self.spindle_stopped
             st.set(g, v)
             self.spindle_stopped = v == "off"
+            self.spindle_stopped_by_tap = False
             # M19 positions at SD 43240 M19_SPOS, 0 degrees by default (spindle_position.py)
             self.spindle_angle = 0.0 if v == "orient" else None
             self.spindle_reported = False

@@ -7,7 +7,8 @@ taps with its rigid tapping cycle, and LinuxCNC has a rigid tap of its own. The 
 table says which (`[options.flat_motion] tapping`, a profile overriding it:
 nctrans.dialects.emit.flat_forms):
 - "g84" (a Fanuc, ISO seed 4.1.11): the records of a G84 tap (in, spindle stopped, reversed,
-  dwell, out to where it began, stopped, forward) as `M29 S..` then `G99 G84 X.. Y.. Z<bottom>
+  dwell, out to where it began, stopped, forward; where the target's G84 ends with the spindle
+  stopped, rules/cycles.toml [tapping]: in, stopped, dwell, reversed, out, dwell, stopped) as `M29 S..` then `G99 G84 X.. Y.. Z<bottom>
   R<start> F<feed> [P<dwell>]` and G80 (G74 when the spindle turns M4); the tool stands at R, so
   the cycle's positioning moves nowhere;
 - "g33.1" (LinuxCNC): the records of a tap that reverses without stopping (in, reversed, out,
@@ -32,6 +33,10 @@ TEMPLATES = {
             ("spindle", "forward")),
     "g33.1": (("spindle", "reverse"), ("out",), ("spindle", "forward")),
 }
+# a G84 that ends with the spindle stopped (the target's rules/cycles.toml [tapping] "stopped": the
+# Siemens ISO seed L3179): stopped, dwell, reversed, out to R, dwell, stopped
+STOPPED_G84 = (("spindle", "off"), ("dwell",), ("spindle", "reverse"), ("out",), ("dwell",),
+               ("spindle", "off"))
 
 
 class TapWriter:
@@ -43,6 +48,8 @@ class TapWriter:
         self.fl = fl
         self.forms = forms
         self.template = TEMPLATES[forms["tapping"]]
+        if forms["tapping"] == "g84" and forms.get("tap_end") == "stopped":
+            self.template = STOPPED_G84
         self.replay = replay
         self.state = state
         self.held: list[tuple] = []
@@ -84,8 +91,10 @@ class TapWriter:
         if step[0] == "spindle":
             want = {"off": "off", "reverse": REVERSE[self.forward], "forward": self.forward}[step[1]]
             return rec.kind == "spindle" and rec.spindle_dir == want and rec.spindle in (None, down.spindle)
-        if step[0] == "dwell":
-            return rec.kind == "dwell" and rec.dwell_s is not None and rec.dwell_s >= 0
+        if step[0] == "dwell":         # one P dwells at both ends of a stopped G84
+            earlier = [r.dwell_s for r, *_ in self.held if r.kind == "dwell"]
+            return (rec.kind == "dwell" and rec.dwell_s is not None and rec.dwell_s >= 0
+                    and all(abs(d - rec.dwell_s) <= _EPS for d in earlier))
         return (rec.kind == "linear" and rec.pitch == down.pitch and rec.feed == down.feed
                 and rec.thread_start is None and rec.spindle == down.spindle
                 and _same(rec.start, down.end) and _same(rec.end, down.start))
@@ -130,6 +139,8 @@ class TapWriter:
         fl.blocks.append(n.Block(span, [n.ModeChange("cycle", "off")]))
         fl.feed = down.feed
         fl.motion = None                # G80: the next move writes its motion code again
+        if self.template is STOPPED_G84:
+            fl.spindle_dir = "off"      # the cycle left the spindle stopped: the next M3 is written
 
 
 def _same(a: Optional[dict], b: Optional[dict]) -> bool:
