@@ -786,6 +786,13 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
     dirs = list(search_path)
     oa = _open_run(a, read_a, dirs, "<a>", None)
     ob = _open_run(b, read_b, dirs, "<b>", None)
+    # a subprogram library against a program holding that subprogram: compared as called
+    from nctrans import library_equiv
+    called_pair = library_equiv.as_called(
+        oa, ob, lambda ca, cb, **kw: equiv(ca, cb, tol=tol, machine=machine, profile=profile,
+                                           profile_b=profile_b, **kw), dirs)
+    if called_pair is not None:
+        return called_pair
     _equiv_profiles(oa, ob, profile, profile_b)
     ma = mb = _equiv_machine(machine, oa[1], ob[1])
     # M99 in a main program loops, as a LOOP does; but where either side is a subprogram file (a

@@ -54,3 +54,32 @@ def test_iso_cannot_name_the_axis_so_the_motion_is_flattened_and_equivalent():
     conv = nctrans.transpile(AXFRAME, read="sinumerik", write="iso-m")
     assert conv.text is not None
     assert nctrans.equiv(AXFRAME, conv.text, read_a="sinumerik", read_b="iso-m")
+
+
+# ------------------------------------------------------------- a PROC library against its ISO file
+
+LIBRARY = "PROC SQUARE\nG91 G1 X10 F200\nY10\nG90\nRET\n"
+
+
+def test_a_proc_library_and_its_iso_conversion_compare_as_called(tmp_path):
+    # run alone the library runs nothing and its O-number conversion runs its body (X+10, Y+10):
+    # they differed at the first move. A one-line caller runs each: from X0 Y0, X10 then X10 Y10
+    conv = nctrans.transpile(LIBRARY, read="sinumerik", write="iso-m")
+    lib, iso = tmp_path / "SQUARE.SPF", tmp_path / "square.nc"
+    lib.write_text(LIBRARY)
+    iso.write_text(conv.text)
+    result = nctrans.equiv(lib, iso, read_a="sinumerik", read_b="iso-m")
+    assert result, result.message
+    assert result.records == (3, 3)                  # two feed moves and the caller's end, each side
+
+
+def test_a_different_subprogram_is_a_difference_named_in_the_files_given(tmp_path):
+    conv = nctrans.transpile(LIBRARY, read="sinumerik", write="iso-m")
+    lib, iso = tmp_path / "SQUARE.SPF", tmp_path / "square.nc"
+    lib.write_text(LIBRARY)
+    iso.write_text(conv.text.replace("X10.", "X5."))      # the converted file edited: X+5
+    result = nctrans.equiv(lib, iso, read_a="sinumerik", read_b="iso-m")
+    assert not result
+    # A's first move ends at X10 (SQUARE.SPF line 2), B's at X5: each named by the file given
+    assert result.difference.a.file == str(lib) and result.difference.a.line == 2
+    assert result.difference.b.file == str(iso)
