@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from typing import Callable, Optional
 
-from nctrans.interp import sections
+from nctrans.interp import contour_tables, sections
 from nctrans.interp.compiled import (Frame, JFALSE, JUMP, MAX_CALL_DEPTH, Unit, label_key,
                                      program_key)
 from nctrans.interp.evaluate import EvalError, Scope
@@ -53,6 +53,10 @@ class CallsMixin:
             self.moved = True
 
     def _h_call(self, s: n.SubCall):
+        what = self.contour_procs.get(s.name.upper()) if s.name and self.contour_procs else None
+        if what and s.modal == "none" and s.target is None:     # CONTPRON, EXECUTE .. (seed 14)
+            contour_tables.run_call(self, s, what)
+            return None
         if s.modal == "after_move":
             self.modal_call = (s, self._call_args(s), self._depth())
             return None

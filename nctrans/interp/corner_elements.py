@@ -96,7 +96,7 @@ def compile_word(it, s: n.Passthrough):
 
 def _h_word(d) -> None:
     it, kind, f, s = d
-    if it.capture is not None:          # reading a turning cycle's contour (lathe.py)
+    if it.capture is not None and it.contour_table is None:     # a turning cycle's contour (lathe.py)
         it.diag("NC220", "warning", f"{s.text.strip()!r} ({s.reason}) in a turning cycle's contour "
                 "is not modelled: the cycle's toolpath leaves it out")
         return
@@ -109,6 +109,10 @@ def _h_word(d) -> None:
     if v < 0 or (v == 0 and kind == "feed"):
         it.diag("NC120", "error", f"{s.text.strip()} must be {'greater than 0' if kind == 'feed' else 'a length without sign'}: "
                 "the control refuses it; nothing is inserted")
+        return
+    if it.contour_table is not None:    # filed with the element in a contour table (contour_tables)
+        from nctrans.interp import contour_tables
+        contour_tables.note_corner(it, kind, v, s.dialect)
         return
     cs = it.corner or CornerStage()
     it.corner = cs
@@ -453,6 +457,13 @@ def apply_to_contour(it, blocks, moves: list) -> list:
             words[id(blk)] = ("round", modal[0], modal[1])
     if not words:
         return moves
+    return insert_corners(it, moves, words)
+
+
+def insert_corners(it, moves: list, words: dict) -> list:
+    """The contour `moves` ((kind, start, end, centre, cw, span, key) in program coordinates) with
+    the corner elements `words` ({id(key): (kind, value, dialect)}) inserted after the last move
+    of each key: shared by turning-cycle contours and contour tables (contour_tables)."""
     a1, a2, _ = PLANE_AXES[it.st.plane]
     out: list = []
     for i, mv in enumerate(moves):

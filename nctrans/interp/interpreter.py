@@ -44,7 +44,7 @@ from typing import Any, Iterator, Optional
 
 from nctrans import plainrun
 from nctrans.diagnostics import at_span
-from nctrans.interp import comp_radius, edge_data, ggroups, settable_frames, sysvars, tool_change, tool_edges
+from nctrans.interp import comp_radius, contour_tables, edge_data, ggroups, settable_frames, sysvars, tool_change, tool_edges
 from nctrans.interp.evaluate import AxisName, EvalError, Evaluator, FrameValue
 from nctrans.interp.frames import Offsets, PLANE_AXES, ProgrammableFrame
 from nctrans.interp.lathe import LatheMixin
@@ -176,6 +176,8 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.polar_stored: Optional[tuple[float, float]] = None   # programmed (angle, radius)
         self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
         self.corner = None              # corner_elements.CornerStage while RND/CHF ... is in play
+        self.contour_table = None       # contour_tables.Session between CONTPRON/CONTDCON and EXECUTE
+        self.contour_procs = contour_tables.kinds(program)
         self.contour_offset = 0.0       # Sinumerik OFFN (contour_offset.py)
         self._unmodelled_at = None                          # the span of the block that set it
         self.spelt_codes: dict[str, str] = {}   # neutral group -> the code spelt last ($P_GG)

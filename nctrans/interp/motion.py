@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Optional
 
-from nctrans.interp import arcs, corner_elements, polar_input, polar_words, rigid_tap, thread_starts
+from nctrans.interp import arcs, contour_tables, corner_elements, polar_input, polar_words, rigid_tap, thread_starts
 from nctrans.interp.frames import PLANE_AXES
 from nctrans.interp.state import LINEAR_AXES
 from nctrans.ir import nodes as n
@@ -95,7 +95,7 @@ class MotionMixin:
                 or self.comp_exit or st.comp_side != "off" or not self.frame.identity
                 or self.unmodelled_motion is not None or st.diameter or st.polar
                 or self.css_surface is not None or self.spindle_stopped or self.watch
-                or self.corner is not None):
+                or self.corner is not None or self.capture is not None):
             return self._slow(d)
         motion = st.motion
         if motion == "rapid":
@@ -181,6 +181,9 @@ class MotionMixin:
         _, center, radius, turns, _, _, via, aperture = d
         st = self.st
         motion = st.motion
+        if self.contour_table is not None and motion not in contour_tables.CONTOUR_MOTIONS:
+            contour_tables.refuse_motion(self, motion)      # thread, spline .. in a contour table
+            return
         used = ARC_WORDS_USED.get(motion)
         if used is not None and (
                 (radius is not None and "radius" not in used) or (via and "via" not in used)
@@ -240,6 +243,8 @@ class MotionMixin:
 
     def _need_feed(self) -> None:
         st = self.st
+        if self.contour_table is not None:  # a contour table's blocks do not move (contour_tables)
+            return
         if not st.feed and not self.feed_reported:
             self.feed_reported = True
             if self.stack or not self._runs_from_a_caller():

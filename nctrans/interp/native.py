@@ -53,7 +53,7 @@ class NativeLaneMixin:
                 or not self.frame.identity or self.modal_call is not None or self.hook is not None
                 or st.feed_mode not in ("per_min", "per_rev") or self.out
                 or self.unmodelled_motion is not None or self.spindle_stopped or self.watch
-                or self.corner is not None or st.polar):
+                or self.corner is not None or st.polar or self.capture is not None):
             return False
         axes = "".join(self.pos)
         return len(axes) == len(self.pos) and axes == "".join(self.mpos) and _KERNEL_AXES.issuperset(axes)

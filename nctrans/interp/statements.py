@@ -56,6 +56,8 @@ class StatementsMixin:
         self._rc_mode(g, v)
         if s.code:
             self.spelt_codes[g] = s.code
+        if self.contour_table is not None:      # G9 in a contour table's block (contour_tables)
+            self.contour_table.note_mode(self, g)
         if g == "motion":
             if st.cycle != "off":
                 self._cycle_off()

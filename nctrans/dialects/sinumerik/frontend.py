@@ -110,13 +110,13 @@ _PATH = re.compile(r"^\s*;\s*\$PATH\s*=\s*(\S*)", re.IGNORECASE)
 _UNIT_NAME = re.compile(r"^_N_(\w+?)_(MPF|SPF)$", re.IGNORECASE)
 _PCALL_PATH = re.compile(r"\b(PCALL\s+)(/[^\s(]*/)([A-Za-z_]\w*)", re.IGNORECASE)
 _WORD_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-_SECTION_START = re.compile(r"^\s*(CTABDEF|CONTPRON|CONTDCON|CPROTDEF|NPROTDEF)\s*\(", re.IGNORECASE)
+# CONTPRON/CONTDCON .. EXECUTE are not sections: their blocks are parsed and run (the interpreter
+# files them in the contour table, nctrans.interp.contour_tables; rules options.contour_tables)
+_SECTION_START = re.compile(r"^\s*(CTABDEF|CPROTDEF|NPROTDEF)\s*\(", re.IGNORECASE)
 _G291 = re.compile(r"(?<![\w.])G291(?![\w.])", re.IGNORECASE)
 _G290 = re.compile(r"(?<![\w.])G290(?![\w.])", re.IGNORECASE)
-_SECTION_END = {"CTABDEF": "CTABEND", "CONTPRON": "EXECUTE", "CONTDCON": "EXECUTE",
-                "CPROTDEF": "EXECUTE", "NPROTDEF": "EXECUTE"}
-_SECTION_REASON = {"CTABDEF": "curve table definition", "CONTPRON": "contour table",
-                   "CONTDCON": "contour table", "CPROTDEF": "protection zone definition",
+_SECTION_END = {"CTABDEF": "CTABEND", "CPROTDEF": "EXECUTE", "NPROTDEF": "EXECUTE"}
+_SECTION_REASON = {"CTABDEF": "curve table definition", "CPROTDEF": "protection zone definition",
                    "NPROTDEF": "protection zone definition"}
 
 
@@ -1111,6 +1111,7 @@ class _FileParse:
         self.file = file
         self.low = Lowerer(file)
         self.low.meta["defaults"] = table().defaults()
+        self.low.meta["contour_tables"] = dict(table().options.get("contour_tables", {}))
         self.low.diags.extend(self.src.diagnostics)
         self.program = ir.Program(file, DIALECT, [], {}, self.low.meta)
 

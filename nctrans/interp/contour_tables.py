@@ -1,0 +1,630 @@
+"""Contour tables (seed 14, L23169-23960): CONTPRON / CONTDCON .. EXECUTE fill a REAL array with the
+contour the blocks between them describe, without moving the tool; EXECTAB traverses one row.
+
+Why: user stock-removal programs and cycle code (CYCLE95) read their contour through these
+tables; left unmodelled, such code moved nothing (NC220).
+
+- `CONTPRON(TAB, MACH, NN, MODE)` (L23230-23262, 11 columns, L23370-23400, L23470-23530): row per
+  element, col 0 previous row, col 1 next row (the printed tables, L23355-23365, L23440-23460,
+  and the footnotes L23505-23530, put "previous" in col 0; the column list's words are swapped),
+  col 2 code abc (a G90 0 / G91 1, b G70 0 / G71 1, c G0..G3), cols 3-4 start, 5-6 end
+  (abscissa, ordinate of the plane), col 7 relief marker, col 8 angle, cols 9-10 arc centre.
+  Row 0 is the first block's element (from the point where CONTPRON was called); row 0's cols
+  0/1 hold the row of the contour end and the last row used; the row after that holds the
+  number of relief cuts forwards (col 0) and backwards (col 1). MODE 1 (SW 4.4, L23262,
+  L23318-23320) adds the contour backwards from the table's last row down (L23516-23530).
+- `CONTDCON(TAB, MODE)` (L23540-23700, 6 columns): row 0 the start point (col 0 = 10 x unit code,
+  col 5 the last row), rows 1..n the elements: col 0 the code (L23680-23700), 1-2 end point,
+  3-4 arc centre, 5 the feed. MODE 0 only (L23655 "Value 1 is not permitted").
+- `EXECUTE(ERR)` ends the table (L23300-23312): ERR 0, or 1 when the contour was refused.
+- `EXECTAB(TAB[n])` (L23960-23985) runs row n of a CONTPRON table as one block.
+
+Derived from the seed's two CONTPRON tables (L23355-23365, L23440-23460), all [NC] where the
+text is silent: col 8 is the element's angle to the abscissa in [0, 180) (a line: its direction
+modulo 180; an arc: the largest value its tangent takes inside it, 180 when it reaches the
+horizontal from above); col 7 marks relief cuts: walking the contour, a relief starts at an
+element that descends (away from the material side: X falling for "L", rising for "G"; Z for the
+face modes "P"/"N" [NC]) and ends at the next element that rises; the start element holds the row
+of the end element, the end element minus the row of the next relief start, -1111 for none. An
+end element that rises above the relief's start level is split there; the rest is appended after
+the table's rows. The contour is extended along the ordinate to its extreme level when it does not
+end there (backwards in the seed's example 2). A relief starting at row 0 (the approach from the
+call point) is not counted. NN gets the forward count.
+Not derived, said at the line (NC242): an arc whose level turns inside it (col 7 and the count
+are then not reliable), transverse machining angles (col 8 measured from the ordinate [NC]).
+The table holds lengths as the blocks program them: program units, X a diameter under DIAMON.
+The blocks' modal changes and the position are undone at EXECUTE: the blocks were only read.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+from nctrans.interp.evaluate import Array, EvalError, Ref
+from nctrans.interp.frames import PLANE_AXES
+from nctrans.ir import nodes as n
+
+EPS = 1e-9
+RELIEF_NONE = -1111                      # seed L23358: the last relief's end marker
+PREPARE_COLS, DECODE_COLS = 11, 6
+_UNIT_CODE = {"G70": 0, "G71": 1, "G700": 2, "G710": 3}      # L23684 (CONTDCON tens)
+_PATH_CODE = {"G60": 0, "G64": 1, "G641": 2, "G642": 3}      # L23690 ("G44" read as G64 [NC])
+_FEED_CODE = {"inverse_time": 0, "per_min": 1, "per_rev": 2}  # L23688 (G96: 3)
+
+
+def kinds(program) -> dict:
+    """{procedure name: what it does} of the program's dialect (rules options.contour_tables)."""
+    meta = program.meta if isinstance(program.meta, dict) else {}
+    return meta.get("contour_tables") or {}
+
+
+@dataclass
+class Snapshot:
+    """The modal codes in force when a contour block moved (CONTDCON's code and feed)."""
+    incremental: bool
+    unit: int
+    feed_code: int
+    path_code: Optional[int]
+    exact_once: bool
+    feed: float
+    corner: Optional[tuple] = None       # (kind, value, dialect) of the block's RND/CHF
+    span: Any = None
+    scale: float = 1.0
+
+
+class _Capture(list):
+    """The interpreter's capture list (records._move appends (kind, start, end, centre, cw,
+    span)): each move gets the modal snapshot of its block."""
+
+    def __init__(self, it, session):
+        super().__init__()
+        self.it, self.session = it, session
+
+    def append(self, item):
+        super().append(tuple(item) + (self.session.snapshot(self.it),))
+
+
+@dataclass
+class Session:
+    kind: str                            # "prepare" (CONTPRON) or "decode" (CONTDCON)
+    table: Array
+    name: str
+    mach: str = "L"
+    nn: Any = None
+    mode: int = 0
+    span: Any = None
+    saved: tuple = ()
+    problems: list = field(default_factory=list)     # (span, message): the contour is refused
+    pending: Optional[tuple] = None      # (span, kind, value, dialect) of a corner word
+    modal_round: Optional[tuple] = None
+
+    exact_span: Any = None               # the block that programs G9 (non-modal)
+
+    def note_mode(self, it, group: str) -> None:
+        if group == "exact_stop_once":
+            self.exact_span = it.span
+
+    def snapshot(self, it) -> Snapshot:
+        st = it.st
+        spelt = it.spelt_codes
+        unit = spelt.get("units")
+        unit_code = _UNIT_CODE.get(str(unit).upper()) if unit else None
+        if unit_code is None:
+            unit_code = {"inch_geometry": 0, "inch": 2}.get(st.groups.get("units", "mm"), 1)
+        path = spelt.get("path_mode")
+        path_code = _PATH_CODE.get(str(path).upper(), None) if path else 0
+        feed_code = 3 if st.groups.get("spindle_mode") == "css" else _FEED_CODE.get(st.feed_mode, 1)
+        corner = None
+        if self.pending is not None and self.pending[0] is it.span:
+            corner = self.pending[1:]
+        elif self.modal_round is not None:
+            corner = ("round",) + self.modal_round
+        feed = (st.feed or 0.0) / (st.feed_scale or 1.0)
+        return Snapshot(st.incremental, unit_code, feed_code, path_code,
+                        self.exact_span is not None and self.exact_span is it.span, feed, corner,
+                        it.span, st.scale)
+
+
+CONTOUR_MOTIONS = frozenset(("rapid", "linear", "arc_cw", "arc_ccw", "arc_3point", "arc_tangent"))
+
+
+def refuse_motion(it, motion: str) -> None:
+    """A motion mode other than G0-G3/CIP/CT in a contour table's block (seed L23281-23285)."""
+    it.contour_table.problems.append((it.span, f"a {motion} move: only G0-G3 (with RND/CHF, CIP, CT) "
+                                      "may describe the contour (seed L23281-23285)"))
+
+
+def _problem(it, message: str, span=None) -> None:
+    it.diag("NC242", "error", message, span)
+
+
+# ---------------------------------------------------------------------------------------------
+# CONTPRON / CONTDCON / EXECUTE in the interpreter
+
+def run_call(it, s: n.SubCall, what: str) -> None:
+    """A contour-table procedure call (what: prepare, decode, execute, traverse)."""
+    if what == "traverse":
+        return traverse(it, s)
+    if what == "execute":
+        return execute(it, s)
+    name = s.name.upper()
+    if it.contour_table is not None:
+        _problem(it, f"{name} while the table of {it.contour_table.name} is still being filled "
+                 "(no EXECUTE since): the control alarms (seed L23640); the call is ignored")
+        return
+    args = list(s.args)
+    need = 3 if what == "prepare" else 1
+    if len(args) < need or type(args[0]) is not n.Var:
+        _problem(it, f"{name} needs {'TABNAME, MACH, NN' if need == 3 else 'TABNAME'} (seed "
+                 f"{'L23233' if need == 3 else 'L23578'}); the blocks up to EXECUTE still move nothing")
+        args = []
+    ev = it.ev
+    table = None
+    try:
+        table = ev.make_ref(args[0]) if args else None
+        mach, nn, mode = "L", None, 0
+        if what == "prepare" and args:
+            mach = str(ev.compile(args[1])()).strip().upper()
+            nn = ev.make_ref(args[2]) if len(args) > 2 and not _omitted(args[2]) else None
+            if len(args) > 3 and not _omitted(args[3]):
+                mode = int(round(float(ev.compile(args[3])())))
+        elif what == "decode" and len(args) > 1 and not _omitted(args[1]):
+            mode = int(round(float(ev.compile(args[1])())))
+    except (EvalError, TypeError, ValueError) as ex:
+        _problem(it, f"{name}: {ex}")
+        table = None
+    cols = PREPARE_COLS if what == "prepare" else DECODE_COLS
+    session = Session(what, table if isinstance(table, Array) else None,
+                      str(args[0].key).upper() if args else "?", mach, nn, mode, it.span)
+    if args and session.table is None:
+        session.problems.append((it.span, f"{name}: {args[0].key} is not an array"))
+    elif session.table is not None and (len(session.table.dims) != 2 or session.table.dims[1] != cols):
+        session.problems.append((it.span, f"{name}: the table {session.name} must be declared "
+                                 f"[rows, {cols}] (seed {'L23336' if cols == 11 else 'L23640'})"))
+    if what == "prepare" and mach not in ("G", "L", "N", "P"):
+        session.problems.append((it.span, f"CONTPRON machining type {mach!r}: the seed knows G, L, N, "
+                                 "P (L23236-23240)"))
+    if what == "prepare" and mode not in (0, 1):
+        session.problems.append((it.span, f"CONTPRON MODE {mode}: 0 forwards or 1 both directions "
+                                 "(seed L23262)"))
+    if what == "decode" and mode != 0:
+        session.problems.append((it.span, f"CONTDCON MODE {mode}: only 0 is permitted (seed L23655)"))
+    if it.st.comp_side != "off":
+        session.problems.append((it.span, f"{name} with tool radius compensation on: G40 must be "
+                                 "active before the call (seed L23275, L23610)"))
+    import copy
+    st = copy.copy(it.st)
+    st.groups = dict(it.st.groups)
+    session.saved = (it.pos, it.mpos, it.st, it.last_from, it.last_arc, it.css_surface,
+                     dict(it.spelt_codes), it.off.total, it.frame)
+    it.st = st
+    it.css_surface = None
+    it.contour_table = session
+    it.capture = _Capture(it, session)
+
+
+def _omitted(e) -> bool:
+    return type(e) is n.Num and e.text == ""
+
+
+def note_corner(it, kind: str, value: float, dialect: str) -> None:
+    """RND/CHF/RNDM inside the table's blocks: kept for the element they end (EXECUTE)."""
+    session = it.contour_table
+    if kind == "round_modal":
+        session.modal_round = (value, dialect) if value > 0 else None
+    elif kind in ("feed", "feed_modal"):
+        return
+    else:
+        session.pending = (it.span, kind, value, dialect) if value > 0 else None
+
+
+def execute(it, s: n.SubCall) -> None:
+    """EXECUTE(ERR): the table from the moves read since CONTPRON/CONTDCON; ERR 0 or 1."""
+    session = it.contour_table
+    err_ref = it.ev.make_ref(s.args[0]) if s.args and type(s.args[0]) is n.Var else None
+    if session is None:
+        _problem(it, "EXECUTE without CONTPRON or CONTDCON before it: nothing to end")
+        return
+    moves = list(it.capture)
+    (it.pos, it.mpos, it.st, it.last_from, it.last_arc, it.css_surface, spelt, total,
+     frame) = session.saved
+    it.spelt_codes.clear()
+    it.spelt_codes.update(spelt)
+    it.capture = None
+    it.contour_table = None
+    problems = list(session.problems)
+    if it.off.total != total or it.frame is not frame:
+        problems.append((it.span, "a frame or offset changed between the call and EXECUTE (seed "
+                         "L23290)"))
+    rows = None
+    if not problems:
+        try:
+            rows = _rows(it, session, moves, problems)
+        except _Refused as ex:
+            problems.append((ex.span or it.span, str(ex)))
+    for span, message in problems:
+        _problem(it, f"contour table {session.name}: {message}; EXECUTE returns 1", span)
+    if rows is not None and not problems:
+        table = session.table
+        table.data.clear()
+        count = rows.pop("_count", 0)
+        for r, row in rows.items():
+            for c, v in enumerate(row):
+                if v:
+                    table.set((r, c), float(v))
+        if session.kind == "prepare" and isinstance(session.nn, Ref):
+            session.nn.set(int(count))
+    if isinstance(err_ref, Ref):
+        err_ref.set(1 if problems else 0)
+
+
+class _Refused(Exception):
+    def __init__(self, message: str, span=None):
+        super().__init__(message)
+        self.span = span
+
+
+# ---------------------------------------------------------------------------------------------
+# Elements in table measure
+
+@dataclass
+class Element:
+    code: int                      # G0..G3 (c digit)
+    start: tuple
+    end: tuple
+    centre: Optional[tuple]
+    snap: Optional[Snapshot]
+    span: Any = None
+
+
+def _elements(it, session, moves) -> tuple[tuple, list]:
+    """(start point, elements) in table measure: plane (abscissa, ordinate), program units, X a
+    diameter under DIAMON; RND/CHF inserted."""
+    st = it.st
+    a1, a2, normal = PLANE_AXES[st.plane]
+    from nctrans.interp import corner_elements
+    keyed = [(k, s, e, c, cw, sp, snap) for k, s, e, c, cw, sp, snap in moves]
+    words = {id(m[6]): m[6].corner for m in keyed if m[6].corner is not None}
+    if words:
+        keyed = corner_elements.insert_corners(it, keyed, words)
+    if not keyed:
+        raise _Refused("no contour block between the call and EXECUTE (seed L23640: too few "
+                       "contour blocks)")
+
+    def f(axis: str, v: float) -> float:
+        v = v / (st.scale or 1.0)
+        return 2 * v if axis == "X" and st.diameter else v
+
+    def pt(p) -> tuple:
+        return (f(a1, p.get(a1, 0.0)), f(a2, p.get(a2, 0.0)))
+    out = []
+    for kind, s, e, c, cw, sp, snap in keyed:
+        if isinstance(snap, Snapshot) and abs(snap.scale - st.scale) > EPS:
+            raise _Refused("G70/G71/G700/G710 changed between the call and EXECUTE (seed L23290)", sp)
+        if kind not in ("rapid", "linear", "arc"):
+            raise _Refused(f"a {kind} move: only G0-G3 (with RND/CHF, CIP, CT) may describe the "
+                           "contour (seed L23281-23285)", sp)
+        if abs(s.get(normal, 0.0) - e.get(normal, 0.0)) > 1e-6:
+            raise _Refused(f"a move along {normal}, out of the plane: the table holds plane "
+                           "elements only [NC]", sp)
+        code = {"rapid": 0, "linear": 1}.get(kind, 2 if cw else 3)
+        centre = None
+        if kind == "arc":
+            centre = (f(a1, c[0]), f(a2, c[1]))
+        out.append(Element(code, pt(s), pt(e), centre, snap if isinstance(snap, Snapshot) else None, sp))
+    return out[0].start, out
+
+
+def _rows(it, session, moves, problems) -> dict:
+    start, elements = _elements(it, session, moves)
+    if session.kind == "decode":
+        return _decode_rows(session, start, elements)
+    return _prepare_rows(it, session, elements, problems)
+
+
+def _decode_rows(session, start, elements) -> dict:
+    """CONTDCON rows (L23660-23700)."""
+    need = len(elements) + 1
+    if need > session.table.dims[0]:
+        raise _Refused(f"{len(elements)} elements need {need} rows; the table has "
+                       f"{session.table.dims[0]} (seed L23640)")
+    first = elements[0].snap
+    rows = {0: [10 * (first.unit if first else 1), start[0], start[1], 0, 0, len(elements)]}
+    for i, el in enumerate(elements, 1):
+        sn = el.snap
+        if sn.path_code is None:
+            raise _Refused("a continuous-path mode CONTDCON cannot code (G60, G64, G641, G642 only, "
+                           "seed L23690)", el.span)
+        code = (el.code + 10 * sn.unit + 100 * int(sn.incremental) + 1000 * sn.feed_code
+                + 10000 * sn.path_code + 100000 * int(sn.exact_once))
+        c = el.centre or (0.0, 0.0)
+        rows[i] = [code, el.end[0], el.end[1], c[0], c[1], sn.feed]
+    return rows
+
+
+# ---------------------------------------------------------------------------------------------
+# CONTPRON
+
+def _norm180(a: float) -> float:
+    a = math.fmod(a, 180.0)
+    if a < 0:
+        a += 180.0
+    return 0.0 if abs(a - 180.0) < 1e-9 or abs(a) < 1e-9 else a
+
+
+def sweep(start, end, centre, cw: bool) -> float:
+    """Signed sweep (degrees, ccw positive) of an arc; a full circle when start == end."""
+    a0 = math.atan2(start[1] - centre[1], start[0] - centre[0])
+    a1 = math.atan2(end[1] - centre[1], end[0] - centre[0])
+    d = math.degrees(a1 - a0)
+    if cw:
+        d = d % 360.0
+        d = -(360.0 - d) if d > 1e-9 else -360.0
+    else:
+        d = d % 360.0
+        d = d if d > 1e-9 else 360.0
+    return d
+
+
+def angle(el: Element, transverse: bool) -> float:
+    """Column 8: the element's angle to the abscissa (to the ordinate when transverse [NC])."""
+    def direction(dx, dy):
+        return math.degrees(math.atan2(dx, dy)) if transverse else math.degrees(math.atan2(dy, dx))
+    if el.centre is None:
+        return _norm180(direction(el.end[0] - el.start[0], el.end[1] - el.start[1]))
+    cw = el.code == 2
+    r0 = (el.start[0] - el.centre[0], el.start[1] - el.centre[1])
+    t0 = (r0[1], -r0[0]) if cw else (-r0[1], r0[0])
+    sw = sweep(el.start, el.end, el.centre, cw)
+    phi0 = direction(*t0)
+    phi1 = phi0 + (-sw if transverse else sw)
+    lo, hi = min(phi0, phi1), max(phi0, phi1)
+    k = math.floor(hi / 180.0 + 1e-12)
+    if 180.0 * k > lo + 1e-9:          # a multiple of 180 in (lo, hi]: approached from below
+        return 180.0
+    return _norm180(hi) if _norm180(hi) > 0 else 180.0
+
+
+def _level(mach: str):
+    """The level a relief is judged on and its sign: (coordinate index, sign)."""
+    return {"L": (1, 1.0), "G": (1, -1.0), "P": (0, 1.0), "N": (0, -1.0)}[mach]
+
+
+def _arc_turns(el: Element, axis: int) -> bool:
+    """True when the arc's coordinate `axis` has an extremum strictly inside it."""
+    sw = sweep(el.start, el.end, el.centre, el.code == 2)
+    a0 = math.degrees(math.atan2(el.start[1] - el.centre[1], el.start[0] - el.centre[0]))
+    targets = (90.0, 270.0) if axis == 1 else (0.0, 180.0)
+    for t in targets:
+        d = (t - a0) % 360.0 if sw > 0 else (a0 - t) % 360.0
+        if 1e-9 < d < abs(sw) - 1e-9:
+            return True
+    return False
+
+
+def _split(el: Element, axis: int, value: float) -> tuple[Element, Element]:
+    """A line split where its coordinate `axis` reaches `value`."""
+    t = (value - el.start[axis]) / (el.end[axis] - el.start[axis])
+    p = tuple(el.start[i] + t * (el.end[i] - el.start[i]) for i in range(2))
+    p = tuple(value if i == axis else p[i] for i in range(2))
+    return (Element(el.code, el.start, p, None, el.snap, el.span),
+            Element(el.code, p, el.end, None, el.snap, el.span))
+
+
+def _split_arc(el: Element, axis: int, value: float) -> Optional[tuple]:
+    r = math.hypot(el.start[0] - el.centre[0], el.start[1] - el.centre[1])
+    other = 1 - axis
+    d = value - el.centre[axis]
+    if abs(d) > r:
+        return None
+    h = math.sqrt(max(r * r - d * d, 0.0))
+    sw = sweep(el.start, el.end, el.centre, el.code == 2)
+    a0 = math.atan2(el.start[1] - el.centre[1], el.start[0] - el.centre[0])
+    best = None
+    for sgn in (1.0, -1.0):
+        q = [0.0, 0.0]
+        q[axis] = value
+        q[other] = el.centre[other] + sgn * h
+        a = math.atan2(q[1] - el.centre[1], q[0] - el.centre[0])
+        dd = math.degrees(a - a0) % 360.0 if sw > 0 else math.degrees(a0 - a) % 360.0
+        if 1e-9 < dd < abs(sw) - 1e-9 and (best is None or dd < best[0]):
+            best = (dd, tuple(q))
+    if best is None:
+        return None
+    p = best[1]
+    return (Element(el.code, el.start, p, el.centre, el.snap, el.span),
+            Element(el.code, p, el.end, el.centre, el.snap, el.span))
+
+
+def _extreme(elements: list, axis: int, sign: float) -> float:
+    """The contour's extreme level (largest sign*coordinate), arcs' inner extremes included."""
+    best = None
+    for el in elements:
+        vals = [el.end[axis]] + ([el.start[axis]] if best is not None else [])
+        if el.centre is not None:
+            r = math.hypot(el.start[0] - el.centre[0], el.start[1] - el.centre[1])
+            if _arc_turns(el, axis):
+                vals += [el.centre[axis] + r, el.centre[axis] - r]
+                vals = [v for v in vals if v is not None]
+        for v in vals:
+            if best is None or sign * v > sign * best:
+                best = v
+    return best
+
+
+def _chain(it, session, elements: list, first_is_approach: bool, extend_to: Optional[float],
+           alloc, problems) -> tuple[list, list, int]:
+    """Relief analysis of one direction. elements in contour order; alloc() gives the next free
+    row. Returns (rows in chain order as (row, Element, marker)), count of reliefs, rows used."""
+    axis, sign = _level(session.mach)
+    chain = [[alloc(), el, 0] for el in elements]
+    last = chain[-1][1]
+    if extend_to is not None and abs(last.end[axis] - extend_to) > 1e-9:
+        p = list(last.end)
+        p[axis] = extend_to
+        chain.append([alloc(), Element(1, last.end, tuple(p), None, last.snap, last.span), 0])
+    reported = False
+    inside = None                       # (index in chain, level) of the open relief's start
+    starts: list[int] = []               # chain indices of relief starts
+    ends: list[int] = []
+    i = 0
+    while i < len(chain):
+        el = chain[i][1]
+        if el.centre is not None and _arc_turns(el, axis) and not reported:
+            reported = True
+            problems.append(("warn", el.span, "an arc whose level turns inside it: col 7 (relief "
+                             "markers) and the relief count are not derived for it [NC]"))
+        h0, h1 = sign * el.start[axis], sign * el.end[axis]
+        if inside is None and h1 < h0 - 1e-9:
+            inside = (i, h0)
+            starts.append(i)
+        elif inside is not None and h1 > h0 + 1e-9:
+            top = inside[1]
+            if h1 > top + 1e-9:          # above the relief's start level: split there
+                pieces = (_split(el, axis, sign * top) if el.centre is None
+                          else _split_arc(el, axis, sign * top))
+                if pieces is not None:
+                    chain[i][1] = pieces[0]
+                    chain.insert(i + 1, [alloc(), pieces[1], 0])
+            ends.append(i)
+            inside = None
+        i += 1
+    for k, si in enumerate(starts):
+        if k < len(ends):
+            chain[si][2] = chain[ends[k]][0]
+    for k, ei in enumerate(ends):
+        nxt = starts[k + 1] if k + 1 < len(starts) else None
+        chain[ei][2] = -chain[nxt][0] if nxt is not None else RELIEF_NONE
+    count = sum(1 for si in starts if not (first_is_approach and si == 0))
+    return chain, count
+
+
+def _prepare_rows(it, session, elements: list, problems) -> dict:
+    """CONTPRON rows (L23336-23530)."""
+    size = session.table.dims[0]
+    transverse = session.mach in ("N", "P")
+    axis, sign = _level(session.mach)
+    extreme = _extreme(elements, axis, sign)
+    rows: dict = {}
+    free = {"next": 0}
+
+    def alloc_fwd():
+        r = free["next"]
+        free["next"] += 1
+        return r
+    fwd, count_f = _chain(it, session, elements, True, extreme, alloc_fwd, problems)
+    fwd_end = free["next"] - 1
+    count_b = 0
+    bwd = []
+    if session.mode == 1:
+        down = {"next": size - 2}
+
+        def alloc_bwd():
+            r = down["next"]
+            down["next"] -= 1
+            return r
+        rev = [Element({2: 3, 3: 2}.get(el.code, el.code), el.end, el.start, el.centre, el.snap, el.span)
+               for el in reversed(elements[1:])]
+        # the reversed elements take rows from the table's end in forward order (L23440-23460)
+        rows_for = {id(el): alloc_bwd() for el in reversed(rev)}
+        bwd, count_b = _chain_bwd(it, session, rev, rows_for, extreme, alloc_bwd, problems)
+        lowest = down["next"] + 1
+        if lowest <= fwd_end + 1:
+            raise _Refused(f"the table of {size} rows is too small for both directions (seed L23640)")
+    if fwd_end + 1 >= size:
+        raise _Refused(f"the contour needs {fwd_end + 2} rows; the table has {size} (seed L23640)")
+    warnings = [p for p in problems if p and p[0] == "warn"]
+    for w in warnings:
+        problems.remove(w)
+        it.diag("NC243", "warning", f"contour table {session.name}: {w[2]}", w[1])
+
+    def code(el):
+        sn = el.snap
+        a = int(sn.incremental) if sn else 0
+        b = 1 if (sn is None or sn.unit in (1, 3)) else 0
+        return 100 * a + 10 * b + el.code
+
+    def fill(chain, first_prev, last_next):
+        for k, (r, el, marker) in enumerate(chain):
+            prev = chain[k - 1][0] if k else first_prev
+            nxt = chain[k + 1][0] if k + 1 < len(chain) else last_next
+            c = el.centre or (0.0, 0.0)
+            rows[r] = [prev, nxt, code(el), el.start[0], el.start[1], el.end[0], el.end[1],
+                       marker, angle(el, transverse), c[0], c[1]]
+    fill(fwd, 0, 0)
+    rows[0][0] = fwd[-1][0]             # contour end forwards (L23505)
+    rows[0][1] = fwd_end                # contour table end forwards (L23507)
+    rows[0][7] = 0
+    rows[fwd_end + 1] = [count_f, count_b] + [0] * 9
+    if session.mode == 1:
+        fill(bwd, 0, 0)
+        e0 = elements[0]
+        back0 = Element({2: 3, 3: 2}.get(e0.code, e0.code), e0.end, e0.start, e0.centre, e0.snap, e0.span)
+        c = back0.centre or (0.0, 0.0)
+        rows[size - 1] = [min(r for r, _, _ in bwd), bwd[0][0], code(back0), back0.start[0],
+                          back0.start[1], back0.end[0], back0.end[1], 0, angle(back0, transverse),
+                          c[0], c[1]]
+    rows["_count"] = count_f
+    return rows
+
+
+def _chain_bwd(it, session, rev, rows_for, extreme, alloc, problems):
+    """The backward chain: the reversed elements keep the rows allocated from the table's end in
+    forward order (rows_for); extensions and splits take the next rows down."""
+    pending = [rows_for[id(el)] for el in rev]
+    state = {"i": 0}
+
+    def alloc_b():
+        if state["i"] < len(pending):
+            r = pending[state["i"]]
+            state["i"] += 1
+            return r
+        return alloc()
+    return _chain(it, session, rev, False, extreme, alloc_b, problems)
+
+
+# ---------------------------------------------------------------------------------------------
+# EXECTAB
+
+def traverse(it, s: n.SubCall) -> None:
+    """EXECTAB(TAB[n]): row n of a CONTPRON table as one block: its G code (G0-G3) to its end
+    point, an arc about its centre (L23960-23985). The end point is absolute [NC]; the modal
+    motion code is not changed (the seed: "non-modally", L23978)."""
+    arg = s.args[0] if s.args else None
+    if type(arg) is not n.Var or len(arg.indices or ()) != 1:
+        _problem(it, "EXECTAB needs one table row, EXECTAB(TAB[n]) (seed L23965); nothing moves")
+        return
+    try:
+        store = it.ev._lookup_name(str(arg.key).upper())
+        table = store[str(arg.key).upper()] if store is not None else None
+        if type(table) is Ref:
+            table = table.get()
+        row = int(round(float(it.ev.compile(arg.indices[0])())))
+    except (EvalError, TypeError, ValueError) as ex:
+        _problem(it, f"EXECTAB: {ex}; nothing moves")
+        return
+    if not isinstance(table, Array) or len(table.dims) != 2 or table.dims[1] != PREPARE_COLS:
+        _problem(it, f"EXECTAB: {arg.key} is not a CONTPRON table (11 columns, seed L23950); nothing moves")
+        return
+    if not 0 <= row < table.dims[0]:
+        _problem(it, f"EXECTAB: row {row} outside the table; nothing moves")
+        return
+    vals = [float(table.get((row, c)) or 0.0) for c in range(PREPARE_COLS)]
+    g = int(round(vals[2])) % 10
+    st = it.st
+    a1, a2, _ = PLANE_AXES[st.plane]
+
+    def f(axis, v):
+        v = v * st.scale
+        return v / 2 if axis == "X" and st.diameter else v
+    end = it._target([(a1, f(a1, vals[5]), "abs"), (a2, f(a2, vals[6]), "abs")])
+    it.moved = True
+    if g == 0:
+        it._move("rapid", end)
+    elif g == 1:
+        it._need_feed()
+        it._move("linear", end)
+    else:
+        it._need_feed()
+        it._move("arc", end, (f(a1, vals[9]), f(a2, vals[10])), g == 2)

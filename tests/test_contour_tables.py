@@ -1,0 +1,279 @@
+"""Contour tables CONTPRON / CONTDCON .. EXECUTE and EXECTAB (seed 14.2-14.5, L23169-23985;
+nctrans.interp.contour_tables): the seed's own example tables reproduced exactly, small contours
+computed by hand, and what is refused at its line."""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from nctrans.dialects.sinumerik.frontend import parse
+from nctrans.interp.interpreter import Interpreter
+
+
+def run(text: str):
+    res = parse(text, "t.mpf")
+    diags: list = list(res.diagnostics)
+    it = Interpreter(res.program, diagnostics=diags)
+    recs = list(it.run())
+    return it, recs, diags
+
+
+def table(it, name: str) -> list[list[float]]:
+    arr = it.ev.scope.names.get(name) or it.ev.global_names.get(name)
+    return [[float(arr.get((r, c))) for c in range(arr.dims[1])] for r in range(arr.dims[0])]
+
+
+def var(it, name: str):
+    return (it.ev.scope.names.get(name) if name in it.ev.scope.names else it.ev.global_names.get(name))
+
+
+def rules(diags) -> list[str]:
+    return [d.rule for d in diags if d.severity in ("error", "warning")]
+
+
+def same(got: list[list[float]], want: list[list[float]]) -> None:
+    for r, (g, w) in enumerate(zip(got, want)):
+        assert all(math.isclose(a, b, abs_tol=1e-7) for a, b in zip(g, w)), (r, g, w)
+    assert len(got) == len(want)
+
+
+# ------------------------------------------------------------------ the seed's examples
+
+SEED_1 = """N10 DEF REAL KTAB[30,11]
+N20 DEF INT ANZHINT
+N30 DEF INT ERROR
+N40 G18
+N50 CONTPRON (KTAB, "G", ANZHINT)
+N60 G1 X150 Z20
+N70 X110 Z30
+N80 X50 RND=15
+N90 Z70
+N100 X40 Z85
+N110 X30 Z90
+N120 X0
+N130 EXECUTE(ERROR)
+M30
+"""
+# seed L23355-23365 (the tool at Z0 X0 when CONTPRON is called); rows 8.. are zeros
+SEED_1_TABLE = [
+    [7, 7, 11, 0, 0, 20, 150, 0, 82.40535663, 0, 0],
+    [0, 2, 11, 20, 150, 30, 110, -1111, 104.0362435, 0, 0],
+    [1, 3, 11, 30, 110, 30, 65, 0, 90, 0, 0],
+    [2, 4, 13, 30, 65, 45, 50, 0, 180, 45, 65],
+    [3, 5, 11, 45, 50, 70, 50, 0, 0, 0, 0],
+    [4, 6, 11, 70, 50, 85, 40, 0, 146.3099325, 0, 0],
+    [5, 7, 11, 85, 40, 90, 30, 0, 116.5650512, 0, 0],
+    [6, 0, 11, 90, 30, 90, 0, 0, 90, 0, 0],
+] + [[0] * 11] * 22
+
+
+def test_contpron_seed_example_1():
+    it, recs, diags = run(SEED_1)
+    assert rules(diags) == []
+    got = table(it, "KTAB")
+    same([[round(v, 7) for v in row] for row in got], [[round(v, 7) for v in row] for row in SEED_1_TABLE])
+    assert var(it, "ANZHINT") == 0 and var(it, "ERROR") == 0
+    assert [r.kind for r in recs] == ["stop"]          # the contour's blocks move nothing
+
+
+SEED_2 = """N10 DEF REAL KTAB[92,11]
+N20 DEF CHAR BT="L"
+N30 DEF INT HE=0
+N40 DEF INT MODE=1
+N50 DEF INT ERR=0
+N100 G18 X100 Z100 F1000
+N105 CONTPRON (KTAB, BT, HE, MODE)
+N110 G1 G90 Z20 X20
+N120 X45
+N130 Z0
+N140 G2 Z-15 X30 K=AC(-15) I=AC(45)
+N150 G1 Z-30
+N160 X80
+N170 Z-40
+N180 EXECUTE(ERR)
+N190 G1 X0
+M30
+"""
+# seed L23440-23460 (forwards and backwards); every other row is zeros
+SEED_2_ROWS = {
+    0: [6, 7, 11, 100, 100, 20, 20, 0, 45, 0, 0],
+    1: [0, 2, 11, 20, 20, 20, 45, -3, 90, 0, 0],
+    2: [1, 3, 11, 20, 45, 0, 45, 0, 0, 0, 0],
+    3: [2, 4, 12, 0, 45, -15, 30, 5, 90, -15, 45],
+    4: [3, 5, 11, -15, 30, -30, 30, 0, 0, 0, 0],
+    5: [4, 7, 11, -30, 30, -30, 45, -1111, 90, 0, 0],
+    6: [7, 0, 11, -30, 80, -40, 80, 0, 0, 0, 0],
+    7: [5, 6, 11, -30, 45, -30, 80, 0, 90, 0, 0],
+    8: [1, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+    83: [84, 0, 11, 20, 45, 20, 80, 0, 90, 0, 0],
+    84: [90, 83, 11, 20, 20, 20, 45, -1111, 90, 0, 0],
+    85: [0, 86, 11, -40, 80, -30, 80, 0, 0, 0, 0],
+    86: [85, 87, 11, -30, 80, -30, 30, 88, 90, 0, 0],
+    87: [86, 88, 11, -30, 30, -15, 30, 0, 0, 0, 0],
+    88: [87, 89, 13, -15, 30, 0, 45, -90, 90, -15, 45],
+    89: [88, 90, 11, 0, 45, 20, 45, 0, 0, 0, 0],
+    90: [89, 84, 11, 20, 45, 20, 20, 84, 90, 0, 0],
+    91: [83, 85, 11, 20, 20, 100, 100, 0, 45, 0, 0],
+}
+
+
+def test_contpron_seed_example_2_both_directions():
+    it, recs, diags = run(SEED_2)
+    assert rules(diags) == []
+    same(table(it, "KTAB"), [SEED_2_ROWS.get(r, [0] * 11) for r in range(92)])
+    assert var(it, "HE") == 1 and var(it, "ERR") == 0          # NN: relief cuts forwards [NC]
+    # the tool stayed at X100 Z100: the G1 after EXECUTE starts there
+    moves = [r for r in recs if r.kind == "linear"]
+    assert moves[-1].start == {"X": 100.0, "Y": 0.0, "Z": 100.0}
+    assert moves[-1].end["X"] == 0.0
+
+
+SEED_3 = """N10 DEF REAL KTAB[9,6]
+N20 DEF INT MODE = 0
+N30 DEF INT ERROR = 0
+N100 G18 G64 G90 G94 G710
+N101 G1 Z100 X100 F1000
+N105 CONTDCON (KTAB, MODE)
+N110 G1 Z20 X20 F200
+N120 G9 X45 F300
+N130 Z0 F400
+N140 G2 Z-15 X30 K=AC(-15) I=AC(45)F100
+N150 G1 G64 Z-30 F600
+N160 X80 F700
+N170 Z-40 F800
+N180 EXECUTE(ERROR)
+M30
+"""
+# seed L23660-23672. The seed's N150 has no G1 (G2 would stay in force); its table codes G1.
+SEED_3_TABLE = [
+    [30, 100, 100, 0, 0, 7],
+    [11031, 20, 20, 0, 0, 200],
+    [111031, 20, 45, 0, 0, 300],
+    [11031, 0, 45, 0, 0, 400],
+    [11032, -15, 30, -15, 45, 100],
+    [11031, -30, 30, 0, 0, 600],
+    [11031, -30, 80, 0, 0, 700],
+    [11031, -40, 80, 0, 0, 800],
+    [0, 0, 0, 0, 0, 0],
+]
+
+
+def test_contdcon_seed_example():
+    it, recs, diags = run(SEED_3)
+    assert rules(diags) == []
+    same(table(it, "KTAB"), SEED_3_TABLE)
+    assert var(it, "ERROR") == 0
+
+
+# ------------------------------------------------------------------ small contours by hand
+
+def test_contpron_line_arc_hand_computed():
+    # G17 (abscissa X, ordinate Y), "L": from (0,0) G1 to (10,0), G3 to (20,10) about (10,10),
+    # G1 to (20,30). Row 0 the first line: angle 0. Row 1 the arc: its tangent turns from 0 to
+    # 90 degrees (ccw, start radius (0,-10) -> tangent (10,0)): largest value 90.
+    # Row 2 the line up: 90. The ordinate rises all the way: no relief, no marker, NN 0.
+    # The end Y30 is the contour's highest level: no extension.
+    it, _, diags = run("DEF REAL TB[6,11]\nDEF INT NN=7, ER=5\nG17 G0 X0 Y0\nCONTPRON(TB, \"L\", NN, 0)\n"
+                       "G1 X10\nG3 X20 Y10 I0 J10\nG1 Y30\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    same(table(it, "TB")[:4], [
+        [2, 2, 11, 0, 0, 10, 0, 0, 0, 0, 0],
+        [0, 2, 13, 10, 0, 20, 10, 0, 90, 10, 10],
+        [1, 0, 11, 20, 10, 20, 30, 0, 90, 0, 0],
+        [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+    ])
+    assert var(it, "NN") == 0 and var(it, "ER") == 0
+
+
+def test_contpron_relief_split_and_extension_hand_computed():
+    # G18 "L" (level X), start Z0 X50. Row 0: G1 to Z-10 X40 (falls: a relief from level 50
+    # starts at row 0, not counted); row 1: Z-20 (flat); row 2: X20 (falls, still inside);
+    # row 3: Z-30 X60 rises 20 -> 60, above the open relief's start level 50: split at X50,
+    # t = (50-20)/(60-20) = 0.75 -> Z = -20 + 0.75 * -10 = -27.5. Row 3 keeps (-20,20)->(-27.5,50)
+    # (relief end, no further relief: -1111); the rest (-27.5,50)->(-30,60) goes to row 4.
+    # Row 0 marks nothing (col 7 of row 0 is not a marker). The end X60 is the highest level.
+    # Angles: row 0 atan2(-10,-10) = -135 -> 45; row 3 atan2(30,-7.5) = 104.036..; row 4
+    # atan2(10,-2.5) = 104.036.. (the same line).
+    it, _, diags = run("DEF REAL TB[8,11]\nDEF INT NN, ER\nG18 G0 X50 Z0\nCONTPRON(TB, \"L\", NN)\n"
+                       "G1 Z-10 X40\nZ-20\nX20\nZ-30 X60\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    a = math.degrees(math.atan2(30, -7.5))
+    same(table(it, "TB")[:6], [
+        [4, 4, 11, 0, 50, -10, 40, 0, 45, 0, 0],
+        [0, 2, 11, -10, 40, -20, 40, 0, 0, 0, 0],
+        [1, 3, 11, -20, 40, -20, 20, 0, 90, 0, 0],
+        [2, 4, 11, -20, 20, -27.5, 50, -1111, a, 0, 0],
+        [3, 0, 11, -27.5, 50, -30, 60, 0, a, 0, 0],
+        [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+    ])
+    assert var(it, "NN") == 0
+    # the relief in the middle (row 2 falls after the flat row 1) is the same relief as row 0's:
+    # it was still open, so row 2 holds no start marker
+
+
+def test_contpron_counts_a_relief_after_the_start():
+    # "L", start Z0 X30: row 0 to Z-5 X30 (flat), row 1 Z-10 X20 (falls from 30: relief 1 starts,
+    # counted), row 2 Z-15 (flat), row 3 Z-20 X30 (rises back to 30: its end, no split).
+    # Markers: row 1 -> 3, row 3 -> -1111. NN 1, row 5 (table end 4? no: rows 0-3, end 3) + 1 = 4.
+    it, _, diags = run("DEF REAL TB[6,11]\nDEF INT NN, ER\nG18 G0 X30 Z0\nCONTPRON(TB, \"L\", NN)\n"
+                       "G1 Z-5\nZ-10 X20\nZ-15\nZ-20 X30\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    t = table(it, "TB")
+    assert [row[7] for row in t[:4]] == [0, 3, 0, -1111]
+    assert t[4][:2] == [1, 0] and var(it, "NN") == 1
+
+
+def test_contdcon_inch_incremental_and_diameter():
+    # G700 (unit code 2), G91 (hundreds 1), G95 (thousands 2), G60 default (0); DIAMON: the table
+    # holds X as programmed (a diameter [NC]): G91 X2 from X10 (diameter) ends at X12.
+    # Row 0: 10*2 = 20, start (Z0, X10), last row 2. Row 1: 1 + 20 + 100 + 2000 = 2121, end
+    # (Z-1, X12), feed F0.2 (as programmed). Row 2: G0 (0) + 20 + 100 + 2000 = 2120, Z-1 -> Z-2.
+    it, _, diags = run("DEF REAL TB[4,6]\nDEF INT ER\nG18 DIAMON G700 G95 G0 X10 Z0\nCONTDCON(TB)\n"
+                       "G91 G1 X2 Z-1 F0.2\nG0 Z-1\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    same(table(it, "TB"), [[20, 0, 10, 0, 0, 2], [2121, -1, 12, 0, 0, 0.2], [2120, -2, 12, 0, 0, 0.2],
+                          [0] * 6])
+
+
+def test_exectab_runs_rows_as_blocks():
+    # rows 1 and 3 of seed example 2's table (forwards): (20,20)->(20,45) G1, then the G2 arc
+    # (0,45)->(-15,30) about (-15,45); from X100 Z100 the first EXECTAB feeds to Z20 X45.
+    it, recs, diags = run(SEED_2.replace("N190 G1 X0\n", "N190 EXECTAB(KTAB[1])\nN200 EXECTAB(KTAB[3])\n"))
+    assert rules(diags) == []
+    moves = [r for r in recs if r.kind in ("linear", "arc")]
+    assert moves[-2].kind == "linear" and moves[-2].end == {"X": 45.0, "Y": 0.0, "Z": 20.0}
+    arc = moves[-1]
+    assert arc.kind == "arc" and arc.end == {"X": 30.0, "Y": 0.0, "Z": -15.0}
+    assert arc.direction == "cw" and (arc.center["Z"], arc.center["X"]) == (-15.0, 45.0)
+
+
+# ------------------------------------------------------------------ refused at the line
+
+@pytest.mark.parametrize("text, line", [
+    ("DEF REAL TB[2,11]\nDEF INT NN, ER\nG18 G0 X0 Z0\nCONTPRON(TB, \"L\", NN)\nG1 X1\nX2\nX3\nEXECUTE(ER)\n", 8),
+    ("DEF REAL TB[9,10]\nDEF INT NN, ER\nG18 G0 X0 Z0\nCONTPRON(TB, \"L\", NN)\nG1 X1\nEXECUTE(ER)\n", 4),
+    ("DEF REAL TB[9,11]\nDEF INT NN, ER\nG18 G0 X0 Z0\nCONTPRON(TB, \"Q\", NN)\nG1 X1\nEXECUTE(ER)\n", 4),
+    ("DEF REAL TB[9,11]\nDEF INT NN, ER\nG18 G0 X0 Z0\nCONTPRON(TB, \"L\", NN, 2)\nG1 X1\nEXECUTE(ER)\n", 4),
+    ("DEF REAL TB[9,6]\nDEF INT ER\nG18 G0 X0 Z0\nCONTDCON(TB, 1)\nG1 X1\nEXECUTE(ER)\n", 4),
+    ("DEF REAL TB[9,6]\nDEF INT ER\nG18 G0 X0 Z0\nCONTDCON(TB)\nG33 Z-10 K1\nEXECUTE(ER)\n", 5),
+    ("DEF REAL TB[9,6]\nDEF INT ER\nG18 G0 X0 Z0\nCONTDCON(TB)\nG1 X1 Y5\nEXECUTE(ER)\n", 5),
+    ("DEF REAL TB[9,6]\nDEF INT ER\nG18 G0 X0 Z0\nCONTDCON(TB)\nG1 X1\nG70 Z-1\nEXECUTE(ER)\n", 6),
+    ("DEF REAL TB[9,6]\nDEF INT ER\nG18 G0 X0 Z0\nCONTDCON(TB)\nEXECUTE(ER)\n", 5),
+    ("DEF INT ER\nEXECUTE(ER)\n", 2),
+])
+def test_refused_contours_say_nc242_and_err_1(text, line):
+    it, recs, diags = run(text + "M30\n")
+    bad = [d for d in diags if d.rule == "NC242"]
+    assert bad and bad[0].line == line, diags
+    if "TB[" in text and "EXECUTE(ER)" in text and "CONTD" in text or "CONTP" in text:
+        assert var(it, "ER") == 1
+    assert not [r for r in recs if r.kind in ("linear", "arc")]
+
+
+def test_arc_turning_inside_is_nc243_not_silent():
+    # G3 from Z0 X20 to Z-20 X20, radius 10 about Z-10 X20: X rises to 30 inside the arc
+    it, _, diags = run("DEF REAL TB[10,11]\nDEF INT NN, ER\nG18 G0 X0 Z10\nCONTPRON(TB, \"L\", NN)\n"
+                       "G1 X20 Z0\nG3 X20 Z-20 CR=10\nG1 X40\nEXECUTE(ER)\nM30\n")
+    assert [(d.rule, d.line) for d in diags] == [("NC243", 6)]
+    assert var(it, "ER") == 0
