@@ -186,36 +186,62 @@ def test_contpron_line_arc_hand_computed():
     assert var(it, "NN") == 0 and var(it, "ER") == 0
 
 
-def test_contpron_relief_split_and_extension_hand_computed():
-    # G18 "L" (level X), start Z0 X50. Row 0: G1 to Z-10 X40 (falls: a relief from level 50
-    # starts at row 0, not counted); row 1: Z-20 (flat); row 2: X20 (falls, still inside);
-    # row 3: Z-30 X60 rises 20 -> 60, above the open relief's start level 50: split at X50,
-    # t = (50-20)/(60-20) = 0.75 -> Z = -20 + 0.75 * -10 = -27.5. Row 3 keeps (-20,20)->(-27.5,50)
-    # (relief end, no further relief: -1111); the rest (-27.5,50)->(-30,60) goes to row 4.
-    # Row 0 marks nothing (col 7 of row 0 is not a marker). The end X60 is the highest level.
-    # Angles: row 0 atan2(-10,-10) = -135 -> 45; row 3 atan2(30,-7.5) = 104.036..; row 4
-    # atan2(10,-2.5) = 104.036.. (the same line).
-    it, _, diags = run("DEF REAL TB[8,11]\nDEF INT NN, ER\nG18 G0 X50 Z0\nCONTPRON(TB, \"L\", NN)\n"
-                       "G1 Z-10 X40\nZ-20\nX20\nZ-30 X60\nEXECUTE(ER)\nM30\n")
+def test_contpron_relief_split_hand_computed():
+    # G18 "L" (level X), start Z0 X50. Row 0: G1 Z-5 (flat); row 1: Z-10 X40 (falls from 50: a
+    # relief starts, counted); row 2: Z-20 (flat); row 3: X20 (falls, the relief still open);
+    # row 4: Z-30 X60 rises 20 -> 60, above the relief's start level 50: split at X50,
+    # t = (50-20)/(60-20) = 0.75 -> Z = -20 + 0.75 * -10 = -27.5. Row 4 keeps (-20,20)->(-27.5,50)
+    # (relief end, no further relief: -1111); the rest (-27.5,50)->(-30,60) goes to row 5.
+    # Markers: row 1 -> 4. The end X60 is the highest level: no extension. Row 6: NN 1, 0.
+    # Angles: row 1 atan2(-10,-5) = -116.565 -> 63.435; rows 4/5 atan2(30,-7.5) = 104.036.
+    it, _, diags = run("DEF REAL TB[9,11]\nDEF INT NN, ER\nG18 G0 X50 Z0\nCONTPRON(TB, \"L\", NN)\n"
+                       "G1 Z-5\nZ-10 X40\nZ-20\nX20\nZ-30 X60\nEXECUTE(ER)\nM30\n")
     assert rules(diags) == []
     a = math.degrees(math.atan2(30, -7.5))
-    same(table(it, "TB")[:6], [
-        [4, 4, 11, 0, 50, -10, 40, 0, 45, 0, 0],
-        [0, 2, 11, -10, 40, -20, 40, 0, 0, 0, 0],
-        [1, 3, 11, -20, 40, -20, 20, 0, 90, 0, 0],
-        [2, 4, 11, -20, 20, -27.5, 50, -1111, a, 0, 0],
-        [3, 0, 11, -27.5, 50, -30, 60, 0, a, 0, 0],
-        [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+    same(table(it, "TB")[:8], [
+        [5, 5, 11, 0, 50, -5, 50, 0, 0, 0, 0],
+        [0, 2, 11, -5, 50, -10, 40, 4, 180 + math.degrees(math.atan2(-10, -5)), 0, 0],
+        [1, 3, 11, -10, 40, -20, 40, 0, 0, 0, 0],
+        [2, 4, 11, -20, 40, -20, 20, 0, 90, 0, 0],
+        [3, 5, 11, -20, 20, -27.5, 50, -1111, a, 0, 0],
+        [4, 0, 11, -27.5, 50, -30, 60, 0, a, 0, 0],
+        [1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+        [0] * 11,
     ])
+    assert var(it, "NN") == 1 and var(it, "ER") == 0
+
+
+def test_contpron_relief_from_the_call_point_is_not_split():
+    # [NC] start Z0 X50, row 0 G1 Z-10 X40 falls from the call point's level 50; row 1 Z-20 X60
+    # rises above 50: the end of that relief (marker -1111) but no split (row 0 is the way from
+    # where the tool stood), no count; X60 the highest level: no extension. Rows 0-1, row 2 the
+    # counts 0, 0.
+    it, _, diags = run("DEF REAL TB[5,11]\nDEF INT NN, ER\nG18 G0 X50 Z0\nCONTPRON(TB, \"L\", NN)\n"
+                       "G1 Z-10 X40\nZ-20 X60\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    t = table(it, "TB")
+    assert [row[:2] + row[5:8] for row in t[:3]] == [[1, 1, -10, 40, 0], [0, 0, -20, 60, -1111],
+                                                      [0, 0, 0, 0, 0]]
     assert var(it, "NN") == 0
-    # the relief in the middle (row 2 falls after the flat row 1) is the same relief as row 0's:
-    # it was still open, so row 2 holds no start marker
+
+
+def test_contpron_extension_to_the_extreme_level():
+    # "L", written from the top down: start Z0 X60, row 0 G1 Z-10 X60 (flat), row 1 Z-20 X40
+    # (falls: relief from 60, counted), row 2 Z-30 (flat). The end X40 is not the highest level
+    # (60): extended along X to X60 as row 3 (-30,40)->(-30,60), which rises to 60 = the relief's
+    # start level: its end (-1111), no split. Row 1 marks row 3. NN 1; row 4 the counts.
+    it, _, diags = run("DEF REAL TB[6,11]\nDEF INT NN, ER\nG18 G0 X60 Z0\nCONTPRON(TB, \"L\", NN)\n"
+                       "G1 Z-10\nZ-20 X40\nZ-30\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    t = table(it, "TB")
+    assert t[3] == [2, 0, 11, -30, 40, -30, 60, -1111, 90, 0, 0]
+    assert t[1][7] == 3 and t[0][:2] == [3, 3] and t[4][:2] == [1, 0] and var(it, "NN") == 1
 
 
 def test_contpron_counts_a_relief_after_the_start():
     # "L", start Z0 X30: row 0 to Z-5 X30 (flat), row 1 Z-10 X20 (falls from 30: relief 1 starts,
     # counted), row 2 Z-15 (flat), row 3 Z-20 X30 (rises back to 30: its end, no split).
-    # Markers: row 1 -> 3, row 3 -> -1111. NN 1, row 5 (table end 4? no: rows 0-3, end 3) + 1 = 4.
+    # Markers: row 1 -> 3, row 3 -> -1111. NN 1; rows 0-3 used, so row 4 holds the counts 1, 0.
     it, _, diags = run("DEF REAL TB[6,11]\nDEF INT NN, ER\nG18 G0 X30 Z0\nCONTPRON(TB, \"L\", NN)\n"
                        "G1 Z-5\nZ-10 X20\nZ-15\nZ-20 X30\nEXECUTE(ER)\nM30\n")
     assert rules(diags) == []

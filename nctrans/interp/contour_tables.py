@@ -27,7 +27,8 @@ element that descends (away from the material side: X falling for "L", rising fo
 face modes "P"/"N" [NC]) and ends at the next element that rises; the start element holds the row
 of the end element, the end element minus the row of the next relief start, -1111 for none. An
 end element that rises above the relief's start level is split there; the rest is appended after
-the table's rows. The contour is extended along the ordinate to its extreme level when it does not
+the table's rows. A relief that starts at row 0 is not split at its end (row 0 is the way from
+the call point, not the contour; its level is where the tool happened to stand). The contour is extended along the ordinate to its extreme level when it does not
 end there (backwards in the seed's example 2). A relief starting at row 0 (the approach from the
 call point) is not counted. NN gets the forward count.
 Not derived, said at the line (NC242): an arc whose level turns inside it (col 7 and the count
@@ -481,7 +482,8 @@ def _chain(it, session, elements: list, first_is_approach: bool, extend_to: Opti
             starts.append(i)
         elif inside is not None and h1 > h0 + 1e-9:
             top = inside[1]
-            if h1 > top + 1e-9:          # above the relief's start level: split there
+            approach = first_is_approach and inside[0] == 0
+            if h1 > top + 1e-9 and not approach:    # above the relief's start level: split there
                 pieces = (_split(el, axis, sign * top) if el.centre is None
                           else _split_arc(el, axis, sign * top))
                 if pieces is not None:
