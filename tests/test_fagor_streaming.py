@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from nctrans import pipeline, plainrun, source, toolpath_io
+from nctrans import limits, pipeline, plainrun, source, toolpath_io
 from nctrans.api import transpile
 from nctrans.dialects.base import StreamedBody
 from nctrans.dialects.fagor.frontend import parse
@@ -86,7 +86,11 @@ def test_conformance_programs_stream_or_not_to_the_same_toolpath(path):
 
 @pytest.mark.skipif(not PROGRAMS, reason="shared corpus not found")
 @pytest.mark.parametrize("path", PROGRAMS, ids=lambda p: p.name)
-def test_corpus_program_as_fagor_streams_to_the_same_toolpath(path):
+def test_corpus_program_as_fagor_streams_to_the_same_toolpath(path, monkeypatch):
+    # An ISO main program ending in M99 becomes an endless loop here; the three runs are
+    # compared up to the budget equiv gives endless programs (limits.MAX_ENDLESS_STEPS), not
+    # MAX_STEPS: 2 M steps took 30 s a run and repeat the same pass. Others end far below it.
+    monkeypatch.setenv("NCTRANS_MAX_STEPS", str(limits.MAX_ENDLESS_STEPS))
     text = as_fagor(path)
     _full, fast, _slow = same_every_way(text)
     assert fast[2] == streamable(text)[0]
