@@ -21,7 +21,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Iterator, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Optional, Sequence, Union, cast
 
 from nctrans import limits
 from nctrans import pipeline
@@ -792,7 +792,7 @@ def equiv(a: Source, b: Source, *, tol: float = DEFAULT_TOL, read_a: Optional[st
         oa, ob, lambda ca, cb, **kw: equiv(ca, cb, tol=tol, machine=machine, profile=profile,
                                            profile_b=profile_b, **kw), dirs)
     if called_pair is not None:
-        return called_pair
+        return cast(Equivalence, called_pair)
     _equiv_profiles(oa, ob, profile, profile_b)
     ma = mb = _equiv_machine(machine, oa[1], ob[1])
     # M99 in a main program loops, as a LOOP does; but where either side is a subprogram file (a

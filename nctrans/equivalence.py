@@ -149,7 +149,10 @@ def _is_zero_move(r: ToolpathRecord) -> bool:
 
 def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Iterator[tuple]:
     """A toolpath's records as the tokens of its gaps and runs, one at a time."""
-    state: dict[str, object] = {}
+    # both runs start at power-on, spindle and coolant off (every dialect's defaults): an M5 or
+    # M9 before anything started them changes nothing, and is no event (a flattened conversion
+    # writes state changes only, so it has no such M5)
+    state: dict[str, object] = {"spindle_dir": "off", "coolant": "off"}
     run: Optional[str] = None              # class of the run being produced
 
     def changed(key: str, value) -> bool:
@@ -211,13 +214,20 @@ def _tokens(records: Iterable[ToolpathRecord], axes: _Axes, tol: float) -> Itera
             if changed("tool_change", r.tool):
                 yield ("E", "tool_change", r.tool, r)
         elif k == "spindle":
-            if r.spindle is not None and changed("spindle_speed", r.spindle):
-                yield ("E", "spindle_speed", r.spindle, r)
             # a positioned spindle compares with its angle: M19 (no angle) positions at the
             # control's setting, 0 degrees by default (SD 43240 M19_SPOS), as SPOS=0 does
             where = r.spindle_dir
             if where == "orient" and r.spindle_angle:          # (NaN: unknown, equal to nothing known)
                 where = f"orient {r.spindle_angle:.3f}"
+            # the speed of a spindle that does not turn is no event: it compares when it turns
+            # (an M5 record carries the S in force, which one side may never have started); an S
+            # set while stopped is the speed the next start compares (S1000, then M3 = S1000 M3)
+            if r.spindle is not None:
+                state["spindle_speed_set"] = r.spindle
+            turns = (where if r.spindle_dir is not None else state["spindle_dir"]) in ("cw", "ccw")
+            speed = state.get("spindle_speed_set")
+            if turns and speed is not None and changed("spindle_speed", speed):
+                yield ("E", "spindle_speed", speed, r)
             if r.spindle_dir is not None and changed("spindle_dir", where):
                 yield ("E", "spindle_dir", where, r)
         elif k == "coolant":

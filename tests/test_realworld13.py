@@ -83,3 +83,45 @@ def test_a_different_subprogram_is_a_difference_named_in_the_files_given(tmp_pat
     # A's first move ends at X10 (SQUARE.SPF line 2), B's at X5: each named by the file given
     assert result.difference.a.file == str(lib) and result.difference.a.line == 2
     assert result.difference.b.file == str(iso)
+
+
+# ------------------------------------------------------------- equiv: an M5 before any M3
+
+def test_a_spindle_stop_before_any_start_is_no_difference():
+    # a student program stops a spindle it never started (M5 with the G28 home), its Fagor
+    # conversion lowered that stretch to plain motion, which writes state changes only: no M5.
+    # Both spindles are off from power-on to the end: the same machine behaviour
+    with_stop = "G21 G90 G54\nG0 X10 Y10 Z50\nG28 G91 Z0 M05\nG90 G0 X0\nM30\n"
+    without = "G21 G90 G54\nG0 X10 Y10 Z50\nG28 G91 Z0\nG90 G0 X0\nM30\n"
+    assert nctrans.equiv(with_stop, without, read_a="iso-m", read_b="iso-m")
+    # a stop after a start still counts: M3 ... M5 against M3 with no stop differs
+    started = "S1000 M3\n" + with_stop
+    assert not nctrans.equiv(started, "S1000 M3\n" + without, read_a="iso-m", read_b="iso-m")
+
+
+def test_the_real_conversion_that_lost_the_idle_m5_is_equivalent():
+    # excerpt of the shape of O00021 (NIMS level 2): T20 M06 and S1254 but no M03, the face pass,
+    # then G28 G91 Y0 M05; Fagor cannot say G28 and lowers those blocks to plain motion
+    src = ("G90 G80 G40 G21\nT20 M06\nS1254\nG00 G90 G54 X-141. Y-25.\nG43 Z50. H20\nG01 Z0 F564.\n"
+           "G01 X50. F1128.\nG00 Z50.\nG28 G91 Z0 M09\nG28 G91 Y0 M05\nM30\n")
+    conv = nctrans.transpile(src, read="iso-m", write="fagor")
+    assert conv.text is not None
+    assert nctrans.equiv(src, conv.text, read_a="iso-m", read_b="fagor")
+
+
+# ------------------------------------------------------------- an unknown M code, said once
+
+def test_an_unknown_m_code_is_said_once_by_lint_and_once_by_convert():
+    # Shelton's lathe programs start the spindle with M93; lint said NC220 (not modelled) and
+    # NC403 (kept verbatim, the conversion's word) at the same line for the one code
+    src = "G21 G90 G54\nG0 X10 M93\nM30\n"
+    assert [d.rule for d in nctrans.lint(src, "iso-m") if d.line == 2] == ["NC220"]
+    conv = nctrans.transpile(src, read="iso-m", write="sinumerik")
+    assert [d.rule for d in conv.diagnostics if d.line == 2] == ["NC403"]
+
+
+def test_a_kept_word_of_another_construct_on_the_line_stays():
+    # G31 P2 (a skip with a signal number): NC220 names G31, NC403 names P2: two things
+    src = "G21 G90 G54\nG91 G31 P2 Z-10. F100\nM30\n"
+    rules = sorted(d.rule for d in nctrans.lint(src, "iso-m") if d.line == 2)
+    assert "NC220" in rules and "NC403" in rules
