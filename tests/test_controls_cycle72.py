@@ -45,9 +45,20 @@ def test_left_of_the_contour_quarter_circles_two_cuts_by_hand():
         return [("linear", (5, 18, z), 100), ("arc", (10, 13, z), 300, (10, 18), "ccw"),
                 ("linear", (47, 13, z), 300), ("linear", (47, 27, z), 300), ("linear", (10, 27, z), 300),
                 ("arc", (5, 22, z), 300, (10, 22), "ccw"), ("rapid", (5, 22, 2), None)]
+    # the cycle ends at RTP 10 (module docstring: "at the end G0 to RTP"; it used to stop at 2)
     want = [("rapid", (5, 18, 20), None), ("rapid", (5, 18, 2), None)] + cut(-3) + \
-        [("linear", (5, 18, 2), 400)] + cut(-6)
+        [("linear", (5, 18, 2), 400)] + cut(-6) + [("rapid", (5, 22, 10), None)]
     assert got == want
+
+
+@pytest.mark.parametrize("vari, last", [(301, -5.5), (201, -3.5), (101, 2)])
+def test_the_cycle_ends_at_rtp_whatever_the_retraction_between_passes(vari, last):
+    # RL 40, AS 1 LP 4 out to (6,30); one cut at -6 + FALD 0.5 = -5.5; the retraction after the pass:
+    # hundreds 3 none (-5.5), 2 by SDIS 2 (-3.5), 1 to RFP+SDIS (2); then G0 to RTP 10
+    got, diags = _run(f'CYCLE72("ANF:ENDE", 10, 0, 2, -6, 0, 0, 0.5, 300, 100, {vari}, 40, 1, 4, , 1, 4)')
+    assert not [d for d in diags if d.severity != "info"]
+    tail = [("rapid", (6, 30, last), None)] if last != -5.5 else []
+    assert got[-len(tail) - 2:] == [("linear", (6, 30, -5.5), 300)] + tail + [("rapid", (6, 30, 10), None)]
 
 
 def test_on_the_contour_straight_approach_and_retract_to_rtp_by_hand():

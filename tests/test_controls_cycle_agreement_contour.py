@@ -10,6 +10,7 @@ choices. Not covered: FAL (the model's offset along the normal), contours given 
 calling program ("ANF:END"), what the models refuse (undercuts, DT/DAM, spatial approach)."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -157,3 +158,95 @@ def test_cycle95_agrees_over_parameter_sets(tmp_path_factory, program):
     text, contour = program
     cycle_agreement.agree(tmp_path_factory.mktemp("t"), text, procs("CYCLE95", "CYC95ON", "CYC95MV"),
                           records_with(contour, ("X", "Z")))
+
+
+# ------------------------------------------------------------------------------------ CYCLE72
+
+MILL = "G17 G90 G54 {units} T1 D1 M6\nS2000 M3 F500\nG0 X0 Y0 Z20\n"
+PROCS72 = ("CYCLE72", "CYC72MV", "CYC72TG", "CYC72LD", "CYC72OFS", "CYC72X", "CYCLEVEL", "CYCAPPR")
+
+
+def mill_records(contour: str):
+    """Records of a milling program with tool 1 (radius 3) in the machine model."""
+    from nctrans.machine import Machine, Tool
+    machine = Machine(name="t", tools=[Tool(number=1, radius=3.0, length=0.0)])
+
+    def records(where: Path, text: str):
+        (where / "KONT.SPF").write_text(contour)
+        path = where / "MAIN.MPF"
+        path.write_text(text)
+        ld = pipeline.load(str(path), "sinumerik")
+        recs = list(pipeline.toolpath_of(ld, machine))
+        bad = [d.format_text() for d in ld.diagnostics if d.severity in ("error", "warning")]
+        out, at = [], None
+        for r in recs:
+            if r.kind in ("rapid", "linear", "arc"):
+                end = tuple(r.end.get(a, 0.0) for a in ("X", "Y", "Z"))
+                if r.kind != "arc" and at is not None and max(abs(p - q) for p, q in zip(end, at)) < 1e-7:
+                    continue
+                at = end
+                arc = ((r.center["X"], r.center["Y"]), r.direction) if r.kind == "arc" else None
+                out.append((r.kind, end, r.feed if r.kind != "rapid" else None, arc))
+        return out, bad
+    return records
+
+
+CONTOURS72 = {
+    # an open rectangle (left of it: one concave corner per turn; right: convex, rounded)
+    "rectangle": "G1 X10 Y10\nX50\nY30\nX10\nRET\n",
+    # a line into a tangent arc and out of it along a line: no corner at either end
+    "tangent-arc": "G1 X10 Y10\nX30\nG3 X40 Y20 CR=10\nG1 Y40\nRET\n",
+    # an arc between two corners (line -> arc and arc -> line corners, concave on one side)
+    "arc-corners": "G1 X0 Y10\nX20\nG2 X40 Y10 CR=10\nG1 X40 Y-10\nRET\n",
+    # two arcs meeting at a right turn (up, then right): convex on the left, concave on the right
+    "arc-arc": "G1 X0 Y0\nG3 X20 Y0 CR=10\nG3 X30 Y10 CR=10\nRET\n",
+}
+CALLS72 = {
+    "left-quarter": 'CYCLE72("KONT", 10, 0, 2, -6, 3, 0, 0, 300, 100, 111, 41, 2, 5, 400, 2, 5)',
+    "right-semi-finish": 'CYCLE72("KONT", 10, 0, 2, -4, 2.5, 0.5, 0.3, 250, 80, 2, 42, 3, 4, , 3, 4)',
+    "right-line-rough": 'CYCLE72("KONT", 10, 0, 2, -5, 2, 0.5, 0.5, 300, 100, 201, 42, 1, 6, , 1, 3)',
+    "left-line-none": 'CYCLE72("KONT", 5, 1, 1, -3, 0, 0, 0, 300, , 301, 41, 1, 4, , 2, 4)',
+    "on-contour": 'CYCLE72("KONT", 10, 0, 2, -6, 4, 0, 0.5, 300, 100, 11, 40, 1, 4, 350, 1, 4)',
+}
+
+
+@pytest.mark.parametrize("units", ["", "G70"])
+@pytest.mark.parametrize("contour", sorted(CONTOURS72))
+@pytest.mark.parametrize("call", sorted(CALLS72))
+def test_cycle72_model_agrees_with_cycle_code(tmp_path, call, contour, units):
+    text = MILL.format(units=units) + CALLS72[call] + "\nG0 Z50\nM30\n"
+    want = cycle_agreement.agree(tmp_path, text, procs(*PROCS72), mill_records(CONTOURS72[contour]))
+    assert sum(m[0] in ("linear", "arc") for m in want) >= 4
+
+
+@st.composite
+def cycle72_programs(draw):
+    """A contour of lines turning by 45 or 90 degrees either way (sides of 10 mm or more, so the
+    offset of at most 3 + 1 mm never swallows a side), and a CYCLE72 call over its parameters."""
+    heading, x, y = draw(st.sampled_from([0, 90, 180, 270])), 0.0, 0.0
+    lines = ["G1 X0 Y0"]
+    for k in range(draw(st.integers(2, 5))):
+        if k:
+            heading += draw(st.sampled_from([-90, -45, 45, 90]))
+        length = draw(st.sampled_from([10, 15, 25]))
+        x += length * round(math.cos(math.radians(heading)), 12)
+        y += length * round(math.sin(math.radians(heading)), 12)
+        lines.append(f"X{x:.6f} Y{y:.6f}")
+    rl = draw(st.sampled_from([40, 41, 42]))
+    vari = draw(st.sampled_from([1, 2])) + 10 * draw(st.integers(0, 1)) + 100 * draw(st.integers(0, 3))
+    as1 = 1 if rl == 40 else draw(st.sampled_from([1, 2, 3]))
+    as2 = 1 if rl == 40 else draw(st.sampled_from([1, 2, 3]))
+    fal = 0 if rl == 40 else draw(st.sampled_from([None, 0, 0.5, 1]))
+    args = [10, 0, 2, draw(st.sampled_from([-2, -5, -8])), draw(st.sampled_from([None, 0, 2, 3.5])), fal,
+            draw(st.sampled_from([None, 0, 0.3])), 300, draw(st.sampled_from([None, 100])), vari, rl, as1,
+            draw(st.sampled_from([2, 4, 6])), draw(st.sampled_from([None, 400])), as2, draw(st.sampled_from([2, 5]))]
+    call = 'CYCLE72("KONT", ' + ", ".join(num(a) for a in args) + ")"
+    units = draw(st.sampled_from(["", "G70"]))
+    return MILL.format(units=units) + call + "\nG0 Z50\nM30\n", "\n".join(lines) + "\nRET\n"
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=list(HealthCheck))
+@given(cycle72_programs())
+def test_cycle72_agrees_over_parameter_sets(tmp_path_factory, program):
+    text, contour = program
+    cycle_agreement.agree(tmp_path_factory.mktemp("t"), text, procs(*PROCS72), mill_records(contour))

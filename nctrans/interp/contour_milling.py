@@ -178,6 +178,7 @@ def plan72(start, moves, p: dict[str, float], radius: float, here: tuple[float, 
             plan.arc(r_far[0], r_far[1], level, r_arc[0], r_arc[1], ffp1)
         up = {0: lv.rtp, 1: lv.approach, 2: level + lv.up * abs(p.get("SDIS", 0.0)), 3: level}[hundreds]
         plan.rapid(r_far[0], r_far[1], up)
+    plan.rapid(r_far[0], r_far[1], lv.rtp)           # the cycle ends at RTP (its docstring, [NC])
     return plan.steps
 
 
