@@ -224,6 +224,26 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
             table.update(part())
         return table
 
+    def _work_position_read(self, axis: str) -> float:
+        """The current work position of `axis` for a position variable ($AA_IW, $P_EP). Under
+        diameter programming (DIAMON) X, the transverse axis, is read as the radius nctrans holds;
+        whether the control gives the diameter there is not in the seeds (the system-variable
+        table, seed L28087, only says "actual value in the WCS") [GK, not confirmed]. A value that
+        may be half or twice the control's changes what it drives, so the read is said at its
+        line (NC138), once per line."""
+        if axis == "X" and self.st.diameter:
+            span = self.span
+            line = span.line if span is not None else 0
+            said = self.__dict__.setdefault("_diameter_reads", set())
+            if line not in said:
+                said.add(line)
+                self.diag("NC138", "warning", "the work position of X is read under diameter "
+                          "programming (DIAMON): nctrans gives the radius; whether the control gives "
+                          "the diameter here is not documented in the seeds [GK], so what this value "
+                          "drives may be half or twice the control's. Read it under DIAMOF (radius) to "
+                          "be sure")
+        return self.pos.get(axis, 0.0)
+
     def _register_system(self) -> None:
         """Values of the neutral system variables (vocabulary.SYSTEM_VARIABLES); each dialect's
         rules table maps its spellings onto them."""
@@ -232,7 +252,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         st = self.st
         for a in "XYZABC":
             values[f"axis_position_work.{a}"] = (
-                lambda a=a: self.pos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
+                lambda a=a: self._work_position_read(a) / (st.scale if a in LINEAR_AXES else 1))
             values[f"axis_position_machine.{a}"] = (
                 lambda a=a: self.mpos.get(a, 0.0) / (st.scale if a in LINEAR_AXES else 1))
         values["programmable_frame"] = lambda: FrameValue((("state", copy_frame(self.frame)),))

@@ -509,13 +509,20 @@ class SinumerikEmitter(SinumerikSpelling, Emitter):
         self.frame(s, out)
 
     def w_SetPosition(self, s: ir.SetPosition, out: "_Line") -> None:
-        """ISO G92 / ISO-T G50: ATRANS by the position minus the new value. A frame offset and
-        $P_EP are radii; an X set under diameter programming (ISO-T, DIAMON) is a diameter, halved."""
+        """ISO G92 / ISO-T G50: ATRANS by the position minus the new value. A frame offset is a
+        radius; an X set under diameter programming (ISO-T, DIAMON) is a diameter, halved. Whether
+        the control reads $P_EP[X] as a diameter under DIAMON is not documented (NC138), so there
+        the ATRANS stands between DIAMOF and DIAMON, where $P_EP[X] is the radius either way."""
         self.info("G92", "G92 written as ATRANS by the programmed position minus the new value")
         self.st.frame_parts.add("g92")
+        halve = self.st.diameter and "X" in s.target
         ws = [f"{a}=$P_EP[{a}]-({self.expr(v.value)})" + ("/2" if a == "X" and self.st.diameter else "")
               for a, v in s.target.items()]
+        if halve:
+            out.alone(self.code_for("diameter", "radius"))
         out.alone(f"{self.code_for('frame', 'trans_add')} " + " ".join(ws))
+        if halve:
+            out.alone(self.code_for("diameter", "diameter"))
 
     def w_ResetSetPosition(self, s: ir.ResetSetPosition, out: "_Line") -> None:
         others = sorted(self.st.frame_parts - {"g92"})
