@@ -40,7 +40,10 @@ def both_runs(tmp_path: Path, text: str, code: dict[str, str], records: Records)
         d.mkdir(exist_ok=True)
         for name, body in files.items():
             (d / name).write_text(body)
-        runs.append(records(d, text))
+        recs, bad = records(d, text)
+        # NC419: a turning model's 1 mm default taken in an inch program (its unit there is not
+        # documented); the PROCs here take the same 1 mm, so it is expected, not a disagreement
+        runs.append((recs, [b for b in bad if "[NC419]" not in str(b)]))
     return runs[0], runs[1]
 
 

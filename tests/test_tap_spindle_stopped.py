@@ -101,3 +101,16 @@ def test_fail_on_warning_exit_1_lint_and_toolpath(tmp_path, capsys):
         assert cli.main([cmd, str(bad), "--fail-on", "warning"]) == 1
         assert cli.main([cmd, str(good), "--fail-on", "warning"]) == 0
     capsys.readouterr()
+
+
+def test_check_keeps_to_its_documented_codes_and_lint_says_it(tmp_path, capsys):
+    # README "Machine check": check prints the machine findings (NC3xx), the program's errors and
+    # what the toolpath leaves out (not-analysed rules); NC209 is none of those, so check is clean
+    # on this program (exit 0) while lint says the second position (line 6)
+    bad = tmp_path / "bad.mpf"
+    bad.write_text(mcall(CYCLE840.format(sdac=5)))
+    assert cli.main(["check", str(bad)]) == 0
+    assert "NC209" not in capsys.readouterr().out
+    assert cli.main(["lint", str(bad), "--fail-on", "warning"]) == 1
+    out = capsys.readouterr().out
+    assert "bad.mpf:6:1: warning[NC209]" in out and ":5:1: warning[NC209]" not in out

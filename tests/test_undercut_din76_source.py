@@ -50,3 +50,23 @@ def test_m42_form_a_rounds_the_face_with_radius_2_by_hand():
     assert got == _approx([("rapid", 22, -23), ("linear", 21, -24), ("linear", 17.8, -24 - 3.2 / TAN30),
                            ("linear", 17.8, -38), ("arc", 19.8, -40), ("linear", 21, -40),
                            ("linear", 22, -40), ("rapid", 22, -23)])
+
+
+def test_cycle96_in_inch_takes_the_metric_size_of_its_inch_diameter():
+    # G700: DIATH 0.944882 inch = 24.0000 mm (M24, pitch 3) and SPL -1.181102 inch = -30 mm: the
+    # same outline as the mm M24 form A (test_controls_undercuts), to 1e-5 mm (the inch rounding);
+    # the 1 mm clearance stays 1 mm ([NC], as the model's other built-in distances)
+    from nctrans import pipeline
+    from nctrans.source import from_text
+    from test_controls_undercuts import _lathe
+    text = ("G18 G90 G700 DIAMON T1 D1\nS800 M3 G95 F0.004\nG0 X2 Z0.2\n"
+            'CYCLE96(0.944882, -1.181102, "A", 3)\nG0 X3\nM30\n')
+    ld = pipeline.load_source(from_text(text, "t.mpf"), "t.mpf", "sinumerik")
+    got = [(r.kind, r.end["X"], r.end["Z"]) for r in pipeline.toolpath_of(ld, _lathe())
+           if r.line == 4 and r.kind in ("rapid", "linear", "arc")]
+    want = [("rapid", 13, -18.5), ("linear", 12, -19.5), ("linear", 9.8, -19.5 - 2.2 / TAN30),
+            ("linear", 9.8, -28.4), ("arc", 11.4, -30), ("linear", 12, -30), ("linear", 13, -30),
+            ("rapid", 13, -18.5)]
+    assert [k for k, *_ in got] == [k for k, *_ in want]
+    for (_, x, z), (_, wx, wz) in zip(got, want):
+        assert x == pytest.approx(wx, abs=1e-4) and z == pytest.approx(wz, abs=1e-4)

@@ -222,6 +222,7 @@ class CycleCallsMixin:
         self._omitted_retract_plane(s)
         filled = self._omitted_from_state(s)
         self._unmodelled_params(s)
+        self._inch_defaults(s)
         if filled is None:
             return self._dispatch_cycle_call(s)
         # NC128 after the call has run: a call refused at its line (NC206 no depth, NC224/NC225
@@ -294,10 +295,32 @@ class CycleCallsMixin:
         for name, entry in table.unmodelled_param.get((s.name or "").upper(), {}).items():
             e = s.params.get(table.neutral(name))
             v = None if e is None else self._value(self.ev.compile(e), f"{s.name} {name}")
-            if v is not None and entry.get("when") == "nonzero" and v != 0:
+            when = entry.get("when")
+            applicate = "XYZ".index(PLANE_AXES[self.st.plane][2]) + 1
+            own_unit = 1 if self.st.scale == 1.0 else 3
+            if v is not None and ((when == "nonzero" and v != 0)
+                                  or (when == "not_applicate" and v not in (0, applicate))
+                                  or (when == "not_program_unit" and v not in (0, own_unit))):
                 self.diag("NC239", "warning", f"{s.name.upper()} with {name} {v:g}: {entry['meaning']} is not "
                           f"modelled [GK]; the analysed path is {entry['modelled']}, which the control's "
                           "cycle does not run. Give its PROC beside the program to run it")
+
+    def _inch_defaults(self, s: n.CycleCall) -> None:
+        """A built-in distance of a turning model (rules/cycles.toml [inch_default]: "0: 1 mm")
+        taken in an inch program: the model keeps 1 mm; whether the control's cycle means 1 inch
+        there is not documented [GK], so it is said at the call (NC419), once per call."""
+        if self.st.scale == 1.0:
+            return
+        table = cycle_table()
+        name = (s.name or "").upper()
+        for param, what in table.inch_default.get(name, {}).items():
+            e = s.params.get(table.neutral(param))
+            c = None if e is None else constant(e)
+            if e is None or c == 0:
+                self.diag("NC419", "warning", f"{name} with {param} omitted or 0 in an inch program: "
+                          f"the analysis takes {what} (the cycles manual's default [GK]); whether the "
+                          "control's cycle takes 1 inch there is not documented, and the path would "
+                          f"then be 24.4 mm wider. Give {param}")
 
     def _cycle_code(self, s: n.CycleCall):
         """A cycle whose own code is in the program or beside it (CYCLE81.SPF on the search

@@ -551,6 +551,7 @@ class CycleTable:
     cycle93_vari: dict[str, GrooveVariant] = field(default_factory=dict)
     omitted_from_state: dict[str, dict[str, str]] = field(default_factory=dict)
     unmodelled_param: dict[str, dict[str, dict[str, str]]] = field(default_factory=dict)
+    inch_default: dict[str, dict[str, str]] = field(default_factory=dict)
 
     @classmethod
     def from_data(cls, d: dict) -> "CycleTable":
@@ -575,7 +576,8 @@ class CycleTable:
                    cycle93_vari={k: GrooveVariant(**v) for k, v in d.get("cycle93_vari", {}).items()},
                    omitted_from_state={k: dict(v) for k, v in d.get("omitted_from_state", {}).items()},
                    unmodelled_param={k: {p: dict(e) for p, e in v.items()}
-                                     for k, v in d.get("unmodelled_param", {}).items()})
+                                     for k, v in d.get("unmodelled_param", {}).items()},
+                   inch_default={k: dict(v) for k, v in d.get("inch_default", {}).items()})
 
     def position_at(self, dialect: str, profile: Optional[str] = None) -> str:
         """How hole cycles of `dialect` reach the next hole ([positioning]; see expand_cycle); a
