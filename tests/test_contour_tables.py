@@ -303,3 +303,47 @@ def test_arc_turning_inside_is_nc243_not_silent():
                        "G1 X20 Z0\nG3 X20 Z-20 CR=10\nG1 X40\nEXECUTE(ER)\nM30\n")
     assert [(d.rule, d.line) for d in diags] == [("NC243", 6)]
     assert var(it, "ER") == 0
+
+
+def test_no_execute_before_the_end_is_said_at_the_call():
+    # the table is never ended: its blocks moved nothing, which must not pass silently
+    it, recs, diags = run("DEF REAL TB[9,11]\nDEF INT NN\nG18 G0 X50 Z0\nCONTPRON(TB, \"L\", NN)\n"
+                          "G1 Z-5 F100\nZ-10 X40\nM30\n")
+    assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC242", 4)]
+    assert [r.kind for r in recs if r.kind in ("linear", "arc")] == []
+
+
+def test_a_cycle_among_the_table_blocks_is_refused():
+    it, recs, diags = run("DEF REAL TB[9,6]\nDEF INT ER\nG17 G0 X0 Y0 Z5\nCONTDCON(TB)\nG1 X10 F100\n"
+                          "CYCLE81(10, 0, 2, -5)\nY10\nEXECUTE(ER)\nM30\n")
+    assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC242", 6)]
+    assert var(it, "ER") == 1
+    assert [r.kind for r in recs if r.kind in ("linear", "arc")] == []
+
+
+def test_intersec_of_seed_example_2_rows():
+    # rows of seed example 2 (forwards): row 2 the line (20,45) -> (0,45), row 3 the G2 arc
+    # (0,45) -> (-15,30) about (-15,45): they meet at (0,45), the line's end (t = 1 along row 2).
+    # Row 1 (20,20) -> (20,45) and row 6 (-30,80) -> (-40,80) do not meet: FALSE, CUT unchanged.
+    # Row 4 (-15,30) -> (-30,30) against row 86 backwards (-30,80) -> (-30,30): (-30,30).
+    text = SEED_2.replace("N50 DEF INT ERR=0\n", "N50 DEF INT ERR=0\nN51 DEF REAL CUT[2]\n"
+                          "N52 DEF BOOL HITA, HITB, HITC\n")
+    text = text.replace("N190 G1 X0\n", "N192 HITA=INTERSEC(KTAB[2],KTAB[3],CUT) R1=CUT[0] R2=CUT[1]\n"
+                        "N193 HITB=INTERSEC(KTAB[1],KTAB[6],CUT)\n"
+                        "N194 HITC=INTERSEC(KTAB[4],KTAB[86],CUT) R3=CUT[0] R4=CUT[1]\n")
+    it, _, diags = run(text)
+    assert rules(diags) == []
+    assert var(it, "HITA") and not var(it, "HITB") and var(it, "HITC")
+    assert [it.ev.R.get(k) for k in (1, 2, 3, 4)] == [0.0, 45.0, -30.0, 30.0]
+
+
+def test_intersec_line_through_an_arc_hand_computed():
+    # G17: TA row 1 a quarter circle about (10,10), radius 10, from (20,10) to (10,20) (G3); TC row 1
+    # the line (10,0) -> (20,20): x = 10 + 10t, y = 20t; on the circle (10t)^2 + (20t-10)^2 = 100
+    # -> 500t^2 - 400t = 0 -> t = 0.8: (18, 16), inside the quarter (angle atan2(6,8) = 36.9 deg)
+    it, _, diags = run("DEF REAL TA[4,11]\nDEF REAL TC[4,11]\nDEF REAL CUT[2]\nDEF BOOL HIT\n"
+                       "DEF INT NN, ER\nG17 G0 X20 Y0\nCONTPRON(TA, \"L\", NN)\nG1 Y10\n"
+                       "G3 X10 Y20 I-10 J0\nEXECUTE(ER)\nG0 X0 Y0\nCONTPRON(TC, \"L\", NN)\nG1 X10 Y0\n"
+                       "X20 Y20\nEXECUTE(ER)\nHIT=INTERSEC(TA[1],TC[1],CUT) R1=CUT[0] R2=CUT[1]\nM30\n")
+    assert rules(diags) == []
+    assert var(it, "HIT") and it.ev.R.get(1) == pytest.approx(18) and it.ev.R.get(2) == pytest.approx(16)

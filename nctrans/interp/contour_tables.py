@@ -18,6 +18,7 @@ tables; left unmodelled, such code moved nothing (NC220).
   3-4 arc centre, 5 the feed. MODE 0 only (L23655 "Value 1 is not permitted").
 - `EXECUTE(ERR)` ends the table (L23300-23312): ERR 0, or 1 when the contour was refused.
 - `EXECTAB(TAB[n])` (L23960-23985) runs row n of a CONTPRON table as one block.
+- `INTERSEC(TAB1[n1], TAB2[n2], CUT)` (L23870-23915): where two rows' elements meet.
 
 Derived from the seed's two CONTPRON tables (L23355-23365, L23440-23460), all [NC] where the
 text is silent: col 8 is the element's angle to the abscissa in [0, 180) (a line: its direction
@@ -207,6 +208,25 @@ def run_call(it, s: n.SubCall, what: str) -> None:
 
 def _omitted(e) -> bool:
     return type(e) is n.Num and e.text == ""
+
+
+def unclosed(it) -> None:
+    """The program ended between CONTPRON/CONTDCON and EXECUTE: its blocks were only read."""
+    session = it.contour_table
+    if session is None:
+        return
+    it.capture = None
+    it.contour_table = None
+    _problem(it, f"the table of {session.name} is never ended: no EXECUTE after this call before the "
+             "program ends (seed L23300); the blocks after it were only read and moved nothing",
+             session.span)
+
+
+def refuse_cycle(it, name: str) -> None:
+    """A cycle called in a contour table's blocks (only G0-G3 may describe it, seed L23281)."""
+    it.contour_table.problems.append((it.span, f"{name} called while a contour table is read: only "
+                                      "G0-G3 (with RND/CHF, CIP, CT) may describe the contour (seed "
+                                      "L23281-23285); the cycle is skipped"))
 
 
 def note_corner(it, kind: str, value: float, dialect: str) -> None:
@@ -630,3 +650,118 @@ def traverse(it, s: n.SubCall) -> None:
     else:
         it._need_feed()
         it._move("arc", end, (f(a1, vals[9]), f(a2, vals[10])), g == 2)
+
+
+# ---------------------------------------------------------------------------------------------
+# INTERSEC
+
+def _row_element(ev, var: n.Var) -> tuple:
+    """(kind, start, end, centre, cw) of CONTPRON table row TAB[n] (kind "line" or "arc")."""
+    name = str(var.key).upper()
+    store = ev._lookup_name(name)
+    table = store[name] if store is not None else None
+    if type(table) is Ref:
+        table = table.get()
+    if not isinstance(table, Array) or len(table.dims) != 2 or table.dims[1] != PREPARE_COLS:
+        raise EvalError("NC242", f"INTERSEC: {var.key} is not a CONTPRON table (11 columns, seed L23910)")
+    if len(var.indices or ()) != 1:
+        raise EvalError("NC242", f"INTERSEC: {var.key} needs one row index, {var.key}[n] (seed L23885)")
+    row = int(round(float(ev.compile(var.indices[0])())))
+    v = [float(table.get((row, c)) or 0.0) for c in range(PREPARE_COLS)]
+    g = int(round(v[2])) % 10
+    if g >= 2:
+        return ("arc", (v[3], v[4]), (v[5], v[6]), (v[9], v[10]), g == 2)
+    return ("line", (v[3], v[4]), (v[5], v[6]), None, None)
+
+
+def _along(el, q) -> Optional[float]:
+    """Where q lies on the element, 0..1 from its start (None: not on it)."""
+    kind, s, e, c, cw = el
+    if kind == "line":
+        dx, dy = e[0] - s[0], e[1] - s[1]
+        L = dx * dx + dy * dy
+        if L <= EPS:
+            return None
+        t = ((q[0] - s[0]) * dx + (q[1] - s[1]) * dy) / L
+        off = abs((q[0] - s[0]) * dy - (q[1] - s[1]) * dx) / math.sqrt(L)
+        return t if -1e-9 <= t <= 1 + 1e-9 and off <= 1e-6 else None
+    sw = sweep(s, e, c, cw)
+    a0 = math.degrees(math.atan2(s[1] - c[1], s[0] - c[0]))
+    a = math.degrees(math.atan2(q[1] - c[1], q[0] - c[0]))
+    d = (a - a0) % 360.0 if sw > 0 else (a0 - a) % 360.0
+    if d > abs(sw) + 1e-7 and d < 360.0 - 1e-7:
+        return None
+    return 0.0 if d >= 360.0 - 1e-7 else d / abs(sw)
+
+
+def _circle(el):
+    kind, s, e, c, cw = el
+    return c, math.hypot(s[0] - c[0], s[1] - c[1])
+
+
+def _line_circle(s, e, c, r) -> list:
+    dx, dy = e[0] - s[0], e[1] - s[1]
+    a = dx * dx + dy * dy
+    b = 2 * (dx * (s[0] - c[0]) + dy * (s[1] - c[1]))
+    cc = (s[0] - c[0]) ** 2 + (s[1] - c[1]) ** 2 - r * r
+    disc = b * b - 4 * a * cc
+    if a <= EPS or disc < -1e-9:
+        return []
+    h = math.sqrt(max(disc, 0.0))
+    return [(s[0] + t * dx, s[1] + t * dy) for t in {(-b + h) / (2 * a), (-b - h) / (2 * a)}]
+
+
+def intersections(el1, el2) -> list:
+    """Points where two table elements meet, ordered along the first [NC]: both bounded (a line
+    between its points, an arc over its sweep); parallel lines meet nowhere."""
+    k1, k2 = el1[0], el2[0]
+    if k1 == "line" and k2 == "line":
+        (s1, e1), (s2, e2) = el1[1:3], el2[1:3]
+        d1 = (e1[0] - s1[0], e1[1] - s1[1])
+        d2 = (e2[0] - s2[0], e2[1] - s2[1])
+        cross = d1[0] * d2[1] - d1[1] * d2[0]
+        if abs(cross) <= EPS:
+            return []
+        t = ((s2[0] - s1[0]) * d2[1] - (s2[1] - s1[1]) * d2[0]) / cross
+        cands = [(s1[0] + t * d1[0], s1[1] + t * d1[1])]
+    elif k1 == "line" or k2 == "line":
+        line, arc = (el1, el2) if k1 == "line" else (el2, el1)
+        cands = _line_circle(line[1], line[2], *_circle(arc))
+    else:
+        (c1, r1), (c2, r2) = _circle(el1), _circle(el2)
+        dx, dy = c2[0] - c1[0], c2[1] - c1[1]
+        d = math.hypot(dx, dy)
+        if d <= EPS or d > r1 + r2 + 1e-9 or d < abs(r1 - r2) - 1e-9:
+            return []
+        a = (r1 * r1 - r2 * r2 + d * d) / (2 * d)
+        h = math.sqrt(max(r1 * r1 - a * a, 0.0))
+        m = (c1[0] + a * dx / d, c1[1] + a * dy / d)
+        cands = [(m[0] - h * dy / d, m[1] + h * dx / d), (m[0] + h * dy / d, m[1] - h * dx / d)]
+    hits = []
+    for q in cands:
+        t1, t2 = _along(el1, q), _along(el2, q)
+        if t1 is not None and t2 is not None:
+            hits.append((t1, q))
+    return [q for _, q in sorted(hits)]
+
+
+def compile_intersec(ev, e: n.Func):
+    """VARIB=INTERSEC(TAB1[n1], TAB2[n2], CUT) (seed 14.4, L23870-23915): TRUE and the first
+    intersection along TAB1[n1] in CUT[0] (abscissa), CUT[1] (ordinate); FALSE when they do not
+    meet (CUT unchanged)."""
+    args = list(e.args)
+
+    def call():
+        if len(args) != 3 or any(type(a) is not n.Var for a in args):
+            raise EvalError("NC242", "INTERSEC needs TAB1[n1], TAB2[n2] and a result array (seed L23880)")
+        el1, el2 = _row_element(ev, args[0]), _row_element(ev, args[1])
+        cut = ev.make_ref(args[2])
+        if not isinstance(cut, Array) or len(cut.dims) != 1 or cut.dims[0] < 2:
+            raise EvalError("NC242", f"INTERSEC: {args[2].key} must be a REAL array of 2 (seed L23900)")
+        hits = intersections(el1, el2)
+        if not hits:
+            return False
+        cut.set((0,), float(hits[0][0]))
+        cut.set((1,), float(hits[0][1]))
+        return True
+    return call

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
+from nctrans.interp import contour_tables
 from nctrans.interp.compiled import BLOCK, Unit
 from nctrans.interp.cycles import (coarse_pitch, cycle_problems, cycle_table, deep_hole_steps,
                                    expand_cycle, hole_pattern, plane_cycle_levels, swivel_plan, tap_steps)
@@ -215,6 +216,9 @@ class CycleCallsMixin:
                 "the tool would rub or break; start the spindle (M3/M4) before the cycle")
 
     def _h_cycle_call(self, s: n.CycleCall):
+        if self.contour_table is not None:      # a cycle among a contour table's blocks
+            contour_tables.refuse_cycle(self, s.name or s.kind)
+            return None
         if s.kind in TURNING_KINDS:
             return self._turning_cycle(s)
         if s.name and s.kind != "swivel_plane" and self._find_unit(s.name) is not None:

@@ -493,6 +493,9 @@ class Evaluator:
                 return self._bad(f"{e.name.upper()}() initialises an array or array element only")
             if e.name.upper() in _strings.FUNCTIONS:
                 return self._compile_string_func(e)
+            if e.name.upper() == "INTERSEC":        # contour-table rows (seed 14.4)
+                from nctrans.interp import contour_tables
+                return contour_tables.compile_intersec(self, e)
             return self._bad(f"unknown function {e.name!r}")
         args = [self.compile(a) for a in e.args]
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 from contextvars import ContextVar
 from typing import Any, Callable, Iterator, Optional
 
-from nctrans.interp import corner_elements, unmodelled
+from nctrans.interp import contour_tables, corner_elements, unmodelled
 from nctrans.interp.compiled import (BLOCK, CASE, EXEC, Frame, JFALSE, JUMP, MAX_CALL_DEPTH, PLAIN,
                                      Unit, _Stop, _plain_entry, label_key)
 from nctrans.interp.compact_code import CompactCode
@@ -407,6 +407,7 @@ class FlowMixin:
         except _Stop:
             pass
         try:
+            contour_tables.unclosed(self)   # CONTPRON/CONTDCON whose EXECUTE never came
             corner_elements.finish(self)    # a move held for a corner element that never came
             self._comp_flush()
             yield from self._release(out)
