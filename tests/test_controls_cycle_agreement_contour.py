@@ -6,8 +6,10 @@ The PROCs (tests/data/cycle-procs/CYCLE95.SPF, CYCLE72.SPF and their helpers) re
 the real cycles do, through the contour tables of seed 14.2/14.3 (CONTPRON in both directions for
 CYCLE95, CONTDCON for CYCLE72; nctrans/interp/contour_tables.py), and follow the models'
 documented [GK] facts and [NC] choices: they check the arithmetic and the interpreter, not those
-choices. Not covered: FAL (the model's offset along the normal), contours given as labels of the
-calling program ("ANF:END"), what the models refuse (undercuts, DT/DAM, spatial approach)."""
+choices; the offset paths (CYCLE72 RL 41/42, CYCLE95 FAL) by a helper of their own (CYC72OFS:
+convex corners rounded, concave ones cut at the intersection, lines and arcs). Not covered:
+contours given as labels of the calling program ("ANF:END"), what the models refuse (undercuts,
+DT/DAM, a spatial approach)."""
 from __future__ import annotations
 
 import math
@@ -46,6 +48,7 @@ def records_with(contour: str, plane: tuple[str, str]):
 
 # ------------------------------------------------------------------------------------ CYCLE95
 
+PROCS95 = ("CYCLE95", "CYC95ON", "CYC95MV", "CYC72OFS", "CYC72TG", "CYC72X")
 TURN = "G18 G90 {units} {diam} T1 D0\nS800 M3 G95 F0.3\nG0 X{x} Z{z}\n"
 AFTER = "G0 X{x} Z30\nM30\n"
 MODES95 = [("", False), ("", True), ("G70", False), ("G700", True)]
@@ -85,6 +88,7 @@ CALLS95 = {
     "rough": 'CYCLE95("KONT", 1.5, 0.2, 0.4, 0, 0.25, 0.1, 0.12, 1, , , 0.5)',
     "finish": 'CYCLE95("KONT", 2, 0, 0, 0, 0.3, 0.1, 0.08, 5)',
     "complete-default-vrt": 'CYCLE95("KONT", 3, 0, 0.3, 0, 0.3, 0.1, 0.1, 9)',
+    "rough-fal": 'CYCLE95("KONT", 2, 0.1, 0.2, 0.4, 0.3, 0.1, 0.1, 1, , , 1)',
 }
 
 
@@ -94,7 +98,7 @@ CALLS95 = {
 def test_cycle95_model_agrees_with_cycle_code(tmp_path, call, contour, units, diamon):
     pts, arcs = CONTOURS95[contour]
     want = cycle_agreement.agree(tmp_path, turn_program(CALLS95[call], units, diamon),
-                                 procs("CYCLE95", "CYC95ON", "CYC95MV"),
+                                 procs(*PROCS95),
                                  records_with(contour95(pts, diamon, arcs), ("X", "Z")))
     assert sum(m[0] == "linear" for m in want) >= 3
 
@@ -113,9 +117,9 @@ FORMS95 = {
 @pytest.mark.parametrize("what", [0, 1, 2])
 def test_cycle95_forms_agree(tmp_path, form, what, units, diamon):
     vari = 4 * what + form + 1
-    call = f'CYCLE95("KONT", 1.75, 0.2, 0.3, 0, 0.3, 0.1, 0.1, {vari}, , , 0.5)'
+    call = f'CYCLE95("KONT", 1.75, 0.2, 0.3, 0.25, 0.3, 0.1, 0.1, {vari}, , , 0.5)'
     want = cycle_agreement.agree(tmp_path, turn_program(call, units, diamon, x=70, z=12),
-                                 procs("CYCLE95", "CYC95ON", "CYC95MV"),
+                                 procs(*PROCS95),
                                  records_with(contour95(list(reversed(FORMS95[form])) if what == 1 else FORMS95[form],
                                                         diamon), ("X", "Z")))
     assert sum(m[0] == "linear" for m in want) >= 3
@@ -127,7 +131,7 @@ def cycle95_programs(draw):
     round, the allowances, MID, _VRT, VARI, DIAMON and the units."""
     vari = draw(st.integers(1, 12))
     form = (vari - 1) % 4
-    steps = draw(st.lists(st.tuples(st.sampled_from(["d", "p", "taper"]), st.sampled_from([0.5, 1, 2.5, 4, 7])),
+    steps = draw(st.lists(st.tuples(st.sampled_from(["d", "p", "taper"]), st.sampled_from([1, 2.5, 4, 7])),
                           min_size=1, max_size=5))
     d, p = 0.0, 2.0
     rel = [(d, p)]
@@ -144,7 +148,8 @@ def cycle95_programs(draw):
         pts.reverse()
     units, diamon = draw(st.sampled_from(MODES95))
     args = [draw(st.sampled_from([0.7, 1.5, 3])), draw(st.sampled_from([None, 0, 0.2])),
-            draw(st.sampled_from([None, 0, 0.4])), 0, 0.3, 0.1, 0.12, vari, None, None,
+            draw(st.sampled_from([None, 0, 0.4])), draw(st.sampled_from([0, 0.2])), 0.3, 0.1, 0.12, vari,
+            None, None,
             draw(st.sampled_from([None, 0, 0.5, 2]))]
     while args and args[-1] is None:
         args.pop()
@@ -156,7 +161,7 @@ def cycle95_programs(draw):
 @given(cycle95_programs())
 def test_cycle95_agrees_over_parameter_sets(tmp_path_factory, program):
     text, contour = program
-    cycle_agreement.agree(tmp_path_factory.mktemp("t"), text, procs("CYCLE95", "CYC95ON", "CYC95MV"),
+    cycle_agreement.agree(tmp_path_factory.mktemp("t"), text, procs(*PROCS95),
                           records_with(contour, ("X", "Z")))
 
 
