@@ -7,6 +7,8 @@ import math
 
 import pytest
 
+from hypothesis import given, settings, strategies as st
+
 from nctrans.dialects.sinumerik.frontend import parse
 from nctrans.interp.interpreter import Interpreter
 
@@ -347,3 +349,72 @@ def test_intersec_line_through_an_arc_hand_computed():
                        "X20 Y20\nEXECUTE(ER)\nHIT=INTERSEC(TA[1],TC[1],CUT) R1=CUT[0] R2=CUT[1]\nM30\n")
     assert rules(diags) == []
     assert var(it, "HIT") and it.ev.R.get(1) == pytest.approx(18) and it.ev.R.get(2) == pytest.approx(16)
+
+
+def test_transverse_angle_and_g91_code_hand_computed():
+    # "P" (face, external): col 8 measured from the ordinate [NC]: the line (Z0,X30) -> (Z-10,X40)
+    # has (d_abs, d_ord) = (-10, 10): atan2(-10, 10) = -45 -> 135. G91 (a digit 1): code 111.
+    # The level for "P" is Z: the first element falls from Z0 to Z-10 (a relief from row 0, no
+    # count); row 1 Z-10 -> Z-10 (X50, flat); the end Z-10 is not Z0, the contour's highest
+    # level excluding the call point (Z0 is row 0's start): extreme Z -10 -> no extension. Row 1
+    # runs along the ordinate X: 0 degrees to it.
+    it, _, diags = run("DEF REAL TB[5,11]\nDEF INT NN, ER\nG18 G0 X30 Z0\nCONTPRON(TB, \"P\", NN)\n"
+                       "G91 G1 Z-10 X10\nX10\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    t = table(it, "TB")
+    assert t[0][2] == 111 and t[0][8] == pytest.approx(135.0)
+    assert t[1][2] == 111 and t[1][3:7] == [-10, 40, -10, 50] and t[1][8] == 0.0   # along X
+    assert t[2][:2] == [0, 0]
+
+
+def test_one_block_cannot_be_prepared_in_both_directions():
+    it, _, diags = run("DEF REAL TB[5,11]\nDEF INT NN, ER\nG18 G0 X30 Z0\nCONTPRON(TB, \"L\", NN, 1)\n"
+                       "G1 Z-10\nEXECUTE(ER)\nM30\n")
+    assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC242", 6)] and var(it, "ER") == 1
+
+
+@st.composite
+def contours(draw):
+    """Contours of lines and arcs (CR with the sign chosen, G2/G3), any MACH, MODE 0/1."""
+    lines, x, z = [], 30.0, 0.0
+    for _ in range(draw(st.integers(1, 6))):
+        dx, dz = draw(st.sampled_from([-10, -5, 0, 5, 10])), draw(st.sampled_from([-10, -5, 0, 5]))
+        if dx == dz == 0:
+            dz = -5
+        x, z = x + dx, z + dz
+        if draw(st.booleans()) and (dx or dz):
+            cr = math.hypot(dx, dz) / 2 * draw(st.sampled_from([1, 1.5, -1.5]))
+            lines.append(f"{draw(st.sampled_from(['G2', 'G3']))} X{x:g} Z{z:g} CR={cr:g}")
+        else:
+            lines.append(f"G1 X{x:g} Z{z:g}")
+    mach = draw(st.sampled_from("GLNP"))
+    return mach, draw(st.integers(0, 1)), lines
+
+
+@settings(max_examples=60, deadline=None)
+@given(contours())
+def test_any_contour_gives_a_continuous_chain_or_a_located_refusal(c):
+    # the forward chain runs from row 0's end through the "next" pointers, each row starting
+    # where the one before ends, to the contour's last point or (extension) along the level axis;
+    # backwards likewise from the last row's "contour start" pointer; never an exception
+    mach, mode, lines = c
+    text = (f"DEF REAL TB[60,11]\nDEF INT NN, ER\nG18 G0 X30 Z0\nCONTPRON(TB, \"{mach}\", NN, {mode})\n"
+            + "\n".join(lines) + "\nEXECUTE(ER)\nM30\n")
+    it, _, diags = run(text)
+    assert all(d.rule in ("NC242", "NC243", "NC203") for d in diags if d.severity != "info"), diags
+    if var(it, "ER") == 1 or any(d.rule == "NC203" for d in diags):
+        return
+    t = table(it, "TB")
+
+    def walk(first: int, start: tuple) -> tuple:
+        at, row, seen = start, first, 0
+        while row:
+            assert t[row][3:5] == pytest.approx(list(at), abs=1e-6)
+            at, row, seen = tuple(t[row][5:7]), int(t[row][1]), seen + 1
+            assert seen < 60
+        return at
+    end = walk(1, tuple(t[0][5:7])) if int(t[0][0]) != 0 else tuple(t[0][5:7])
+    assert int(t[0][1]) + 1 < 60 and t[int(t[0][1]) + 1][0] == var(it, "NN")
+    if mode == 1:
+        walk(int(t[59][1]), tuple(t[int(t[59][1])][3:5]))
+    assert end is not None

@@ -264,6 +264,10 @@ def execute(it, s: n.SubCall) -> None:
             rows = _rows(it, session, moves, problems)
         except _Refused as ex:
             problems.append((ex.span or it.span, str(ex)))
+    warnings = [p for p in problems if len(p) == 3]      # ("warn", span, message): NC243
+    problems = [p for p in problems if len(p) == 2]
+    for _, span, message in warnings:
+        it.diag("NC243", "warning", f"contour table {session.name}: {message}", span)
     for span, message in problems:
         _problem(it, f"contour table {session.name}: {message}; EXECUTE returns 1", span)
     if rows is not None and not problems:
@@ -458,16 +462,28 @@ def _split_arc(el: Element, axis: int, value: float) -> Optional[tuple]:
             Element(el.code, p, el.end, el.centre, el.snap, el.span))
 
 
+def _arc_extremes(el: Element, axis: int) -> list:
+    """The values of coordinate `axis` at the arc's inner turning points."""
+    sw = sweep(el.start, el.end, el.centre, el.code == 2)
+    r = math.hypot(el.start[0] - el.centre[0], el.start[1] - el.centre[1])
+    a0 = math.degrees(math.atan2(el.start[1] - el.centre[1], el.start[0] - el.centre[0]))
+    out = []
+    for t, v in (((90.0, el.centre[1] + r), (270.0, el.centre[1] - r)) if axis == 1 else
+                 ((0.0, el.centre[0] + r), (180.0, el.centre[0] - r))):
+        d = (t - a0) % 360.0 if sw > 0 else (a0 - t) % 360.0
+        if 1e-9 < d < abs(sw) - 1e-9:
+            out.append(v)
+    return out
+
+
 def _extreme(elements: list, axis: int, sign: float) -> float:
-    """The contour's extreme level (largest sign*coordinate), arcs' inner extremes included."""
+    """The contour's extreme level (largest sign*coordinate), arcs' inner extremes included; the
+    first element's start (where the tool stood at the call) is not the contour's."""
     best = None
     for el in elements:
         vals = [el.end[axis]] + ([el.start[axis]] if best is not None else [])
         if el.centre is not None:
-            r = math.hypot(el.start[0] - el.centre[0], el.start[1] - el.centre[1])
-            if _arc_turns(el, axis):
-                vals += [el.centre[axis] + r, el.centre[axis] - r]
-                vals = [v for v in vals if v is not None]
+            vals += _arc_extremes(el, axis)
         for v in vals:
             if best is None or sign * v > sign * best:
                 best = v
@@ -539,6 +555,9 @@ def _prepare_rows(it, session, elements: list, problems) -> dict:
     fwd_end = free["next"] - 1
     count_b = 0
     bwd = []
+    if session.mode == 1 and len(elements) < 2:
+        raise _Refused("one contour block only: both directions need two or more (seed L23640: "
+                       "too few contour blocks)")
     if session.mode == 1:
         down = {"next": size - 2}
 
@@ -556,10 +575,6 @@ def _prepare_rows(it, session, elements: list, problems) -> dict:
             raise _Refused(f"the table of {size} rows is too small for both directions (seed L23640)")
     if fwd_end + 1 >= size:
         raise _Refused(f"the contour needs {fwd_end + 2} rows; the table has {size} (seed L23640)")
-    warnings = [p for p in problems if p and p[0] == "warn"]
-    for w in warnings:
-        problems.remove(w)
-        it.diag("NC243", "warning", f"contour table {session.name}: {w[2]}", w[1])
 
     def code(el):
         sn = el.snap
