@@ -83,7 +83,9 @@ def as_called(oa: tuple[Any, Optional[str]], ob: tuple[Any, Optional[str]],
     other_caller = api.transpile(lib_caller, read=lib_d, write=other_d).text
     called = _called_name(other_caller, other_d) if other_caller else None
     lib_files, other_files = get(lib_d).subprogram_files(entry), get(other_d).subprogram_files(called or "")
-    if not (lib_files and other_files):
+    if not (lib_files and other_files) or set(lib_files) & set(other_files):
+        # one directory holds both: a name either caller may find must be its own file's alone
+        # (a Fagor conversion keeps the PROC's name, which the Sinumerik caller looks for too)
         return None
     with tempfile.TemporaryDirectory(prefix="nctrans-callers-") as where:
         paths = {os.path.join(where, lib_files[0]): lib[0].label,

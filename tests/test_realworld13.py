@@ -125,3 +125,18 @@ def test_a_kept_word_of_another_construct_on_the_line_stays():
     src = "G21 G90 G54\nG91 G31 P2 Z-10. F100\nM30\n"
     rules = sorted(d.rule for d in nctrans.lint(src, "iso-m") if d.line == 2)
     assert "NC220" in rules and "NC403" in rules
+
+
+def test_a_conversion_that_keeps_the_library_name_is_compared_as_before(tmp_path):
+    # the Fagor conversion of a PROC file is called by the same name: one directory cannot hold
+    # both files under names only their own caller finds, so the pair is compared as given (both
+    # run nothing: equivalent), not with one caller reading the other's file (it read the
+    # Sinumerik text as Fagor: NC129 syntax errors, then a difference)
+    src = "PROC PROBEOFF\nM96\nG4 F0.1\nRET\n"
+    conv = nctrans.transpile(src, read="sinumerik", write="fagor")
+    assert conv.text is not None
+    lib = tmp_path / "PROBEOFF.SPF"
+    lib.write_text(src)
+    result = nctrans.equiv(lib, conv.text, read_a="sinumerik", read_b="fagor")
+    assert result, result.message
+    assert not [d for d in result.diagnostics if d.rule == "NC129"]
