@@ -418,3 +418,10 @@ def test_any_contour_gives_a_continuous_chain_or_a_located_refusal(c):
     if mode == 1:
         walk(int(t[59][1]), tuple(t[int(t[59][1])][3:5]))
     assert end is not None
+
+
+def test_a_dwell_or_spindle_word_among_the_table_blocks_is_refused_not_recorded():
+    it, recs, diags = run("DEF REAL TB[9,6]\nDEF INT ER\nG17 G0 X0 Y0 Z5\nCONTDCON(TB)\nG1 X10 F100\n"
+                          "G4 F2\nY10\nEXECUTE(ER)\nM30\n")
+    assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC242", 6)]
+    assert var(it, "ER") == 1 and [r.kind for r in recs if r.kind == "dwell"] == []

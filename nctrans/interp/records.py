@@ -21,6 +21,11 @@ class RecordsMixin:
     """Moves and other records into `out`; cutter compensation glue."""
 
     def _record(self, kind: str, **kw) -> None:
+        if self.contour_table is not None:      # a dwell, M function .. among a contour table's blocks
+            self.contour_table.problems.append((self.span, f"a {kind} record (only G0-G3, RND/CHF, CIP, "
+                                                "CT and the modal codes may describe the contour, seed "
+                                                "L23281, L23600-23615): left out"))
+            return
         rec = ToolpathRecord(0, self.span.file if self.span else self.program.file,
                              self.span.line if self.span else 1, kind, **kw)
         if self.corner is not None and corner_elements.record(self, rec):
