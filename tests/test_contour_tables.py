@@ -265,15 +265,23 @@ def test_contdcon_inch_incremental_and_diameter():
 
 
 def test_exectab_runs_rows_as_blocks():
-    # rows 1 and 3 of seed example 2's table (forwards): (20,20)->(20,45) G1, then the G2 arc
-    # (0,45)->(-15,30) about (-15,45); from X100 Z100 the first EXECTAB feeds to Z20 X45.
-    it, recs, diags = run(SEED_2.replace("N190 G1 X0\n", "N190 EXECTAB(KTAB[1])\nN200 EXECTAB(KTAB[3])\n"))
+    # rows 1, 2 and 3 of seed example 2's table (forwards), from X100 Z100: row 1 ends at (Z20, X45),
+    # row 2 at (Z0, X45), row 3 is the G2 arc to (Z-15, X30) about (Z-15, X45)
+    it, recs, diags = run(SEED_2.replace("N190 G1 X0\n", "N190 EXECTAB(KTAB[1])\nN200 EXECTAB(KTAB[2])\n"
+                                         "N210 EXECTAB(KTAB[3])\n"))
     assert rules(diags) == []
     moves = [r for r in recs if r.kind in ("linear", "arc")]
-    assert moves[-2].kind == "linear" and moves[-2].end == {"X": 45.0, "Y": 0.0, "Z": 20.0}
+    assert [(m.kind, m.end["Z"], m.end["X"]) for m in moves[-3:]] == [
+        ("linear", 20.0, 45.0), ("linear", 0.0, 45.0), ("arc", -15.0, 30.0)]
     arc = moves[-1]
-    assert arc.kind == "arc" and arc.end == {"X": 30.0, "Y": 0.0, "Z": -15.0}
     assert arc.direction == "cw" and (arc.center["Z"], arc.center["X"]) == (-15.0, 45.0)
+
+
+def test_exectab_arc_away_from_its_start_alarms():
+    # row 3's arc (radius 15 about (-15,45)) run from (Z20, X45), 35 from its centre: NC203, no move
+    it, recs, diags = run(SEED_2.replace("N190 G1 X0\n", "N190 EXECTAB(KTAB[1])\nN200 EXECTAB(KTAB[3])\n"))
+    assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC203", 17)]
+    assert [r.kind for r in recs if r.kind == "arc"] == []
 
 
 # ------------------------------------------------------------------ refused at the line

@@ -663,8 +663,15 @@ def traverse(it, s: n.SubCall) -> None:
         it._need_feed()
         it._move("linear", end)
     else:
+        from nctrans.interp import arcs
+        centre = (f(a1, vals[9]), f(a2, vals[10]))
+        err = arcs.check_center(it.pos.get(a1, 0.0), it.pos.get(a2, 0.0), end[a1], end[a2], centre[0],
+                                centre[1], st.scale != 1.0)
+        if err:                 # the row's arc does not start where the tool stands: the control alarms
+            it.diag("NC203", "error", f"EXECTAB({arg.key}[{row}]): {err}")
+            return
         it._need_feed()
-        it._move("arc", end, (f(a1, vals[9]), f(a2, vals[10])), g == 2)
+        it._move("arc", end, centre, g == 2)
 
 
 # ---------------------------------------------------------------------------------------------
