@@ -63,6 +63,13 @@ def installed(outside):
     return venv / "bin", wheel, env
 
 
+def test_one_worker_runs_this_module(request):
+    """Under make test (--dist loadgroup) the group mark reaches xdist, so the wheel is built and
+    installed once; a pytest or xdist whose node ids lose the group would build it on each worker."""
+    if getattr(request.config.option, "loadgroup", False):
+        assert request.node.nodeid.endswith("@wheel"), request.node.nodeid
+
+
 def test_wheel_carries_every_data_file_and_the_kernel(installed):
     _, wheel, _ = installed
     names = set(zipfile.ZipFile(wheel).namelist())
