@@ -36,13 +36,15 @@ bench: $(STAMP)
 
 # FUZZ_SECONDS: coverage-guided (atheris) time per front end; crashes are kept as regression cases
 # under tests/data/fuzz-crashes (run by tests/test_fuzz_crashes.py in `make test`). FUZZ_EXAMPLES:
-# examples of each long property run (tests/fuzz) after it. Exit 1 when a crash was kept.
+# examples of each long property run (tests/fuzz) after it; then the property tests marked
+# long_property run at their full count (make test runs them briefly). Exit 1 when a crash was kept.
 FUZZ_SECONDS ?= 120
 FUZZ_EXAMPLES ?= 20000
 fuzz: $(STAMP)
 	$(BIN)/pip install --quiet -e '.[fuzz]'
 	status=0; $(BIN)/python fuzz/fuzz_frontends.py $(FUZZ_SECONDS) || status=$$?; \
 	NCTRANS_FUZZ_PROFILE_SET=1 NCTRANS_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 tests/fuzz --hypothesis-profile=fuzz || status=$$?; \
+	NCTRANS_FUZZ_PROFILE_SET=1 $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 -m long_property tests || status=$$?; \
 	exit $$status
 
 clean:

@@ -82,8 +82,16 @@ settings.register_profile(
 )
 settings.register_profile("default", max_examples=60, deadline=None,
                           suppress_health_check=[HealthCheck.too_slow])
-if not os.environ.get("NCTRANS_FUZZ_PROFILE_SET"):
+FUZZING = bool(os.environ.get("NCTRANS_FUZZ_PROFILE_SET"))
+if not FUZZING:
     settings.load_profile("default")
+
+
+def examples(full: int, brief: int) -> int:
+    """max_examples of a long property test (marked long_property): `brief` in `make test`, which
+    must stay inside the CI budget on 2 cores, and `full` under `make fuzz`, which runs the marked
+    tests again with NCTRANS_FUZZ_PROFILE_SET. `brief` stays large enough for the property to bite."""
+    return full if FUZZING else brief
 
 
 class TextSink:

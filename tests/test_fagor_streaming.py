@@ -24,7 +24,7 @@ from nctrans.dialects.base import StreamedBody
 from nctrans.dialects.fagor.frontend import parse
 from nctrans.dialects.fagor.stream import plain_line, streamable
 
-from conftest import CORPUS
+from conftest import CORPUS, examples
 
 NATIVE = plainrun.native
 ISO_MILL = CORPUS / "iso-mill"
@@ -173,7 +173,8 @@ PLAIN_WORD = st.tuples(st.sampled_from("NGXYZIJKFABCUVW"),
                                         "0.0001"])).map("".join)
 
 
-@settings(max_examples=500, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(500, 150), deadline=None)
 @given(st.lists(PLAIN_WORD, min_size=1, max_size=6), st.sampled_from([" ", "  ", ""]))
 def test_scan_takes_only_lines_plain_line_lowers_as_the_front_end_does(words, sep):
     """A line the kernel's strict scan takes is lowered by plain_line exactly as the full front end

@@ -13,7 +13,7 @@ from nctrans import equivalence as equiv
 from nctrans.dialects.base import get
 from nctrans.interp import interpret
 from test_iso_roundtrip import iso_program
-from conftest import CORPUS
+from conftest import CORPUS, examples
 
 ISO_MILL = CORPUS / "iso-mill"
 ISO = get("iso-m")
@@ -37,7 +37,8 @@ def _assert_normalised_equivalent(text: str, name: str) -> None:
 
 # derandomized: equiv discretises arcs by chord error, so a generated arc of a 10 m radius costs
 # ~10^4 chords; a fixed example set keeps this test's time stable in CI (make fuzz explores more)
-@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow],
+@pytest.mark.long_property
+@settings(max_examples=examples(80, 30), deadline=None, suppress_health_check=[HealthCheck.too_slow],
           derandomize=True)
 @given(iso_program())
 def test_generated_program_equals_its_normalised_form(text):

@@ -9,7 +9,7 @@ from hypothesis import given, settings, strategies as st
 
 from nctrans.dialects.iso_m import emit, parse
 from nctrans.ir import nodes as n
-from conftest import CORPUS
+from conftest import CORPUS, examples
 from roundtrip import assert_ir_round_trip
 
 ISO_FILES = sorted((CORPUS / "iso-mill").glob("*"))
@@ -99,7 +99,8 @@ def iso_program(draw):
     return "\n".join(lines) + "\n%\n"
 
 
-@settings(max_examples=150, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(150, 60), deadline=None)
 @given(iso_program())
 def test_generated_programs_round_trip(text):
     assert_round_trip(text)

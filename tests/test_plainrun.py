@@ -22,7 +22,7 @@ from nctrans import pipeline, plainrun, source, toolpath_io
 from nctrans.dialects.iso_m.fastpath import PLAIN, WORD
 from nctrans.dialects.iso_m.frontend import Lowering
 
-from conftest import CORPUS
+from conftest import CORPUS, examples
 
 GEOMETRY = Path(__file__).parent / "data" / "rs274-geometry-machine.toml"
 NATIVE = plainrun.native
@@ -164,7 +164,8 @@ HEADER = st.lists(st.sampled_from(["G20", "G21", "G90", "G91", "G54", "G55", "G4
                   min_size=0, max_size=4)
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@pytest.mark.long_property
+@settings(max_examples=examples(150, 60), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(HEADER.map("".join), st.lists(st.one_of(*[SPACED] * 6, HEADER.map("".join), st.just("")),
                                      min_size=1, max_size=30),
        st.sampled_from(["\n", "\r\n"]), st.booleans())
@@ -188,7 +189,8 @@ CAM_LINE = st.tuples(
 ).map(lambda t: t[0] + t[1] + "".join(f"{a}{v}" for a, v in zip(t[2], t[3])) + t[5] + t[4])
 
 
-@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@pytest.mark.long_property
+@settings(max_examples=examples(100, 40), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(HEADER.map("".join), st.lists(st.one_of(*[CAM_LINE] * 12, HEADER.map("".join)), min_size=5,
                                      max_size=60), st.booleans())
 def test_generated_cam_program_same_with_and_without_kernel(header, lines, geometry):
@@ -203,7 +205,8 @@ def test_generated_cam_program_same_with_and_without_kernel(header, lines, geome
 
 # ------------------------------------------------------------------ the scan
 
-@settings(max_examples=600, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(600, 200), deadline=None)
 @given(SPACED, st.sampled_from(["", "\r"]), st.sampled_from([None, "rapid", "linear", "arc_cw", "arc_ccw"]),
        st.sampled_from([None, "drill"]), st.booleans())
 def test_scan_accepts_only_what_the_python_fast_path_lowers(line, cr, motion, cycle, arc_abs):
@@ -233,7 +236,8 @@ def test_scan_spans_blank_lines_inside_a_run_only():
     assert text[end:].startswith("\n(comment)")              # the trailing blank line is not taken
 
 
-@settings(max_examples=3000, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(3000, 500), deadline=None)
 @given(st.one_of(st.floats(-2e9, 2e9, allow_nan=False), st.floats(-1e-3, 1e-3),
                  st.integers(-10**9, 10**9).map(lambda i: i / 128),
                  st.integers(-10**12, 10**12).map(lambda i: (i + 0.5) / 1e6),
@@ -255,7 +259,8 @@ WORD_NUMBER = st.one_of(
 ).filter(re.compile(r"[-+]?(\d+\.?\d*|\.\d+)").fullmatch)      # a word's number (number_len)
 
 
-@settings(max_examples=3000, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(3000, 500), deadline=None)
 @given(WORD_NUMBER)
 def test_kernel_reads_numbers_as_float_does(text):
     """The kernel's exact fast path (integer digits / 10^k) and its fallback give float()'s double,

@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from nctrans import pipeline, plainrun, source, toolpath_io
 from nctrans.interp import native as native_lane
 
-from conftest import CORPUS
+from conftest import CORPUS, examples
 
 NATIVE = plainrun.native
 
@@ -96,7 +96,8 @@ LINE = st.one_of(
 )
 
 
-@settings(max_examples=120, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(120, 60), deadline=None)
 @given(st.lists(LINE, min_size=1, max_size=40), st.integers(1, 4), st.booleans(),
        st.sampled_from(["sinumerik", "iso-m"]))
 def test_kernel_calls_of_few_blocks_give_the_same_toolpath(lines, kernel_blocks, final_newline, dialect):

@@ -11,7 +11,7 @@ from nctrans.dialects.sinumerik.emitter import emit
 from nctrans.dialects.sinumerik.frontend import parse
 from nctrans.ir import nodes as ir
 from nctrans.source import read_source
-from conftest import CORPUS
+from conftest import CORPUS, examples
 from roundtrip import assert_ir_round_trip, ir_round_trip
 
 REPO = Path(__file__).resolve().parents[1]
@@ -258,7 +258,8 @@ def programs(draw):
     return "\n".join(lines) + "\n"
 
 
-@settings(max_examples=80, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(80, 30), deadline=None)
 @given(programs())
 def test_roundtrip_generated_programs(text):
     first = parse(text, "gen.mpf")

@@ -24,7 +24,7 @@ from nctrans.dialects.base import StreamedBody
 from nctrans.dialects.sinumerik.frontend import parse, plain_line, streamable
 from nctrans.machine import Machine
 
-from conftest import CORPUS
+from conftest import CORPUS, examples
 
 NATIVE = plainrun.native
 ISO_MILL = CORPUS / "iso-mill"
@@ -178,7 +178,8 @@ PLAIN_WORD = st.tuples(st.sampled_from("NGXYZIJKFABCUVW"),
                                         "0.0001"])).map("".join)
 
 
-@settings(max_examples=500, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(500, 150), deadline=None)
 @given(st.lists(PLAIN_WORD, min_size=1, max_size=6), st.sampled_from([" ", "  ", ""]))
 def test_scan_takes_only_lines_plain_line_lowers_as_the_front_end_does(words, sep):
     """A line the kernel's strict scan takes is lowered by plain_line exactly as the full front end
@@ -241,7 +242,8 @@ PLAIN_BLOCK_WORD = st.one_of(
               st.sampled_from(["0", "5", "5.5", ".5", "2.", "1EX3"]))).map("".join)
 
 
-@settings(max_examples=400, deadline=None)
+@pytest.mark.long_property
+@settings(max_examples=examples(400, 120), deadline=None)
 @given(st.lists(PLAIN_BLOCK_WORD, min_size=1, max_size=5), st.sampled_from([" ", "  "]))
 def test_plain_words_read_without_the_parser_lower_as_the_parsers_trees(words, sep):
     """Blocks of plain words (`X10`, `Z1=0`, `CR=-5.5`) skip lark (frontend._plain_words): the
