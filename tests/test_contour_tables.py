@@ -433,3 +433,34 @@ def test_a_dwell_or_spindle_word_among_the_table_blocks_is_refused_not_recorded(
                           "G4 F2\nY10\nEXECUTE(ER)\nM30\n")
     assert [(d.rule, d.line) for d in diags if d.severity != "info"] == [("NC242", 6)]
     assert var(it, "ER") == 1 and [r.kind for r in recs if r.kind == "dwell"] == []
+
+
+def test_diamon_table_holds_diameters_and_true_angles():
+    # DIAMON, from X20 (radius 10) Z1: row 0 G1 Z0; row 1 X40 Z-10 (radius 10 -> 20 over 10 in Z):
+    # held as X20 -> X40 as programmed [NC], its angle the true one, atan2(+10, -10) = 135 degrees
+    # (not atan2(20, -10) = 116.57 of the diameters). Row 2 G2 X60 Z-20 CR=10 from (Z-10, r20) to
+    # (Z-20, r30): the minor arc's centre is (Z-10, r30), held as X60; its direction turns from
+    # 180 (along -Z) clockwise to 90 (+X): inside values (90, 180) -> largest 180.
+    it, _, diags = run("DEF REAL TB[6,11]\nDEF INT NN, ER\nG18 DIAMON G0 X20 Z1\nCONTPRON(TB, \"L\", NN)\n"
+                       "G1 Z0\nX40 Z-10\nG2 X60 Z-20 CR=10\nEXECUTE(ER)\nM30\n")
+    assert rules(diags) == []
+    t = table(it, "TB")
+    assert t[1][3:7] == [0, 20, -10, 40] and t[1][8] == pytest.approx(135.0)
+    assert t[2][3:7] == [-10, 40, -20, 60] and t[2][9:11] == [-10, 60] and t[2][8] == pytest.approx(180.0)
+
+
+def test_intersec_under_diamon_works_in_radius():
+    # the DIAMON table above: row 1 X20 -> X40 (Z0 -> Z-10; radius 10 -> 20) and a second table's
+    # line at radius 15 along Z (X30 from Z5 to Z-15): they meet at Z-5, radius 15, held as X30.
+    # Row 2's arc (centre Z-10 r30, radius 10) against the line at radius 25 (X50) from Z0 to Z-30:
+    # (Z+10)^2 + (25-30)^2 = 100 -> Z = -10 -/+ 8.660: on the arc (Z -10 .. -20) Z = -18.660; X50.
+    it, _, diags = run("DEF REAL TB[6,11]\nDEF REAL TL[6,11]\nDEF REAL TM[6,11]\nDEF REAL CUT[2]\n"
+                       "DEF BOOL HITA, HITB\nDEF INT NN, ER\nG18 DIAMON G0 X20 Z1\n"
+                       "CONTPRON(TB, \"L\", NN)\nG1 Z0\nX40 Z-10\nG2 X60 Z-20 CR=10\nEXECUTE(ER)\n"
+                       "G0 X30 Z10\nCONTPRON(TL, \"L\", NN)\nG1 Z5\nZ-15\nEXECUTE(ER)\n"
+                       "G0 X50 Z10\nCONTPRON(TM, \"L\", NN)\nG1 Z0\nZ-30\nEXECUTE(ER)\n"
+                       "HITA=INTERSEC(TB[1],TL[1],CUT) R1=CUT[0] R2=CUT[1]\n"
+                       "HITB=INTERSEC(TB[2],TM[1],CUT) R3=CUT[0] R4=CUT[1]\nM30\n")
+    assert rules(diags) == []
+    assert var(it, "HITA") and var(it, "HITB")
+    assert [it.ev.R.get(k) for k in (1, 2, 3, 4)] == pytest.approx([-5, 30, -10 - math.sqrt(75), 50])

@@ -318,8 +318,7 @@ def _elements(it, session, moves) -> tuple[tuple, list]:
                        "contour blocks)")
 
     def f(axis: str, v: float) -> float:
-        v = v / (st.scale or 1.0)
-        return 2 * v if axis == "X" and st.diameter else v
+        return v / (st.scale or 1.0)
 
     def pt(p) -> tuple:
         return (f(a1, p.get(a1, 0.0)), f(a2, p.get(a2, 0.0)))
@@ -342,10 +341,38 @@ def _elements(it, session, moves) -> tuple[tuple, list]:
 
 
 def _rows(it, session, moves, problems) -> dict:
+    """The table's rows. The geometry is worked out true to size (program units, X a radius);
+    the rows hold X as programmed, a diameter under DIAMON [NC]."""
     start, elements = _elements(it, session, moves)
     if session.kind == "decode":
-        return _decode_rows(session, start, elements)
-    return _prepare_rows(it, session, elements, problems)
+        rows = _decode_rows(session, start, elements)
+        cols = ((1, 2), (3, 4))
+    else:
+        rows = _prepare_rows(it, session, elements, problems)
+        cols = ((3, 4), (5, 6), (9, 10))
+    k = diameter_index(it)
+    if k is not None:
+        for r, row in rows.items():
+            if r == "_count" or (session.kind == "prepare" and r == _counts_row(rows)):
+                continue
+            for pair in cols:
+                if session.kind == "decode" and r == 0 and pair == (3, 4):
+                    continue
+                row[pair[k]] *= 2
+    return rows
+
+
+def diameter_index(it) -> Optional[int]:
+    """The table coordinate (0 abscissa, 1 ordinate) that holds X as a diameter, or None."""
+    a1, a2, _ = PLANE_AXES[it.st.plane]
+    if not it.st.diameter or "X" not in (a1, a2):
+        return None
+    return 0 if a1 == "X" else 1
+
+
+def _counts_row(rows: dict) -> int:
+    """The CONTPRON row after the forward table: the relief counts (no coordinates)."""
+    return int(rows[0][1]) + 1
 
 
 def _decode_rows(session, start, elements) -> dict:
@@ -696,6 +723,12 @@ def _row_element(ev, var: n.Var) -> tuple:
     return ("line", (v[3], v[4]), (v[5], v[6]), None, None)
 
 
+def _scaled(el, k: int, f: float) -> tuple:
+    def s(p):
+        return None if p is None else tuple(v * f if i == k else v for i, v in enumerate(p))
+    return (el[0], s(el[1]), s(el[2]), s(el[3]), el[4])
+
+
 def _along(el, q) -> Optional[float]:
     """Where q lies on the element, 0..1 from its start (None: not on it)."""
     kind, s, e, c, cw = el
@@ -780,10 +813,17 @@ def compile_intersec(ev, e: n.Func):
         cut = ev.make_ref(args[2])
         if not isinstance(cut, Array) or len(cut.dims) != 1 or cut.dims[0] < 2:
             raise EvalError("NC242", f"INTERSEC: {args[2].key} must be a REAL array of 2 (seed L23900)")
+        reader = getattr(ev, "table_diameter_index", None)
+        k = reader() if reader is not None else None
+        if k is not None:               # X held as a diameter: the circles are true to size in radius
+            el1, el2 = _scaled(el1, k, 0.5), _scaled(el2, k, 0.5)
         hits = intersections(el1, el2)
         if not hits:
             return False
-        cut.set((0,), float(hits[0][0]))
-        cut.set((1,), float(hits[0][1]))
+        q = list(hits[0])
+        if k is not None:
+            q[k] *= 2
+        cut.set((0,), float(q[0]))
+        cut.set((1,), float(q[1]))
         return True
     return call

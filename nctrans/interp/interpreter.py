@@ -275,6 +275,8 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         settable_frames.register(self)
         tool_edges.register(self)      # [t, d] edges first: edge_data adds the flat [d] form
         edge_data.register(self)
+        # which table coordinate is X held as a diameter (INTERSEC works true to size)
+        self.ev.table_diameter_index = lambda: contour_tables.diameter_index(self)
         self.ev.on_unmodelled_read = lambda name: self.diag(
             "NC236", "warning", f"system variable {name} is not modelled: its value is unknown to "
             "the analysis (what it drives is left out)")
