@@ -34,7 +34,8 @@ end there (backwards in the seed's example 2). A relief starting at row 0 (the a
 call point) is not counted. NN gets the forward count.
 Not derived, said at the line (NC242): an arc whose level turns inside it (col 7 and the count
 are then not reliable), transverse machining angles (col 8 measured from the ordinate [NC]).
-The table holds lengths as the blocks program them: program units, X a diameter under DIAMON.
+The table holds lengths as the blocks program them: program units, X a diameter under DIAMON;
+the geometry (angles, levels, splits, INTERSEC) is worked out true to size, X a radius.
 The blocks' modal changes and the position are undone at EXECUTE: the blocks were only read.
 """
 from __future__ import annotations
