@@ -25,6 +25,10 @@ from roundtrip import ConversionRoundTrip, convert_policy
 from test_conversion_iso_sinumerik import (ISO_MILL, _errors, originals,  # noqa: F401
                                            zero_table)
 
+# One xdist worker runs these tests (make test: --dist loadgroup): they share what is computed once
+# per process (the rs274 runs of the originals, the lru-cached round trips), which a split computes twice.
+pytestmark = pytest.mark.xdist_group("conversion-rs274")
+
 REPO = Path(__file__).resolve().parents[1]
 FAGOR = sorted((REPO / "corpus" / "fagor").glob("*.nc"))
 

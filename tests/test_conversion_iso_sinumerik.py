@@ -39,6 +39,10 @@ from nctrans.dialects.iso_m.plan import stable_number
 from nctrans.lower.flatten import flatten
 from nctrans.machine import default_mill
 
+# One xdist worker runs these tests (make test: --dist loadgroup): they share what is computed once
+# per process (the rs274 runs of the originals, the lru-cached round trips), which a split computes twice.
+pytestmark = pytest.mark.xdist_group("conversion-rs274")
+
 REPO = Path(__file__).resolve().parents[1]
 ISO_MILL = sorted(p for p in (CORPUS / "iso-mill").iterdir() if p.is_file()) \
     if (CORPUS / "iso-mill").is_dir() else []

@@ -12,6 +12,10 @@ import pytest
 
 from conftest import CORPUS
 
+# One xdist worker runs this module (make test: --dist loadgroup): its tests read one module fixture
+# (every corpus program converted both ways, ~10 s), which a split computes on each worker.
+pytestmark = pytest.mark.xdist_group("structure-share")
+
 _SPEC = importlib.util.spec_from_file_location(
     "bench_structure", Path(__file__).resolve().parents[1] / "bench" / "bench_structure.py")
 bench_structure = importlib.util.module_from_spec(_SPEC)
