@@ -107,6 +107,7 @@ M99
 O0300 (G68 rotation, G52 local offset, G92 shift, G51.1 mirror, G51 scale)
 G21 G90 G17 G54
 T1 M6
+S1000 M3
 G0 X0 Y0 Z5.
 G1 F300.
 G68 X10. Y10. R30.

@@ -129,6 +129,24 @@ def test_tool_change_that_stops_the_spindle():
     assert found(text.replace("G1 X20\n", run + "\n"), "iso-m") == [(6, "NC209")]
 
 
+def test_tool_change_before_the_spindle_was_ever_started():
+    """A real program (a NIMS training part) changes to its face mill, sets S and cuts with no
+    M03: the spindle stands from power-on through the change, so the first feed (line 4) is NC209.
+    With the M03 it is clean; the change on a machine whose M6 leaves the spindle alone is not
+    flagged (its power-on state is no program's stop); a program with no tool change and no
+    spindle word stays unflagged (a fragment)."""
+    text = "G90 G21\nT20 M06\nS1254\nG01 Z0 F564.\nG01 X50.\nM30\n"
+    assert found(text, "iso-m") == [(4, "NC209")]                   # said once, at the first cut
+    assert found(text.replace("S1254", "S1254 M03"), "iso-m") == []
+    keeps = Machine(name="m", tool_change=ToolChange(stops_spindle=False))
+    assert found(text, "iso-m", keeps) == []
+    assert found(text.replace("T20 M06\n", ""), "iso-m") == []
+    # M05, a cut (said), then a change: the spindle has stood since the M05, said once until it is
+    # programmed again, so the cut after the change (line 7) is not said a second time
+    two = "T1 M06\nS1000 M03\nG01 X10 F100\nM05\nG01 X20\nT2 M06\nG01 X30\nM30\n"
+    assert found(two, "iso-m") == [(5, "NC209")]
+
+
 # --------------------------------------------------------------------------- NC214 units
 
 UNITS = {

@@ -168,8 +168,11 @@ class RunChecks:
         if running:
             self.diag("NC213", "warning", f"tool change while {' and '.join(running)}: this machine's "
                       "tool change needs them stopped first")
-        if self._rc_stops_spindle and st.spindle_dir in ("cw", "ccw"):
-            # the change leaves the spindle stopped: NC209 reports a cut before it starts again
+        if self._rc_stops_spindle and not self.spindle_stopped:
+            # the change leaves the spindle stopped: NC209 reports a cut before it starts again,
+            # also where the program had not yet started it (its power-on state): after the
+            # change it is known to stand, and a program that changes tools is no fragment
+            # (`T20 M06`, `S1254`, then a cut with no M03 linted clean)
             self.spindle_stopped = True
             self.spindle_reported = False
             self.spindle_stopped_by_tap = False
