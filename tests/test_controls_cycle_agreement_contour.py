@@ -24,14 +24,15 @@ import cycle_agreement
 from cycle_agreement import num, procs
 
 
-def records_with(contour: str, plane: tuple[str, str]):
-    """A records function for cycle_agreement: the program beside its contour subprogram KONT."""
+def records_with(contour: str, plane: tuple[str, str], machine=None):
+    """A records function for cycle_agreement: the program beside its contour subprogram KONT,
+    run with `machine` (None: the dialect's default machine)."""
     def records(where: Path, text: str):
         (where / "KONT.SPF").write_text(contour)
         path = where / "MAIN.MPF"
         path.write_text(text)
         ld = pipeline.load(str(path), "sinumerik")
-        recs = list(pipeline.toolpath_of(ld))
+        recs = list(pipeline.toolpath_of(ld, machine))
         bad = [d.format_text() for d in ld.diagnostics if d.severity in ("error", "warning")]
         out, at = [], None
         for r in recs:
@@ -175,25 +176,7 @@ def mill_records(contour: str):
     """Records of a milling program with tool 1 (radius 3) in the machine model."""
     from nctrans.machine import Machine, Tool
     machine = Machine(name="t", tools=[Tool(number=1, radius=3.0, length=0.0)])
-
-    def records(where: Path, text: str):
-        (where / "KONT.SPF").write_text(contour)
-        path = where / "MAIN.MPF"
-        path.write_text(text)
-        ld = pipeline.load(str(path), "sinumerik")
-        recs = list(pipeline.toolpath_of(ld, machine))
-        bad = [d.format_text() for d in ld.diagnostics if d.severity in ("error", "warning")]
-        out, at = [], None
-        for r in recs:
-            if r.kind in ("rapid", "linear", "arc"):
-                end = tuple(r.end.get(a, 0.0) for a in ("X", "Y", "Z"))
-                if r.kind != "arc" and at is not None and max(abs(p - q) for p, q in zip(end, at)) < 1e-7:
-                    continue
-                at = end
-                arc = ((r.center["X"], r.center["Y"]), r.direction) if r.kind == "arc" else None
-                out.append((r.kind, end, r.feed if r.kind != "rapid" else None, arc))
-        return out, bad
-    return records
+    return records_with(contour, ("X", "Y"), machine)
 
 
 CONTOURS72 = {
