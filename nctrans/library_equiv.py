@@ -94,7 +94,12 @@ def as_called(oa: tuple[Any, Optional[str]], ob: tuple[Any, Optional[str]],
             with open(path, "w", encoding="utf-8") as f:
                 f.write(text)
         a_text, b_text = (lib_caller, other_caller) if lib is oa else (other_caller, lib_caller)
-        result = compare(a_text, b_text, read_a=oa[1], read_b=ob[1], search_path=[where, *dirs])
+        # then the given files' own directories: a subprogram the library calls sits beside it
+        # (and its conversion beside the other file), as when either file runs where it is
+        beside = [os.path.dirname(os.path.abspath(side[0].label)) for side in (lib, other)
+                  if os.path.isfile(side[0].label)]
+        result = compare(a_text, b_text, read_a=oa[1], read_b=ob[1],
+                         search_path=[where, *dict.fromkeys(beside), *dirs])
     return _relabelled(result, paths)
 
 

@@ -464,3 +464,47 @@ def test_intersec_under_diamon_works_in_radius():
     assert rules(diags) == []
     assert var(it, "HITA") and var(it, "HITB")
     assert [it.ev.R.get(k) for k in (1, 2, 3, 4)] == pytest.approx([-5, 30, -10 - math.sqrt(75), 50])
+
+
+# ------------------------------------------------------------- the session ends cleanly (review)
+
+def test_a_frame_set_among_the_table_blocks_is_refused_and_undone():
+    """TRANS X100 between CONTPRON and EXECUTE (forbidden, seed L23311): the frame is edited in
+    place, so the old identity test never saw it; lint was clean and the move after EXECUTE went
+    to X101. Now NC242 at EXECUTE and the call's frame again: G0 X1 Z1 ends at X1 Z1."""
+    it, recs, diags = run('DEF REAL TABC[12,11]\nDEF INT NN, ER\nG18 G0 X0 Z0 F100\n'
+                          'CONTPRON(TABC,"L",NN)\nTRANS X100\nG1 X10 Z-5\nEXECUTE(ER)\n'
+                          'G0 X1 Z1\nM30\n')
+    assert [(d.rule, d.line) for d in diags if d.severity == "error"] == [("NC242", 7)]
+    moves = [r for r in recs if r.kind in ("rapid", "linear", "arc")]
+    assert moves[-1].end["X"] == pytest.approx(1.0) and moves[-1].end["Z"] == pytest.approx(1.0)
+    assert var(it, "ER") == 1
+
+
+def test_a_bad_err_argument_still_ends_the_session():
+    """EXECUTE(UNDEFX): the name was resolved before the session closed, so the error left it
+    capturing and every later block moved nothing. Now NC101 at EXECUTE and the move after runs."""
+    it, recs, diags = run('DEF REAL TABC[12,11]\nDEF INT NN\nG18 G0 X0 Z0 F100\n'
+                          'CONTPRON(TABC,"L",NN)\nG1 X10 Z-5\nEXECUTE(UNDEFX)\nG1 X4 Z-8\nM30\n')
+    assert ("NC101", 6) in [(d.rule, d.line) for d in diags]
+    ends = [(r.end["X"], r.end["Z"]) for r in recs if r.kind == "linear"]
+    assert ends == [(4.0, -8.0)]                    # the table's G1 moved nothing, line 7 moves
+
+
+def test_a_subprogram_that_returns_without_execute_gives_the_caller_its_moves_back(tmp_path):
+    """CONTPRON in a PROC that returns with no EXECUTE: the caller's blocks were captured and
+    vanished (one record). Now NC242 at the CONTPRON line; the caller's G1 X50 Y50 and G0 X0 Y0
+    run, from where the PROC's call left the tool (its G1 X10 Y5 only described a contour)."""
+    from nctrans import pipeline
+    (tmp_path / "SUBT.SPF").write_text('PROC SUBT\nDEF REAL TABC[8,11]\nDEF INT NN\n'
+                                       'CONTPRON(TABC,"L",NN)\nG1 X10 Y5\nM17\n')
+    main = tmp_path / "MAIN.MPF"
+    main.write_text("G17 G0 X0 Y0 F100\nSUBT\nG1 X50 Y50\nG0 X0 Y0\nM30\n")
+    ld = pipeline.load(str(main), "sinumerik")
+    recs = list(pipeline.toolpath_of(ld))
+    found = [(d.rule, d.file.endswith("SUBT.SPF"), d.line) for d in ld.diagnostics
+             if d.severity == "error"]
+    assert found == [("NC242", True, 4)]
+    ends = [(r.kind, r.end["X"], r.end["Y"]) for r in recs if r.kind in ("rapid", "linear")]
+    # line 1's rapid, then the caller's two moves after the return
+    assert ends == [("rapid", 0.0, 0.0), ("linear", 50.0, 50.0), ("rapid", 0.0, 0.0)]

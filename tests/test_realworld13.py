@@ -140,3 +140,33 @@ def test_a_conversion_that_keeps_the_library_name_is_compared_as_before(tmp_path
     result = nctrans.equiv(lib, conv.text, read_a="sinumerik", read_b="fagor")
     assert result, result.message
     assert not [d for d in result.diagnostics if d.rule == "NC129"]
+
+
+def test_a_library_that_calls_a_sibling_is_compared_with_it_wherever_it_is_run(tmp_path, monkeypatch):
+    """Review of wave 13: the callers searched only the temporary directory and --search-path, so
+    the subprogram the library calls (beside it) was found from one working directory and not from
+    another: "equivalent" from the first, the called part never compared. The given files' own
+    directories are searched now: the sibling's move (X30 Y5, edited to X31 on one side) counts."""
+    lib_dir, iso_dir = tmp_path / "lib", tmp_path / "conv"
+    lib_dir.mkdir()
+    iso_dir.mkdir()
+    (lib_dir / "LIBH.SPF").write_text("PROC LIBH\nG1 X10 Y10 F200\nHELPR\nM17\n")
+    (lib_dir / "HELPR.SPF").write_text("PROC HELPR\nG1 X30 Y5\nM17\n")
+    for name in ("LIBH", "HELPR"):
+        conv = nctrans.transpile((lib_dir / f"{name}.SPF").read_text(), read="sinumerik",
+                                 write="iso-m")
+        number = conv.text.split("\n")[1].split()[0]            # the O-number line: O9115
+        (iso_dir / f"{number}.nc").write_text(conv.text)
+        (iso_dir / f"{name}.nc").write_text(conv.text)
+    for cwd in (tmp_path, iso_dir):
+        monkeypatch.chdir(cwd)
+        same = nctrans.equiv(lib_dir / "LIBH.SPF", iso_dir / "LIBH.nc", read_a="sinumerik",
+                             read_b="iso-m")
+        assert same, same.message
+        assert same.records == (3, 3)          # X10 Y10, the sibling's X30 Y5, the caller's end
+    (lib_dir / "HELPR.SPF").write_text("PROC HELPR\nG1 X31 Y5\nM17\n")
+    monkeypatch.chdir(tmp_path)
+    differs = nctrans.equiv(lib_dir / "LIBH.SPF", iso_dir / "LIBH.nc", read_a="sinumerik",
+                            read_b="iso-m")
+    assert not differs
+    assert differs.difference.a.file.endswith("HELPR.SPF") and differs.difference.a.line == 2

@@ -270,6 +270,8 @@ class CallsMixin:
             return fr.callee, fr.callee.code, 0, 0
         self.stack.pop()
         self.moved = False       # the caller's block resumes after the call: no motion of its own
+        if self.contour_table is not None:  # CONTPRON/CONTDCON in the callee, no EXECUTE there
+            contour_tables.left_by_return(self)
         if fr.section:
             self.sections -= 1
         if fr.modal:

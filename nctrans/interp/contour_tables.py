@@ -103,6 +103,7 @@ class Session:
     modal_round: Optional[tuple] = None
 
     exact_span: Any = None               # the block that programs G9 (non-modal)
+    depth: int = 0                       # call depth of the CONTPRON/CONTDCON (len(it.stack))
 
     def note_mode(self, it, group: str) -> None:
         if group == "exact_stop_once":
@@ -180,6 +181,7 @@ def run_call(it, s: n.SubCall, what: str) -> None:
     cols = PREPARE_COLS if what == "prepare" else DECODE_COLS
     session = Session(what, table if isinstance(table, Array) else None,
                       str(args[0].key).upper() if args else "?", mach, nn, mode, it.span)
+    session.depth = len(it.stack)
     if args and session.table is None:
         session.problems.append((it.span, f"{name}: {args[0].key} is not an array"))
     elif session.table is not None and (len(session.table.dims) != 2 or session.table.dims[1] != cols):
@@ -199,12 +201,31 @@ def run_call(it, s: n.SubCall, what: str) -> None:
     import copy
     st = copy.copy(it.st)
     st.groups = dict(it.st.groups)
+    from nctrans.interp.offsets import copy_frame
+    # the frame is edited in place (offsets._h_frame): keep a copy to compare and restore
     session.saved = (it.pos, it.mpos, it.st, it.last_from, it.last_arc, it.css_surface,
-                     dict(it.spelt_codes), it.off.total, it.frame)
+                     dict(it.spelt_codes), it.off.total, copy_frame(it.frame))
     it.st = st
     it.css_surface = None
     it.contour_table = session
     it.capture = _Capture(it, session)
+
+
+def _close(it, session) -> bool:
+    """End the table session: position, modal state and frame as they were at the call (the
+    blocks between only described the contour). True where the blocks changed a frame or offset."""
+    from nctrans.interp.offsets import copy_frame
+    (it.pos, it.mpos, it.st, it.last_from, it.last_arc, it.css_surface, spelt, total,
+     frame) = session.saved
+    it.spelt_codes.clear()
+    it.spelt_codes.update(spelt)
+    it.capture = None
+    it.contour_table = None
+    changed = it.off.total != total or any(
+        getattr(it.frame, slot) != getattr(frame, slot) for slot in type(frame).__slots__)
+    if changed:
+        copy_frame(frame, it.frame)
+    return changed
 
 
 def _omitted(e) -> bool:
@@ -220,6 +241,18 @@ def unclosed(it) -> None:
     it.contour_table = None
     _problem(it, f"the table of {session.name} is never ended: no EXECUTE after this call before the "
              "program ends (seed L23300); the blocks after it were only read and moved nothing",
+             session.span)
+
+
+def left_by_return(it) -> None:
+    """A subprogram returned between its CONTPRON/CONTDCON and EXECUTE: the table is refused at
+    the call and the session ends there, so the caller's blocks move again (they are no contour)."""
+    session = it.contour_table
+    if session is None or session.depth <= len(it.stack):
+        return
+    _close(it, session)
+    _problem(it, f"the table of {session.name} is never ended: its subprogram returned with no "
+             "EXECUTE (seed L23300); the blocks after the call were only read and moved nothing",
              session.span)
 
 
@@ -244,21 +277,15 @@ def note_corner(it, kind: str, value: float, dialect: str) -> None:
 def execute(it, s: n.SubCall) -> None:
     """EXECUTE(ERR): the table from the moves read since CONTPRON/CONTDCON; ERR 0 or 1."""
     session = it.contour_table
-    err_ref = it.ev.make_ref(s.args[0]) if s.args and type(s.args[0]) is n.Var else None
     if session is None:
         _problem(it, "EXECUTE without CONTPRON or CONTDCON before it: nothing to end")
         return
     moves = list(it.capture)
-    (it.pos, it.mpos, it.st, it.last_from, it.last_arc, it.css_surface, spelt, total,
-     frame) = session.saved
-    it.spelt_codes.clear()
-    it.spelt_codes.update(spelt)
-    it.capture = None
-    it.contour_table = None
+    frame_changed = _close(it, session)
     problems = list(session.problems)
-    if it.off.total != total or it.frame is not frame:
+    if frame_changed:
         problems.append((it.span, "a frame or offset changed between the call and EXECUTE (seed "
-                         "L23290)"))
+                         "L23290); the frame of the call is in force again"))
     rows = None
     if not problems:
         try:
@@ -281,6 +308,9 @@ def execute(it, s: n.SubCall) -> None:
                     table.set((r, c), float(v))
         if session.kind == "prepare" and isinstance(session.nn, Ref):
             session.nn.set(int(count))
+    # ERR is resolved last, after the session is closed and its findings said: a bad ERR (an
+    # undefined name, an index error) is said at this line and leaves the run as at the call
+    err_ref = it.ev.make_ref(s.args[0]) if s.args and type(s.args[0]) is n.Var else None
     if isinstance(err_ref, Ref):
         err_ref.set(1 if problems else 0)
 
