@@ -508,3 +508,17 @@ def test_a_subprogram_that_returns_without_execute_gives_the_caller_its_moves_ba
     ends = [(r.kind, r.end["X"], r.end["Y"]) for r in recs if r.kind in ("rapid", "linear")]
     # line 1's rapid, then the caller's two moves after the return
     assert ends == [("rapid", 0.0, 0.0), ("linear", 50.0, 50.0), ("rapid", 0.0, 0.0)]
+
+
+def test_values_where_the_calls_write_their_results_are_said():
+    """NN and ERR receive the call's results (seed L23242, L23247): `CONTPRON(T,"L",3)` refused
+    the table with no word before, and `EXECUTE(3)` dropped the status silently."""
+    head = 'DEF REAL TABC[12,11]\nDEF INT NN\nG18 G0 X0 Z0 F100\n'
+    _, _, diags = run(head + 'CONTPRON(TABC,"L",3)\nG1 X10 Z-5\nEXECUTE(NN)\nM30\n')
+    # said at the CONTPRON line (4), as the other refusals of the call are
+    assert [(d.rule, d.line) for d in diags if d.severity == "error"] == [("NC242", 4)]
+    assert "NN must be a variable" in " ".join(d.message for d in diags)
+    _, _, diags = run(head + 'CONTPRON(TABC,"L",NN)\nG1 X10 Z-5\nEXECUTE(3)\nM30\n')
+    assert [(d.rule, d.line) for d in diags if d.severity == "error"] == [("NC242", 6)]
+    _, _, diags = run(head + 'CONTPRON(TABC,"L",NN)\nG1 X10 Z-5\nEXECUTE(NN)\nM30\n')
+    assert [d for d in diags if d.severity == "error"] == []

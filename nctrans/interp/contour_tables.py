@@ -187,6 +187,11 @@ def run_call(it, s: n.SubCall, what: str) -> None:
     elif session.table is not None and (len(session.table.dims) != 2 or session.table.dims[1] != cols):
         session.problems.append((it.span, f"{name}: the table {session.name} must be declared "
                                  f"[rows, {cols}] (seed {'L23336' if cols == 11 else 'L23640'})"))
+    if what == "prepare" and len(args) > 2 and not _omitted(args[2]) and type(args[2]) is not n.Var:
+        # NN is written by the call ("result variable", seed L23242): a value there cannot
+        # take the count
+        session.problems.append((it.span, "CONTPRON: NN must be a variable, which receives the "
+                                 "number of relief cuts (seed L23242)"))
     if what == "prepare" and mach not in ("G", "L", "N", "P"):
         session.problems.append((it.span, f"CONTPRON machining type {mach!r}: the seed knows G, L, N, "
                                  "P (L23236-23240)"))
@@ -311,6 +316,9 @@ def execute(it, s: n.SubCall) -> None:
     # ERR is resolved last, after the session is closed and its findings said: a bad ERR (an
     # undefined name, an index error) is said at this line and leaves the run as at the call
     err_ref = it.ev.make_ref(s.args[0]) if s.args and type(s.args[0]) is n.Var else None
+    if s.args and not _omitted(s.args[0]) and type(s.args[0]) is not n.Var:
+        _problem(it, "EXECUTE: ERR must be a variable, which receives 0 or 1 (seed L23247); "
+                 "the status is not kept")
     if isinstance(err_ref, Ref):
         err_ref.set(1 if problems else 0)
 
