@@ -96,24 +96,19 @@ class CycleCallsMixin:
             self.diag("NC132", "warning", f"canned cycle {kind}: {'; '.join(problems)} (a control may "
                       "alarm here; the analysed motion is nctrans' reading of these values)")
 
-    def _position_at(self) -> str:
-        mode = self.__dict__.get("_cycle_positioning")
-        if mode is None:
-            mode = self._cycle_positioning = cycle_table().position_at(
-                self.program.dialect, self.program.meta.get("profile"))
-        return mode
-
-    def _tap_end(self) -> str:
-        mode = self.__dict__.get("_cycle_tap_end")
-        if mode is None:
-            mode = self._cycle_tap_end = cycle_table().tap_end(
-                self.program.dialect, self.program.meta.get("profile"))
-        return mode
+    def _cycle_rule(self, name: str) -> str:
+        """A dialect/profile rule of rules/cycles.toml (`position_at`, `tap_end`), looked up once
+        per run: the cycle table's method of that name for this program's dialect and profile."""
+        rules = self.__dict__.setdefault("_cycle_rules", {})
+        if name not in rules:
+            rules[name] = getattr(cycle_table(), name)(self.program.dialect,
+                                                       self.program.meta.get("profile"))
+        return rules[name]
 
     def _expand(self, kind, hole, approach, bottom, retract, p, repeat=1, step=None,
                 steps=None, own: Optional[dict] = None) -> None:
         st = self.st
-        seed_tap = steps is None and kind in ("tap", "tap_left") and self._tap_end() == "stopped"
+        seed_tap = steps is None and kind in ("tap", "tap_left") and self._cycle_rule("tap_end") == "stopped"
         if seed_tap:
             # the spindle an earlier hole's tap stopped is turned by this one (rules [tapping]);
             # one the program stopped (M5, a tool change) is not: NC209 at the feed in, and at
@@ -134,7 +129,7 @@ class CycleCallsMixin:
                                  peck=p.get("peck"), dwell_s=p.get("dwell"), shift=p.get("shift"),
                                  feed=feed, spindle_dir=(own or {}).get("spindle_dir", st.spindle_dir),
                                  units_mm=st.scale == 1.0, repeat=repeat, step=step,
-                                 position_at=self._position_at(),
+                                 position_at=self._cycle_rule("position_at"),
                                  **{k: v for k, v in (own or {}).items() if k != "spindle_dir"})
         elif callable(steps):
             steps = steps(feed)

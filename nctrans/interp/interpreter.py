@@ -177,6 +177,7 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         self.unmodelled_motion: Optional[str] = None       # unmodelled motion code in force (G34 ...)
         self.corner = None              # corner_elements.CornerStage while RND/CHF ... is in play
         self.contour_table = None       # contour_tables.Session between CONTPRON/CONTDCON and EXECUTE
+        self._diameter_reads: set = set()  # (file, line) of X position reads under DIAMON said (NC138)
         self.contour_procs = contour_tables.kinds(program)
         self.contour_offset = 0.0       # Sinumerik OFFN (contour_offset.py)
         self._unmodelled_at = None                          # the span of the block that set it
@@ -233,10 +234,9 @@ class Interpreter(FlowMixin, CallsMixin, StatementsMixin, MotionMixin, RecordsMi
         line (NC138), once per line."""
         if axis == "X" and self.st.diameter:
             span = self.span
-            line = span.line if span is not None else 0
-            said = self.__dict__.setdefault("_diameter_reads", set())
-            if line not in said:
-                said.add(line)
+            where = (span.file, span.line) if span is not None else None
+            if where not in self._diameter_reads:
+                self._diameter_reads.add(where)
                 self.diag("NC138", "warning", "the work position of X is read under diameter "
                           "programming (DIAMON): nctrans gives the radius; whether the control gives "
                           "the diameter here is not documented in the seeds [GK], so what this value "
